@@ -1,0 +1,329 @@
+//! Request and response bodies (JSON, SI units; every field name ends in
+//! its unit, non-dimensional values sit beside them with `_nondim`).
+//! The same types serve the CLI, the HTTP API and the job queue.
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+/// The cable. Give `mass_per_length_kg_m`, or `density_kg_m3` and `area_m2`.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, ToSchema)]
+pub struct CableInput {
+    /// Mass per unit length ρA (kg/m).
+    #[schema(example = 0.078, exclusive_minimum = 0.0)]
+    pub mass_per_length_kg_m: Option<f64>,
+    /// Material density ρ (kg/m³), with `area_m2`.
+    #[schema(example = 7800.0, exclusive_minimum = 0.0)]
+    pub density_kg_m3: Option<f64>,
+    /// Cross-section area A (m²), with `density_kg_m3`.
+    #[schema(example = 1e-5, exclusive_minimum = 0.0)]
+    pub area_m2: Option<f64>,
+}
+
+/// The aerostat at the top of the cable.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct AerostatInput {
+    /// Net buoyancy F = F_b − m g (N): the upward pull on the cable.
+    #[schema(example = 1000.0, exclusive_minimum = 0.0)]
+    pub net_buoyancy_n: f64,
+    /// Aerostat mass m (kg).
+    #[serde(default)]
+    #[schema(example = 10.0, minimum = 0.0)]
+    pub mass_kg: f64,
+}
+
+/// Which cable model, and its discretisation.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct ModelInput {
+    /// Model kind.
+    #[serde(default)]
+    pub kind: ModelKind,
+    /// Number of finite elements (2..=2000).
+    #[serde(default = "default_elements")]
+    #[schema(example = 50, minimum = 2, maximum = 2000)]
+    pub elements: usize,
+}
+
+impl Default for ModelInput {
+    fn default() -> Self {
+        Self { kind: ModelKind::LinearString, elements: default_elements() }
+    }
+}
+
+fn default_elements() -> usize {
+    50
+}
+
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelKind {
+    /// Linear string with end mass (thesis ch. 2–4).
+    #[default]
+    LinearString,
+}
+
+/// The physical system and its model: common to every request.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct SystemInput {
+    pub cable: CableInput,
+    pub aerostat: AerostatInput,
+    /// Initial cable length L0 (m), the length scale.
+    #[serde(default = "default_initial_length")]
+    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    pub initial_length_m: f64,
+    /// Gravitational acceleration (m/s²).
+    #[serde(default = "default_gravity")]
+    #[schema(example = 9.81, exclusive_minimum = 0.0)]
+    pub gravity_m_s2: f64,
+    #[serde(default)]
+    pub model: ModelInput,
+}
+
+fn default_initial_length() -> f64 {
+    1.0
+}
+
+fn default_gravity() -> f64 {
+    9.81
+}
+
+/// A deployment profile L(t). Positive rates lengthen, negative shorten.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ProfileInput {
+    /// L = L0 + v t.
+    ConstantRate {
+        /// Winch rate v (m/s); negative retrieves.
+        #[schema(example = 10.0)]
+        rate_m_s: f64,
+        /// Length at which the winch stops (m); none: never stops.
+        #[serde(default)]
+        target_length_m: Option<f64>,
+    },
+    /// From rest: L = L0 + a t²/2.
+    ConstantAcceleration {
+        /// Winch acceleration a (m/s²); negative retrieves.
+        #[schema(example = 0.5)]
+        acceleration_m_s2: f64,
+        /// Length at which the winch stops (m); none: never stops.
+        #[serde(default)]
+        target_length_m: Option<f64>,
+    },
+}
+
+/// Instantaneous deployment state for a stability query.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct StateInput {
+    /// Cable length L (m).
+    #[schema(example = 500.0, exclusive_minimum = 0.0)]
+    pub length_m: f64,
+    /// Winch rate L̇ (m/s).
+    #[serde(default)]
+    #[schema(example = 10.0)]
+    pub rate_m_s: f64,
+    /// Winch acceleration L̈ (m/s²).
+    #[serde(default)]
+    pub acceleration_m_s2: f64,
+}
+
+/// `POST /api/v1/stability`: the QEP spectrum at one state.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct StabilityRequest {
+    #[serde(flatten)]
+    pub system: SystemInput,
+    pub state: StateInput,
+    /// How many modes (eigenvalues with Im ≥ 0, by frequency) to return.
+    #[serde(default = "default_modes")]
+    #[schema(example = 3, minimum = 1, maximum = 4000)]
+    pub modes: usize,
+}
+
+fn default_modes() -> usize {
+    3
+}
+
+/// `POST /api/v1/critical`: critical time of one profile.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct CriticalRequest {
+    #[serde(flatten)]
+    pub system: SystemInput,
+    pub profile: ProfileInput,
+    /// Also solve the full QEP at the start, half-way, and 0.1 % either side
+    /// of t* to confirm the answer (about 10 ms at 50 elements). Profiles
+    /// whose criterion is the QEP itself (accelerating) always do.
+    #[serde(default)]
+    pub confirm_with_qep: bool,
+}
+
+/// `POST /api/v1/safe-rate`: largest constant rate that reaches a target.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct SafeRateRequest {
+    #[serde(flatten)]
+    pub system: SystemInput,
+    /// Elevation (cable length) to reach (m).
+    #[schema(example = 1200.0, exclusive_minimum = 0.0)]
+    pub target_elevation_m: f64,
+}
+
+/// An evenly spaced grid of rates.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct RateGrid {
+    /// Smallest rate (m/s).
+    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    pub min: f64,
+    /// Largest rate (m/s).
+    #[schema(example = 100.0, exclusive_minimum = 0.0)]
+    pub max: f64,
+    /// Number of rates.
+    #[schema(example = 100, minimum = 1, maximum = 1000000)]
+    pub count: usize,
+}
+
+/// `POST /api/v1/charts`: t* and h* against rate, one series per buoyancy.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct ChartRequest {
+    #[serde(flatten)]
+    pub system: SystemInput,
+    /// Rates of the chart (m/s).
+    pub rates_m_s: RateGrid,
+    /// Net buoyancies, one series each (N); default: the aerostat's.
+    #[serde(default)]
+    pub net_buoyancies_n: Vec<f64>,
+}
+
+/// Scales and non-dimensional groups of the system.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct Groups {
+    /// Wave speed sqrt(F/ρA) (m/s).
+    pub wave_speed_m_s: f64,
+    /// Time scale L0/c (s).
+    pub time_scale_s: f64,
+    /// F̃ = F/(ρA g L0).
+    pub buoyancy_ratio_nondim: f64,
+    /// m̃ = m/(ρA L0).
+    pub mass_ratio_nondim: f64,
+    /// F/(ρA g) (m): no rate is safe above it.
+    pub static_lift_limit_m: f64,
+}
+
+/// One eigenvalue λ of λ²M + λC + K = 0.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct EigenvalueOutput {
+    /// Re λ (1/s): growth rate if positive.
+    pub re_1_s: f64,
+    /// Im λ (rad/s): circular frequency.
+    pub im_1_s: f64,
+    /// Re λ in units of 1/t̄.
+    pub re_nondim: f64,
+    /// Im λ in units of 1/t̄.
+    pub im_nondim: f64,
+    /// Im λ / 2π (Hz).
+    pub frequency_hz: f64,
+}
+
+/// The deployment state, SI and non-dimensional.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct StateOutput {
+    pub length_m: f64,
+    pub rate_m_s: f64,
+    pub acceleration_m_s2: f64,
+    pub length_nondim: f64,
+    pub rate_nondim: f64,
+    pub acceleration_nondim: f64,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct StabilityResponse {
+    /// Every Re λ ≤ tolerance.
+    pub stable: bool,
+    /// Largest Re λ (1/s).
+    pub max_real_1_s: f64,
+    /// Largest Re λ (1/t̄).
+    pub max_real_nondim: f64,
+    /// Tolerance on Re λ used for the verdict (1/s).
+    pub tolerance_1_s: f64,
+    /// The first `modes` eigenvalues with Im λ ≥ 0, by frequency.
+    pub eigenvalues: Vec<EigenvalueOutput>,
+    pub state: StateOutput,
+    pub groups: Groups,
+    pub elements: usize,
+}
+
+/// A QEP solve made to confirm a critical time.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct QepProbeOutput {
+    pub time_s: f64,
+    pub length_m: f64,
+    /// Largest Re λ there (1/s).
+    pub max_real_1_s: f64,
+    pub stable: bool,
+    pub expected_stable: bool,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct CriticalResponse {
+    /// t* (s): first unstable instant; 0 if unstable at once, null if never.
+    pub critical_time_s: Option<f64>,
+    /// t* in units of L0/c.
+    pub critical_time_nondim: Option<f64>,
+    /// h* = L(t*) (m): the highest safe elevation; null if never unstable.
+    pub max_elevation_m: Option<f64>,
+    /// Continuum estimate of h* (m): (F/ρA − v²)/g for constant rate; the
+    /// root-tension estimate for constant acceleration; null when shortening.
+    pub closed_form_elevation_m: Option<f64>,
+    /// `immediate`, `during` or `never`.
+    pub onset: String,
+    /// Plain-language account of the answer.
+    pub explanation: String,
+    /// How t* was located.
+    pub method: String,
+    /// Whether every QEP probe agreed with the answer (true if none were made).
+    pub confirmed_by_qep: bool,
+    pub qep_probes: Vec<QepProbeOutput>,
+    pub groups: Groups,
+    pub elements: usize,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct SafeRateResponse {
+    /// Largest safe constant rate (m/s); null when none is safe.
+    pub max_rate_m_s: Option<f64>,
+    /// The same as ṽ = v/c.
+    pub max_rate_nondim: Option<f64>,
+    /// Continuum estimate sqrt(F/ρA − g H) (m/s); null above the static limit.
+    pub closed_form_rate_m_s: Option<f64>,
+    /// Time to reach the target at the safe rate (s).
+    pub time_to_target_s: Option<f64>,
+    /// Why no rate is safe, when none is.
+    pub reason: Option<String>,
+    pub target_elevation_m: f64,
+    pub groups: Groups,
+    pub elements: usize,
+}
+
+/// One chart point.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct ChartPointOutput {
+    /// Deployment rate (m/s).
+    pub rate_m_s: f64,
+    /// t* (s); 0 if unstable at once.
+    pub critical_time_s: f64,
+    /// h* (m).
+    pub max_elevation_m: f64,
+    /// (F/ρA − v²)/g (m), clipped at 0.
+    pub closed_form_elevation_m: f64,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct ChartSeriesOutput {
+    /// Net buoyancy of this series (N).
+    pub net_buoyancy_n: f64,
+    /// Wave speed sqrt(F/ρA) of this series (m/s): rates above it fail at once.
+    pub wave_speed_m_s: f64,
+    pub points: Vec<ChartPointOutput>,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct ChartResponse {
+    pub series: Vec<ChartSeriesOutput>,
+    pub elements: usize,
+}

@@ -1,0 +1,299 @@
+//! Runs one request against the numerical core: validates and converts the
+//! SI input, calls the core, and converts the outcome back to SI output.
+
+use crate::contract::dto::*;
+use crate::numerics::chart::{self, Parallelism};
+use crate::numerics::params::{AerostatSystem, InvalidInput, Kinematics, require_finite, require_positive};
+use crate::numerics::profile::Profile;
+use crate::numerics::qep::QepError;
+use crate::numerics::string::StringModel;
+use crate::numerics::string::critical::{self, ImmediateCause, Onset, SafeRate, SearchConfig, SearchMethod};
+
+/// Why a request was not answered.
+#[derive(Debug, thiserror::Error)]
+pub enum RequestError {
+    /// Bad input: the field and the reason (HTTP 422/400).
+    #[error(transparent)]
+    Invalid(#[from] InvalidInput),
+    /// The numerics failed on valid input (HTTP 500; should not happen).
+    #[error("numerical failure: {0}")]
+    Numerical(#[from] QepError),
+    /// The work was cancelled through its progress handle.
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// Progress reporting and cancellation for long requests.
+pub trait Progress: Sync {
+    /// `done` of `total` units finished.
+    fn report(&self, done: usize, total: usize);
+    /// Should the work stop?
+    fn cancelled(&self) -> bool {
+        false
+    }
+}
+
+/// Progress that goes nowhere.
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn report(&self, _: usize, _: usize) {}
+}
+
+impl CableInput {
+    /// ρA (kg/m) from either form.
+    pub fn mass_per_length(&self) -> Result<f64, InvalidInput> {
+        match (self.mass_per_length_kg_m, self.density_kg_m3, self.area_m2) {
+            (Some(rho_a), None, None) => require_positive("cable.mass_per_length_kg_m", rho_a),
+            (None, Some(rho), Some(a)) => {
+                Ok(require_positive("cable.density_kg_m3", rho)? * require_positive("cable.area_m2", a)?)
+            }
+            (Some(_), _, _) => Err(InvalidInput::new(
+                "cable.mass_per_length_kg_m",
+                "give either mass_per_length_kg_m or density_kg_m3 with area_m2, not both",
+            )),
+            (None, Some(_), None) => Err(InvalidInput::new("cable.area_m2", "is required with density_kg_m3")),
+            (None, None, Some(_)) => Err(InvalidInput::new("cable.density_kg_m3", "is required with area_m2")),
+            (None, None, None) => Err(InvalidInput::new(
+                "cable.mass_per_length_kg_m",
+                "is required (or density_kg_m3 with area_m2)",
+            )),
+        }
+    }
+}
+
+impl SystemInput {
+    pub fn system(&self) -> Result<AerostatSystem, InvalidInput> {
+        AerostatSystem::new(
+            self.cable.mass_per_length()?,
+            self.aerostat.net_buoyancy_n,
+            self.aerostat.mass_kg,
+            self.initial_length_m,
+            self.gravity_m_s2,
+        )
+    }
+
+    pub fn model(&self) -> Result<StringModel, InvalidInput> {
+        let system = self.system()?;
+        match self.model.kind {
+            ModelKind::LinearString => StringModel::new(system, self.model.elements),
+        }
+    }
+}
+
+impl ProfileInput {
+    pub fn profile(&self, initial_length_m: f64) -> Result<Profile, InvalidInput> {
+        match *self {
+            Self::ConstantRate { rate_m_s, target_length_m } => {
+                Profile::constant_rate(initial_length_m, rate_m_s, target_length_m)
+            }
+            Self::ConstantAcceleration { acceleration_m_s2, target_length_m } => {
+                Profile::constant_acceleration(initial_length_m, acceleration_m_s2, target_length_m)
+            }
+        }
+    }
+}
+
+pub fn groups(s: &AerostatSystem) -> Groups {
+    Groups {
+        wave_speed_m_s: s.wave_speed_m_s(),
+        time_scale_s: s.time_scale_s(),
+        buoyancy_ratio_nondim: s.buoyancy_ratio(),
+        mass_ratio_nondim: s.mass_ratio(),
+        static_lift_limit_m: s.static_lift_limit_m(),
+    }
+}
+
+/// Largest number of modes a stability answer lists.
+pub const MAX_MODES: usize = 4000;
+
+pub fn stability(req: &StabilityRequest) -> Result<StabilityResponse, RequestError> {
+    let model = req.system.model()?;
+    let sys = model.system;
+    let k = Kinematics {
+        length_m: require_positive("state.length_m", req.state.length_m)?,
+        rate_m_s: require_finite("state.rate_m_s", req.state.rate_m_s)?,
+        acceleration_m_s2: require_finite("state.acceleration_m_s2", req.state.acceleration_m_s2)?,
+    };
+    if req.modes == 0 || req.modes > MAX_MODES {
+        return Err(InvalidInput::new("modes", format!("must be between 1 and {MAX_MODES}, got {}", req.modes)).into());
+    }
+    let s = sys.to_nondim(k);
+    let spectrum = model.spectrum(s)?;
+    let to_si = |v: f64| sys.eigenvalue_to_si(v);
+    let eigenvalues = spectrum
+        .modes()
+        .into_iter()
+        .take(req.modes)
+        .map(|e| EigenvalueOutput {
+            re_1_s: to_si(e.re),
+            im_1_s: to_si(e.im),
+            re_nondim: e.re,
+            im_nondim: e.im,
+            frequency_hz: to_si(e.im) / (2.0 * std::f64::consts::PI),
+        })
+        .collect();
+    Ok(StabilityResponse {
+        stable: spectrum.is_stable(),
+        max_real_1_s: to_si(spectrum.max_real),
+        max_real_nondim: spectrum.max_real,
+        tolerance_1_s: to_si(spectrum.tolerance()),
+        eigenvalues,
+        state: StateOutput {
+            length_m: k.length_m,
+            rate_m_s: k.rate_m_s,
+            acceleration_m_s2: k.acceleration_m_s2,
+            length_nondim: s.length,
+            rate_nondim: s.rate,
+            acceleration_nondim: s.acceleration,
+        },
+        groups: groups(&sys),
+        elements: model.elements(),
+    })
+}
+
+pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError> {
+    let model = req.system.model()?;
+    let sys = model.system;
+    let profile = req.profile.profile(sys.initial_length_m)?;
+    let result = critical::critical_time(&model, &profile, SearchConfig { confirm_with_qep: req.confirm_with_qep })?;
+    let closed_form = match req.profile {
+        ProfileInput::ConstantRate { rate_m_s, .. } if rate_m_s > 0.0 => Some(sys.closed_form_elevation_m(rate_m_s).max(0.0)),
+        ProfileInput::ConstantAcceleration { acceleration_m_s2, .. } if acceleration_m_s2 > 0.0 => {
+            Some(sys.closed_form_elevation_accelerating_m(acceleration_m_s2).max(0.0))
+        }
+        _ => None,
+    };
+    let (onset, explanation, max_elevation_m) = match result.onset {
+        Onset::Immediate(cause) => {
+            let why = match cause {
+                ImmediateCause::RateAboveWaveSpeed => format!(
+                    "unstable at t = 0: the rate reaches the transverse wave speed of the cable (about {:.1} m/s at {} m)",
+                    sys.wave_speed_m_s(),
+                    sys.initial_length_m
+                ),
+                ImmediateCause::Shortening => {
+                    "unstable at t = 0: a shortening cable has negative damping and is unstable at every instant".into()
+                }
+                ImmediateCause::UnstableInitialState => {
+                    "unstable at t = 0: the initial state is already beyond the stability limit".into()
+                }
+            };
+            ("immediate", why, Some(sys.initial_length_m))
+        }
+        Onset::During { time_s, length_m } => (
+            "during",
+            format!("stable until t* = {time_s:.3} s, when the cable is {length_m:.1} m long"),
+            Some(length_m),
+        ),
+        Onset::Never { until_s } => (
+            "never",
+            format!(
+                "stable for the whole deployment (checked up to t = {until_s:.3} s, length {:.1} m)",
+                profile.kinematics(until_s).length_m
+            ),
+            None,
+        ),
+    };
+    let method = match result.method {
+        SearchMethod::StiffnessInertia => "stiffness_inertia",
+        SearchMethod::NegativeDamping => "negative_damping",
+        SearchMethod::DivergenceConfirmedByQep => "divergence_confirmed_by_qep",
+        SearchMethod::QepScan => "qep_scan",
+    };
+    let t = result.time_s();
+    Ok(CriticalResponse {
+        critical_time_s: t,
+        critical_time_nondim: t.map(|t| t / sys.time_scale_s()),
+        max_elevation_m,
+        closed_form_elevation_m: closed_form,
+        onset: onset.into(),
+        explanation,
+        method: method.into(),
+        confirmed_by_qep: result.confirmed(),
+        qep_probes: result
+            .probes
+            .iter()
+            .map(|p| QepProbeOutput {
+                time_s: p.time_s,
+                length_m: p.length_m,
+                max_real_1_s: p.max_real_1_s,
+                stable: p.stable,
+                expected_stable: p.expected_stable,
+            })
+            .collect(),
+        groups: groups(&sys),
+        elements: model.elements(),
+    })
+}
+
+pub fn safe_rate(req: &SafeRateRequest) -> Result<SafeRateResponse, RequestError> {
+    let model = req.system.model()?;
+    let sys = model.system;
+    let target = require_positive("target_elevation_m", req.target_elevation_m)?;
+    let answer = critical::safe_rate(&model, target)?;
+    let closed = sys.net_buoyancy_n / sys.mass_per_length_kg_m - sys.gravity_m_s2 * target;
+    let closed_form_rate_m_s = (closed > 0.0).then(|| closed.sqrt());
+    let (max_rate_m_s, max_rate_nondim, reason) = match answer {
+        SafeRate::Rate { rate_m_s, rate_nondim } => (Some(rate_m_s), Some(rate_nondim), None),
+        SafeRate::NoSafeRate { reason } => (None, None, Some(reason)),
+    };
+    Ok(SafeRateResponse {
+        max_rate_m_s,
+        max_rate_nondim,
+        closed_form_rate_m_s,
+        time_to_target_s: max_rate_m_s.map(|v| (target - sys.initial_length_m) / v),
+        reason,
+        target_elevation_m: target,
+        groups: groups(&sys),
+        elements: model.elements(),
+    })
+}
+
+/// Number of points a chart request asks for (for admission limits).
+pub fn chart_points(req: &ChartRequest) -> usize {
+    req.rates_m_s.count.saturating_mul(req.net_buoyancies_n.len().max(1))
+}
+
+pub fn chart(req: &ChartRequest, parallelism: Parallelism, progress: &dyn Progress) -> Result<ChartResponse, RequestError> {
+    let model = req.system.model()?;
+    let sys = model.system;
+    if chart_points(req) > chart::MAX_CHART_POINTS {
+        return Err(InvalidInput::new(
+            "rates_m_s.count",
+            format!(
+                "the chart would have {} points; at most {} are allowed",
+                chart_points(req),
+                chart::MAX_CHART_POINTS
+            ),
+        )
+        .into());
+    }
+    let rates = chart::rate_grid(req.rates_m_s.min, req.rates_m_s.max, req.rates_m_s.count)?;
+    let buoyancies = if req.net_buoyancies_n.is_empty() { vec![sys.net_buoyancy_n] } else { req.net_buoyancies_n.clone() };
+    let report = |done: usize, total: usize| progress.report(done, total);
+    let series = chart::deployment_chart(&sys, model.elements(), &rates, &buoyancies, parallelism, &report)?;
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    Ok(ChartResponse {
+        series: series
+            .into_iter()
+            .map(|s| ChartSeriesOutput {
+                net_buoyancy_n: s.net_buoyancy_n,
+                wave_speed_m_s: (s.net_buoyancy_n / sys.mass_per_length_kg_m).sqrt(),
+                points: s
+                    .points
+                    .into_iter()
+                    .map(|p| ChartPointOutput {
+                        rate_m_s: p.rate_m_s,
+                        critical_time_s: p.critical_time_s,
+                        max_elevation_m: p.max_elevation_m,
+                        closed_form_elevation_m: p.closed_form_elevation_m,
+                    })
+                    .collect(),
+            })
+            .collect(),
+        elements: model.elements(),
+    })
+}

@@ -1,0 +1,15 @@
+//! tetherplan: deployment planning for tethered aerostats.
+//!
+//! * [`numerics`]: the pure numerical core (no I/O): cable models, the
+//!   quadratic eigenvalue stability analysis, critical-time searches and
+//!   deployment charts.
+//! * [`contract`]: the JSON request/response types shared by the CLI, the
+//!   HTTP API and the job queue (SI units, field names end in their unit),
+//!   and the functions that run one request.
+//!
+//! Invariants: `numerics` never touches serde, tokio, axum or SQLite;
+//! invalid input is an `Err` naming the field; physical outcomes
+//! ("unstable at t = 0", "no safe rate") are answers, not errors.
+
+pub mod contract;
+pub mod numerics;

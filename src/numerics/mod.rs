@@ -1,0 +1,11 @@
+//! The numerical core: pure functions of `f64`, faer and rayon. No I/O, no
+//! serialisation, no async (a test in `tests/tidy.rs` keeps it so).
+//! Inputs are SI; inside, the models work non-dimensionally (SPEC §1).
+
+pub mod chart;
+pub mod mesh;
+pub mod params;
+pub mod profile;
+pub mod qep;
+pub mod string;
+pub mod tridiag;
