@@ -1,1 +1,110 @@
-fn main(){}
+//! The `tetherplan` binary: CLI subcommands over the JSON contract.
+//! Each reads a request (file or stdin), prints the JSON answer on stdout,
+//! and on bad input prints the error body and exits with status 2.
+
+use std::io::Read;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use tetherplan::contract::{self, Progress, RequestError, dto, run};
+use tetherplan::numerics::chart::Parallelism;
+
+#[derive(Parser)]
+#[command(name = "tetherplan", version, about = "Deployment planning for tethered aerostats")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(clap::Args)]
+struct InputArg {
+    /// Request JSON file; `-` or absent reads standard input.
+    #[arg(long, short)]
+    input: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Eigenvalues and stability verdict at one state.
+    Stability(InputArg),
+    /// Critical time and maximum safe elevation of a deployment profile.
+    Critical(InputArg),
+    /// Largest safe constant rate for a target elevation.
+    SafeRate(InputArg),
+    /// Deployment chart: t* and h* against rate, one series per buoyancy.
+    Chart(InputArg),
+}
+
+fn read_input(arg: &InputArg) -> Result<Vec<u8>, String> {
+    match &arg.input {
+        Some(path) if path.as_os_str() != "-" => {
+            std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))
+        }
+        _ => {
+            let mut buf = Vec::new();
+            std::io::stdin().read_to_end(&mut buf).map_err(|e| format!("cannot read standard input: {e}"))?;
+            Ok(buf)
+        }
+    }
+}
+
+fn print_json(value: &impl Serialize) {
+    println!("{}", serde_json::to_string_pretty(value).expect("responses serialise"));
+}
+
+fn answer<Req: dto::SystemRequest, Resp: Serialize>(
+    arg: &InputArg,
+    run: impl FnOnce(&Req) -> Result<Resp, RequestError>,
+) -> ExitCode {
+    let body = match read_input(arg) {
+        Ok(b) => b,
+        Err(msg) => {
+            print_json(&dto::ErrorBody::new("io", None, msg));
+            return ExitCode::from(2);
+        }
+    };
+    match contract::parse::<Req>(&body).and_then(|req| run(&req)) {
+        Ok(resp) => {
+            print_json(&resp);
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            print_json(&e.body());
+            ExitCode::from(if matches!(e, RequestError::Invalid(_) | RequestError::Malformed(_)) { 2 } else { 1 })
+        }
+    }
+}
+
+/// A progress bar on standard error.
+struct Bar(ProgressBar);
+
+impl Progress for Bar {
+    fn report(&self, done: usize, total: usize) {
+        self.0.set_length(total as u64);
+        self.0.set_position(done as u64);
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match &cli.command {
+        Command::Stability(arg) => answer(arg, run::stability),
+        Command::Critical(arg) => answer(arg, run::critical),
+        Command::SafeRate(arg) => answer(arg, run::safe_rate),
+        Command::Chart(arg) => answer(arg, |req: &dto::ChartRequest| {
+            let bar = ProgressBar::new(run::chart_points(req) as u64);
+            bar.set_style(
+                ProgressStyle::with_template("{spinner} chart [{bar:40}] {pos}/{len} points ({eta})")
+                    .expect("valid template")
+                    .progress_chars("=> "),
+            );
+            let bar = Bar(bar);
+            let out = run::chart(req, Parallelism::Rayon, &bar);
+            bar.0.finish_and_clear();
+            out
+        }),
+    }
+}

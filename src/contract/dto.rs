@@ -130,6 +130,13 @@ pub struct StateInput {
 pub struct StabilityRequest {
     #[serde(flatten)]
     pub system: SystemInput,
+    #[serde(flatten)]
+    pub params: StabilityParams,
+}
+
+/// The fields of a stability request besides the system.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct StabilityParams {
     pub state: StateInput,
     /// How many modes (eigenvalues with Im ≥ 0, by frequency) to return.
     #[serde(default = "default_modes")]
@@ -146,6 +153,13 @@ fn default_modes() -> usize {
 pub struct CriticalRequest {
     #[serde(flatten)]
     pub system: SystemInput,
+    #[serde(flatten)]
+    pub params: CriticalParams,
+}
+
+/// The fields of a critical-time request besides the system.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct CriticalParams {
     pub profile: ProfileInput,
     /// Also solve the full QEP at the start, half-way, and 0.1 % either side
     /// of t* to confirm the answer (about 10 ms at 50 elements). Profiles
@@ -159,6 +173,13 @@ pub struct CriticalRequest {
 pub struct SafeRateRequest {
     #[serde(flatten)]
     pub system: SystemInput,
+    #[serde(flatten)]
+    pub params: SafeRateParams,
+}
+
+/// The fields of a safe-rate request besides the system.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct SafeRateParams {
     /// Elevation (cable length) to reach (m).
     #[schema(example = 1200.0, exclusive_minimum = 0.0)]
     pub target_elevation_m: f64,
@@ -183,6 +204,13 @@ pub struct RateGrid {
 pub struct ChartRequest {
     #[serde(flatten)]
     pub system: SystemInput,
+    #[serde(flatten)]
+    pub params: ChartParams,
+}
+
+/// The fields of a chart request besides the system.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct ChartParams {
     /// Rates of the chart (m/s).
     pub rates_m_s: RateGrid,
     /// Net buoyancies, one series each (N); default: the aerostat's.
@@ -327,3 +355,53 @@ pub struct ChartResponse {
     pub series: Vec<ChartSeriesOutput>,
     pub elements: usize,
 }
+
+/// The one error body of the CLI and the API.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct ErrorBody {
+    pub error: ErrorDetail,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct ErrorDetail {
+    /// Machine-readable kind: `invalid_input`, `malformed_json`,
+    /// `payload_too_large`, `queue_full`, `overloaded`, `not_found`,
+    /// `cancelled`, `internal`.
+    pub code: String,
+    /// The offending field as a JSON path (`cable.mass_per_length_kg_m`), when one is to blame.
+    pub field: Option<String>,
+    /// What is wrong, in words.
+    pub message: String,
+}
+
+impl ErrorBody {
+    pub fn new(code: &str, field: Option<String>, message: impl Into<String>) -> Self {
+        Self { error: ErrorDetail { code: code.into(), field, message: message.into() } }
+    }
+}
+
+/// A request made of the common system part and its own parameters;
+/// the two are parsed separately so that every error names its field
+/// (serde loses the path inside `#[serde(flatten)]`).
+pub trait SystemRequest: Sized {
+    type Params: serde::de::DeserializeOwned;
+    fn from_parts(system: SystemInput, params: Self::Params) -> Self;
+}
+
+macro_rules! system_request {
+    ($($req:ty => $params:ty),* $(,)?) => {$(
+        impl SystemRequest for $req {
+            type Params = $params;
+            fn from_parts(system: SystemInput, params: $params) -> Self {
+                Self { system, params }
+            }
+        }
+    )*};
+}
+
+system_request!(
+    StabilityRequest => StabilityParams,
+    CriticalRequest => CriticalParams,
+    SafeRateRequest => SafeRateParams,
+    ChartRequest => ChartParams,
+);

@@ -8,15 +8,33 @@ pub mod run;
 
 pub use run::{Progress, RequestError};
 
-/// Parses a JSON body; errors name the offending field path.
-pub fn parse<T: serde::de::DeserializeOwned>(body: &[u8]) -> Result<T, RequestError> {
-    let mut de = serde_json::Deserializer::from_slice(body);
-    let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+use crate::numerics::params::InvalidInput;
+
+/// Parses a request body (system part and parameters); errors name the
+/// offending field path.
+pub fn parse<T: dto::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
+    let value: serde_json::Value = serde_json::from_slice(body)
+        .map_err(|e| RequestError::Malformed(e.to_string()))?;
+    if !value.is_object() {
+        return Err(RequestError::Invalid(InvalidInput::new("body", "must be a JSON object")));
+    }
+    let system = parse_value::<dto::SystemInput>(&value)?;
+    let params = parse_value::<T::Params>(&value)?;
+    Ok(T::from_parts(system, params))
+}
+
+/// Deserialises `T` from a JSON value with the error's field path.
+pub fn parse_value<T: serde::de::DeserializeOwned>(value: &serde_json::Value) -> Result<T, RequestError> {
+    serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
-        let inner = e.into_inner();
-        let field = if path == "." || path.is_empty() { "body".to_string() } else { path };
-        RequestError::Invalid(crate::numerics::params::InvalidInput::new(field, inner.to_string()))
-    })?;
-    de.end().map_err(|e| RequestError::Invalid(crate::numerics::params::InvalidInput::new("body", e.to_string())))?;
-    Ok(value)
+        let message = e.into_inner().to_string();
+        let prefix = if path == "." || path.is_empty() { String::new() } else { format!("{path}.") };
+        // serde names a missing field only in its message: lift it into the path.
+        let field = match message.strip_prefix("missing field `").and_then(|rest| rest.split('`').next()) {
+            Some(name) => format!("{prefix}{name}"),
+            None if prefix.is_empty() => "body".to_string(),
+            None => path,
+        };
+        RequestError::Invalid(InvalidInput::new(field, message))
+    })
 }

@@ -12,6 +12,9 @@ use crate::numerics::string::critical::{self, ImmediateCause, Onset, SafeRate, S
 /// Why a request was not answered.
 #[derive(Debug, thiserror::Error)]
 pub enum RequestError {
+    /// The body is not JSON (HTTP 400).
+    #[error("malformed JSON: {0}")]
+    Malformed(String),
     /// Bad input: the field and the reason (HTTP 422/400).
     #[error(transparent)]
     Invalid(#[from] InvalidInput),
@@ -111,12 +114,12 @@ pub fn stability(req: &StabilityRequest) -> Result<StabilityResponse, RequestErr
     let model = req.system.model()?;
     let sys = model.system;
     let k = Kinematics {
-        length_m: require_positive("state.length_m", req.state.length_m)?,
-        rate_m_s: require_finite("state.rate_m_s", req.state.rate_m_s)?,
-        acceleration_m_s2: require_finite("state.acceleration_m_s2", req.state.acceleration_m_s2)?,
+        length_m: require_positive("state.length_m", req.params.state.length_m)?,
+        rate_m_s: require_finite("state.rate_m_s", req.params.state.rate_m_s)?,
+        acceleration_m_s2: require_finite("state.acceleration_m_s2", req.params.state.acceleration_m_s2)?,
     };
-    if req.modes == 0 || req.modes > MAX_MODES {
-        return Err(InvalidInput::new("modes", format!("must be between 1 and {MAX_MODES}, got {}", req.modes)).into());
+    if req.params.modes == 0 || req.params.modes > MAX_MODES {
+        return Err(InvalidInput::new("modes", format!("must be between 1 and {MAX_MODES}, got {}", req.params.modes)).into());
     }
     let s = sys.to_nondim(k);
     let spectrum = model.spectrum(s)?;
@@ -124,7 +127,7 @@ pub fn stability(req: &StabilityRequest) -> Result<StabilityResponse, RequestErr
     let eigenvalues = spectrum
         .modes()
         .into_iter()
-        .take(req.modes)
+        .take(req.params.modes)
         .map(|e| EigenvalueOutput {
             re_1_s: to_si(e.re),
             im_1_s: to_si(e.im),
@@ -155,9 +158,9 @@ pub fn stability(req: &StabilityRequest) -> Result<StabilityResponse, RequestErr
 pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError> {
     let model = req.system.model()?;
     let sys = model.system;
-    let profile = req.profile.profile(sys.initial_length_m)?;
-    let result = critical::critical_time(&model, &profile, SearchConfig { confirm_with_qep: req.confirm_with_qep })?;
-    let closed_form = match req.profile {
+    let profile = req.params.profile.profile(sys.initial_length_m)?;
+    let result = critical::critical_time(&model, &profile, SearchConfig { confirm_with_qep: req.params.confirm_with_qep })?;
+    let closed_form = match req.params.profile {
         ProfileInput::ConstantRate { rate_m_s, .. } if rate_m_s > 0.0 => Some(sys.closed_form_elevation_m(rate_m_s).max(0.0)),
         ProfileInput::ConstantAcceleration { acceleration_m_s2, .. } if acceleration_m_s2 > 0.0 => {
             Some(sys.closed_form_elevation_accelerating_m(acceleration_m_s2).max(0.0))
@@ -230,7 +233,7 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
 pub fn safe_rate(req: &SafeRateRequest) -> Result<SafeRateResponse, RequestError> {
     let model = req.system.model()?;
     let sys = model.system;
-    let target = require_positive("target_elevation_m", req.target_elevation_m)?;
+    let target = require_positive("target_elevation_m", req.params.target_elevation_m)?;
     let answer = critical::safe_rate(&model, target)?;
     let closed = sys.net_buoyancy_n / sys.mass_per_length_kg_m - sys.gravity_m_s2 * target;
     let closed_form_rate_m_s = (closed > 0.0).then(|| closed.sqrt());
@@ -252,7 +255,7 @@ pub fn safe_rate(req: &SafeRateRequest) -> Result<SafeRateResponse, RequestError
 
 /// Number of points a chart request asks for (for admission limits).
 pub fn chart_points(req: &ChartRequest) -> usize {
-    req.rates_m_s.count.saturating_mul(req.net_buoyancies_n.len().max(1))
+    req.params.rates_m_s.count.saturating_mul(req.params.net_buoyancies_n.len().max(1))
 }
 
 pub fn chart(req: &ChartRequest, parallelism: Parallelism, progress: &dyn Progress) -> Result<ChartResponse, RequestError> {
@@ -269,8 +272,8 @@ pub fn chart(req: &ChartRequest, parallelism: Parallelism, progress: &dyn Progre
         )
         .into());
     }
-    let rates = chart::rate_grid(req.rates_m_s.min, req.rates_m_s.max, req.rates_m_s.count)?;
-    let buoyancies = if req.net_buoyancies_n.is_empty() { vec![sys.net_buoyancy_n] } else { req.net_buoyancies_n.clone() };
+    let rates = chart::rate_grid(req.params.rates_m_s.min, req.params.rates_m_s.max, req.params.rates_m_s.count)?;
+    let buoyancies = if req.params.net_buoyancies_n.is_empty() { vec![sys.net_buoyancy_n] } else { req.params.net_buoyancies_n.clone() };
     let report = |done: usize, total: usize| progress.report(done, total);
     let series = chart::deployment_chart(&sys, model.elements(), &rates, &buoyancies, parallelism, &report)?;
     if progress.cancelled() {
@@ -296,4 +299,16 @@ pub fn chart(req: &ChartRequest, parallelism: Parallelism, progress: &dyn Progre
             .collect(),
         elements: model.elements(),
     })
+}
+
+impl RequestError {
+    /// The error body the CLI prints and the API returns.
+    pub fn body(&self) -> ErrorBody {
+        match self {
+            Self::Malformed(m) => ErrorBody::new("malformed_json", Some("body".into()), format!("malformed JSON: {m}")),
+            Self::Invalid(e) => ErrorBody::new("invalid_input", Some(e.field.clone()), format!("{}: {}", e.field, e.reason)),
+            Self::Numerical(e) => ErrorBody::new("internal", None, e.to_string()),
+            Self::Cancelled => ErrorBody::new("cancelled", None, "the work was cancelled"),
+        }
+    }
 }
