@@ -13,7 +13,11 @@ use tetherplan::contract::{self, Progress, RequestError, dto, run};
 use tetherplan::numerics::chart::Parallelism;
 
 #[derive(Parser)]
-#[command(name = "tetherplan", version, about = "Deployment planning for tethered aerostats")]
+#[command(
+    name = "tetherplan",
+    version,
+    about = "Deployment planning for tethered aerostats"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -45,14 +49,19 @@ fn read_input(arg: &InputArg) -> Result<Vec<u8>, String> {
         }
         _ => {
             let mut buf = Vec::new();
-            std::io::stdin().read_to_end(&mut buf).map_err(|e| format!("cannot read standard input: {e}"))?;
+            std::io::stdin()
+                .read_to_end(&mut buf)
+                .map_err(|e| format!("cannot read standard input: {e}"))?;
             Ok(buf)
         }
     }
 }
 
 fn print_json(value: &impl Serialize) {
-    println!("{}", serde_json::to_string_pretty(value).expect("responses serialise"));
+    println!(
+        "{}",
+        serde_json::to_string_pretty(value).expect("responses serialise")
+    );
 }
 
 fn answer<Req: dto::SystemRequest, Resp: Serialize>(
@@ -73,7 +82,13 @@ fn answer<Req: dto::SystemRequest, Resp: Serialize>(
         }
         Err(e) => {
             print_json(&e.body());
-            ExitCode::from(if matches!(e, RequestError::Invalid(_) | RequestError::Malformed(_)) { 2 } else { 1 })
+            ExitCode::from(
+                if matches!(e, RequestError::Invalid(_) | RequestError::Malformed(_)) {
+                    2
+                } else {
+                    1
+                },
+            )
         }
     }
 }
@@ -97,9 +112,11 @@ fn main() -> ExitCode {
         Command::Chart(arg) => answer(arg, |req: &dto::ChartRequest| {
             let bar = ProgressBar::new(run::chart_points(req) as u64);
             bar.set_style(
-                ProgressStyle::with_template("{spinner} chart [{bar:40}] {pos}/{len} points ({eta})")
-                    .expect("valid template")
-                    .progress_chars("=> "),
+                ProgressStyle::with_template(
+                    "{spinner} chart [{bar:40}] {pos}/{len} points ({eta})",
+                )
+                .expect("valid template")
+                .progress_chars("=> "),
             );
             let bar = Bar(bar);
             let out = run::chart(req, Parallelism::Rayon, &bar);

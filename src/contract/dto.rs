@@ -45,7 +45,10 @@ pub struct ModelInput {
 
 impl Default for ModelInput {
     fn default() -> Self {
-        Self { kind: ModelKind::LinearString, elements: default_elements() }
+        Self {
+            kind: ModelKind::LinearString,
+            elements: default_elements(),
+        }
     }
 }
 
@@ -376,7 +379,13 @@ pub struct ErrorDetail {
 
 impl ErrorBody {
     pub fn new(code: &str, field: Option<String>, message: impl Into<String>) -> Self {
-        Self { error: ErrorDetail { code: code.into(), field, message: message.into() } }
+        Self {
+            error: ErrorDetail {
+                code: code.into(),
+                field,
+                message: message.into(),
+            },
+        }
     }
 }
 

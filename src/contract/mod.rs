@@ -13,10 +13,13 @@ use crate::numerics::params::InvalidInput;
 /// Parses a request body (system part and parameters); errors name the
 /// offending field path.
 pub fn parse<T: dto::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
-    let value: serde_json::Value = serde_json::from_slice(body)
-        .map_err(|e| RequestError::Malformed(e.to_string()))?;
+    let value: serde_json::Value =
+        serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
     if !value.is_object() {
-        return Err(RequestError::Invalid(InvalidInput::new("body", "must be a JSON object")));
+        return Err(RequestError::Invalid(InvalidInput::new(
+            "body",
+            "must be a JSON object",
+        )));
     }
     let system = parse_value::<dto::SystemInput>(&value)?;
     let params = parse_value::<T::Params>(&value)?;
@@ -24,13 +27,22 @@ pub fn parse<T: dto::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
 }
 
 /// Deserialises `T` from a JSON value with the error's field path.
-pub fn parse_value<T: serde::de::DeserializeOwned>(value: &serde_json::Value) -> Result<T, RequestError> {
+pub fn parse_value<T: serde::de::DeserializeOwned>(
+    value: &serde_json::Value,
+) -> Result<T, RequestError> {
     serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
         let message = e.into_inner().to_string();
-        let prefix = if path == "." || path.is_empty() { String::new() } else { format!("{path}.") };
+        let prefix = if path == "." || path.is_empty() {
+            String::new()
+        } else {
+            format!("{path}.")
+        };
         // serde names a missing field only in its message: lift it into the path.
-        let field = match message.strip_prefix("missing field `").and_then(|rest| rest.split('`').next()) {
+        let field = match message
+            .strip_prefix("missing field `")
+            .and_then(|rest| rest.split('`').next())
+        {
             Some(name) => format!("{prefix}{name}"),
             None if prefix.is_empty() => "body".to_string(),
             None => path,

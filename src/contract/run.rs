@@ -3,11 +3,15 @@
 
 use crate::contract::dto::*;
 use crate::numerics::chart::{self, Parallelism};
-use crate::numerics::params::{AerostatSystem, InvalidInput, Kinematics, require_finite, require_positive};
+use crate::numerics::params::{
+    AerostatSystem, InvalidInput, Kinematics, require_finite, require_positive,
+};
 use crate::numerics::profile::Profile;
 use crate::numerics::qep::QepError;
 use crate::numerics::string::StringModel;
-use crate::numerics::string::critical::{self, ImmediateCause, Onset, SafeRate, SearchConfig, SearchMethod};
+use crate::numerics::string::critical::{
+    self, ImmediateCause, Onset, SafeRate, SearchConfig, SearchMethod,
+};
 
 /// Why a request was not answered.
 #[derive(Debug, thiserror::Error)]
@@ -48,15 +52,20 @@ impl CableInput {
     pub fn mass_per_length(&self) -> Result<f64, InvalidInput> {
         match (self.mass_per_length_kg_m, self.density_kg_m3, self.area_m2) {
             (Some(rho_a), None, None) => require_positive("cable.mass_per_length_kg_m", rho_a),
-            (None, Some(rho), Some(a)) => {
-                Ok(require_positive("cable.density_kg_m3", rho)? * require_positive("cable.area_m2", a)?)
-            }
+            (None, Some(rho), Some(a)) => Ok(require_positive("cable.density_kg_m3", rho)?
+                * require_positive("cable.area_m2", a)?),
             (Some(_), _, _) => Err(InvalidInput::new(
                 "cable.mass_per_length_kg_m",
                 "give either mass_per_length_kg_m or density_kg_m3 with area_m2, not both",
             )),
-            (None, Some(_), None) => Err(InvalidInput::new("cable.area_m2", "is required with density_kg_m3")),
-            (None, None, Some(_)) => Err(InvalidInput::new("cable.density_kg_m3", "is required with area_m2")),
+            (None, Some(_), None) => Err(InvalidInput::new(
+                "cable.area_m2",
+                "is required with density_kg_m3",
+            )),
+            (None, None, Some(_)) => Err(InvalidInput::new(
+                "cable.density_kg_m3",
+                "is required with area_m2",
+            )),
             (None, None, None) => Err(InvalidInput::new(
                 "cable.mass_per_length_kg_m",
                 "is required (or density_kg_m3 with area_m2)",
@@ -87,10 +96,14 @@ impl SystemInput {
 impl ProfileInput {
     pub fn profile(&self, initial_length_m: f64) -> Result<Profile, InvalidInput> {
         match *self {
-            Self::ConstantRate { rate_m_s, target_length_m } => {
-                Profile::constant_rate(initial_length_m, rate_m_s, target_length_m)
-            }
-            Self::ConstantAcceleration { acceleration_m_s2, target_length_m } => {
+            Self::ConstantRate {
+                rate_m_s,
+                target_length_m,
+            } => Profile::constant_rate(initial_length_m, rate_m_s, target_length_m),
+            Self::ConstantAcceleration {
+                acceleration_m_s2,
+                target_length_m,
+            } => {
                 Profile::constant_acceleration(initial_length_m, acceleration_m_s2, target_length_m)
             }
         }
@@ -116,10 +129,20 @@ pub fn stability(req: &StabilityRequest) -> Result<StabilityResponse, RequestErr
     let k = Kinematics {
         length_m: require_positive("state.length_m", req.params.state.length_m)?,
         rate_m_s: require_finite("state.rate_m_s", req.params.state.rate_m_s)?,
-        acceleration_m_s2: require_finite("state.acceleration_m_s2", req.params.state.acceleration_m_s2)?,
+        acceleration_m_s2: require_finite(
+            "state.acceleration_m_s2",
+            req.params.state.acceleration_m_s2,
+        )?,
     };
     if req.params.modes == 0 || req.params.modes > MAX_MODES {
-        return Err(InvalidInput::new("modes", format!("must be between 1 and {MAX_MODES}, got {}", req.params.modes)).into());
+        return Err(InvalidInput::new(
+            "modes",
+            format!(
+                "must be between 1 and {MAX_MODES}, got {}",
+                req.params.modes
+            ),
+        )
+        .into());
     }
     let s = sys.to_nondim(k);
     let spectrum = model.spectrum(s)?;
@@ -159,12 +182,23 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
     let model = req.system.model()?;
     let sys = model.system;
     let profile = req.params.profile.profile(sys.initial_length_m)?;
-    let result = critical::critical_time(&model, &profile, SearchConfig { confirm_with_qep: req.params.confirm_with_qep })?;
+    let result = critical::critical_time(
+        &model,
+        &profile,
+        SearchConfig {
+            confirm_with_qep: req.params.confirm_with_qep,
+        },
+    )?;
     let closed_form = match req.params.profile {
-        ProfileInput::ConstantRate { rate_m_s, .. } if rate_m_s > 0.0 => Some(sys.closed_form_elevation_m(rate_m_s).max(0.0)),
-        ProfileInput::ConstantAcceleration { acceleration_m_s2, .. } if acceleration_m_s2 > 0.0 => {
-            Some(sys.closed_form_elevation_accelerating_m(acceleration_m_s2).max(0.0))
+        ProfileInput::ConstantRate { rate_m_s, .. } if rate_m_s > 0.0 => {
+            Some(sys.closed_form_elevation_m(rate_m_s).max(0.0))
         }
+        ProfileInput::ConstantAcceleration {
+            acceleration_m_s2, ..
+        } if acceleration_m_s2 > 0.0 => Some(
+            sys.closed_form_elevation_accelerating_m(acceleration_m_s2)
+                .max(0.0),
+        ),
         _ => None,
     };
     let (onset, explanation, max_elevation_m) = match result.onset {
@@ -238,7 +272,10 @@ pub fn safe_rate(req: &SafeRateRequest) -> Result<SafeRateResponse, RequestError
     let closed = sys.net_buoyancy_n / sys.mass_per_length_kg_m - sys.gravity_m_s2 * target;
     let closed_form_rate_m_s = (closed > 0.0).then(|| closed.sqrt());
     let (max_rate_m_s, max_rate_nondim, reason) = match answer {
-        SafeRate::Rate { rate_m_s, rate_nondim } => (Some(rate_m_s), Some(rate_nondim), None),
+        SafeRate::Rate {
+            rate_m_s,
+            rate_nondim,
+        } => (Some(rate_m_s), Some(rate_nondim), None),
         SafeRate::NoSafeRate { reason } => (None, None, Some(reason)),
     };
     Ok(SafeRateResponse {
@@ -255,10 +292,17 @@ pub fn safe_rate(req: &SafeRateRequest) -> Result<SafeRateResponse, RequestError
 
 /// Number of points a chart request asks for (for admission limits).
 pub fn chart_points(req: &ChartRequest) -> usize {
-    req.params.rates_m_s.count.saturating_mul(req.params.net_buoyancies_n.len().max(1))
+    req.params
+        .rates_m_s
+        .count
+        .saturating_mul(req.params.net_buoyancies_n.len().max(1))
 }
 
-pub fn chart(req: &ChartRequest, parallelism: Parallelism, progress: &dyn Progress) -> Result<ChartResponse, RequestError> {
+pub fn chart(
+    req: &ChartRequest,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<ChartResponse, RequestError> {
     let model = req.system.model()?;
     let sys = model.system;
     if chart_points(req) > chart::MAX_CHART_POINTS {
@@ -272,10 +316,25 @@ pub fn chart(req: &ChartRequest, parallelism: Parallelism, progress: &dyn Progre
         )
         .into());
     }
-    let rates = chart::rate_grid(req.params.rates_m_s.min, req.params.rates_m_s.max, req.params.rates_m_s.count)?;
-    let buoyancies = if req.params.net_buoyancies_n.is_empty() { vec![sys.net_buoyancy_n] } else { req.params.net_buoyancies_n.clone() };
+    let rates = chart::rate_grid(
+        req.params.rates_m_s.min,
+        req.params.rates_m_s.max,
+        req.params.rates_m_s.count,
+    )?;
+    let buoyancies = if req.params.net_buoyancies_n.is_empty() {
+        vec![sys.net_buoyancy_n]
+    } else {
+        req.params.net_buoyancies_n.clone()
+    };
     let report = |done: usize, total: usize| progress.report(done, total);
-    let series = chart::deployment_chart(&sys, model.elements(), &rates, &buoyancies, parallelism, &report)?;
+    let series = chart::deployment_chart(
+        &sys,
+        model.elements(),
+        &rates,
+        &buoyancies,
+        parallelism,
+        &report,
+    )?;
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
@@ -305,8 +364,16 @@ impl RequestError {
     /// The error body the CLI prints and the API returns.
     pub fn body(&self) -> ErrorBody {
         match self {
-            Self::Malformed(m) => ErrorBody::new("malformed_json", Some("body".into()), format!("malformed JSON: {m}")),
-            Self::Invalid(e) => ErrorBody::new("invalid_input", Some(e.field.clone()), format!("{}: {}", e.field, e.reason)),
+            Self::Malformed(m) => ErrorBody::new(
+                "malformed_json",
+                Some("body".into()),
+                format!("malformed JSON: {m}"),
+            ),
+            Self::Invalid(e) => ErrorBody::new(
+                "invalid_input",
+                Some(e.field.clone()),
+                format!("{}: {}", e.field, e.reason),
+            ),
             Self::Numerical(e) => ErrorBody::new("internal", None, e.to_string()),
             Self::Cancelled => ErrorBody::new("cancelled", None, "the work was cancelled"),
         }

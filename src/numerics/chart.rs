@@ -49,15 +49,23 @@ pub fn rate_grid(min_m_s: f64, max_m_s: f64, count: usize) -> Result<Vec<f64>, I
         crate::numerics::params::require_positive(field, v)?;
     }
     if max_m_s < min_m_s {
-        return Err(InvalidInput::new("rates_m_s.max", format!("must be at least rates_m_s.min = {min_m_s}")));
+        return Err(InvalidInput::new(
+            "rates_m_s.max",
+            format!("must be at least rates_m_s.min = {min_m_s}"),
+        ));
     }
     if count == 0 || count > MAX_CHART_POINTS {
-        return Err(InvalidInput::new("rates_m_s.count", format!("must be between 1 and {MAX_CHART_POINTS}, got {count}")));
+        return Err(InvalidInput::new(
+            "rates_m_s.count",
+            format!("must be between 1 and {MAX_CHART_POINTS}, got {count}"),
+        ));
     }
     if count == 1 {
         return Ok(vec![min_m_s]);
     }
-    Ok((0..count).map(|i| min_m_s + (max_m_s - min_m_s) * i as f64 / (count - 1) as f64).collect())
+    Ok((0..count)
+        .map(|i| min_m_s + (max_m_s - min_m_s) * i as f64 / (count - 1) as f64)
+        .collect())
 }
 
 /// Computes the chart. `progress(done, total)` is called as points finish
@@ -72,7 +80,10 @@ pub fn deployment_chart(
 ) -> Result<Vec<ChartSeries>, InvalidInput> {
     crate::numerics::string::validate_elements("model.elements", elements)?;
     if net_buoyancies_n.is_empty() {
-        return Err(InvalidInput::new("net_buoyancies_n", "must list at least one buoyancy"));
+        return Err(InvalidInput::new(
+            "net_buoyancies_n",
+            "must list at least one buoyancy",
+        ));
     }
     let total = rates_m_s.len().saturating_mul(net_buoyancies_n.len());
     if total > MAX_CHART_POINTS {
@@ -85,7 +96,8 @@ pub fn deployment_chart(
         .iter()
         .enumerate()
         .map(|(i, &f)| {
-            base.with_net_buoyancy(f).map_err(|e| InvalidInput::new(format!("net_buoyancies_n[{i}]"), e.reason))
+            base.with_net_buoyancy(f)
+                .map_err(|e| InvalidInput::new(format!("net_buoyancies_n[{i}]"), e.reason))
         })
         .collect::<Result<Vec<_>, _>>()?;
     for (i, &v) in rates_m_s.iter().enumerate() {
@@ -107,7 +119,10 @@ pub fn deployment_chart(
     Ok(systems
         .iter()
         .zip(flat.chunks(rates_m_s.len().max(1)))
-        .map(|(sys, pts)| ChartSeries { net_buoyancy_n: sys.net_buoyancy_n, points: pts.to_vec() })
+        .map(|(sys, pts)| ChartSeries {
+            net_buoyancy_n: sys.net_buoyancy_n,
+            points: pts.to_vec(),
+        })
         .collect())
 }
 

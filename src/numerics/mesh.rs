@@ -5,7 +5,10 @@
 /// Gauss–Legendre points and weights on `[-1, 1]`.
 pub fn gauss_legendre(points: usize) -> &'static [(f64, f64)] {
     const G1: [(f64, f64); 1] = [(0.0, 2.0)];
-    const G2: [(f64, f64); 2] = [(-0.577_350_269_189_625_8, 1.0), (0.577_350_269_189_625_8, 1.0)];
+    const G2: [(f64, f64); 2] = [
+        (-0.577_350_269_189_625_8, 1.0),
+        (0.577_350_269_189_625_8, 1.0),
+    ];
     const G3: [(f64, f64); 3] = [
         (-0.774_596_669_241_483_4, 5.0 / 9.0),
         (0.0, 8.0 / 9.0),
@@ -47,13 +50,22 @@ impl UniformMesh {
     /// Quadrature points of element `e` mapped to `ζ`, with their weights
     /// (already scaled by the Jacobian `h/2`), and the shape values
     /// `(N_a, N_b)` there.
-    pub fn element_quadrature(&self, e: usize, points: usize) -> impl Iterator<Item = QuadraturePoint> + '_ {
+    pub fn element_quadrature(
+        &self,
+        e: usize,
+        points: usize,
+    ) -> impl Iterator<Item = QuadraturePoint> + '_ {
         let h = self.element_size();
         let a = e as f64 * h;
         gauss_legendre(points).iter().map(move |&(xi, w)| {
             let zeta = a + 0.5 * h * (xi + 1.0);
             let nb = (zeta - a) / h;
-            QuadraturePoint { zeta, weight: 0.5 * h * w, shape: [1.0 - nb, nb], slope: [-1.0 / h, 1.0 / h] }
+            QuadraturePoint {
+                zeta,
+                weight: 0.5 * h * w,
+                shape: [1.0 - nb, nb],
+                slope: [-1.0 / h, 1.0 / h],
+            }
         })
     }
 }

@@ -18,17 +18,26 @@ pub struct InvalidInput {
 
 impl InvalidInput {
     pub fn new(field: impl Into<String>, reason: impl fmt::Display) -> Self {
-        Self { field: field.into(), reason: reason.to_string() }
+        Self {
+            field: field.into(),
+            reason: reason.to_string(),
+        }
     }
 }
 
 /// Checks that `value` is finite and `> 0`.
 pub fn require_positive(field: &str, value: f64) -> Result<f64, InvalidInput> {
     if !value.is_finite() {
-        return Err(InvalidInput::new(field, format!("must be a finite number, got {value}")));
+        return Err(InvalidInput::new(
+            field,
+            format!("must be a finite number, got {value}"),
+        ));
     }
     if value <= 0.0 {
-        return Err(InvalidInput::new(field, format!("must be greater than zero, got {value}")));
+        return Err(InvalidInput::new(
+            field,
+            format!("must be greater than zero, got {value}"),
+        ));
     }
     Ok(value)
 }
@@ -36,10 +45,16 @@ pub fn require_positive(field: &str, value: f64) -> Result<f64, InvalidInput> {
 /// Checks that `value` is finite and `>= 0`.
 pub fn require_non_negative(field: &str, value: f64) -> Result<f64, InvalidInput> {
     if !value.is_finite() {
-        return Err(InvalidInput::new(field, format!("must be a finite number, got {value}")));
+        return Err(InvalidInput::new(
+            field,
+            format!("must be a finite number, got {value}"),
+        ));
     }
     if value < 0.0 {
-        return Err(InvalidInput::new(field, format!("must not be negative, got {value}")));
+        return Err(InvalidInput::new(
+            field,
+            format!("must not be negative, got {value}"),
+        ));
     }
     Ok(value)
 }
@@ -47,7 +62,10 @@ pub fn require_non_negative(field: &str, value: f64) -> Result<f64, InvalidInput
 /// Checks that `value` is finite.
 pub fn require_finite(field: &str, value: f64) -> Result<f64, InvalidInput> {
     if !value.is_finite() {
-        return Err(InvalidInput::new(field, format!("must be a finite number, got {value}")));
+        return Err(InvalidInput::new(
+            field,
+            format!("must be a finite number, got {value}"),
+        ));
     }
     Ok(value)
 }
@@ -77,7 +95,10 @@ impl AerostatSystem {
         gravity_m_s2: f64,
     ) -> Result<Self, InvalidInput> {
         Ok(Self {
-            mass_per_length_kg_m: require_positive("cable.mass_per_length_kg_m", mass_per_length_kg_m)?,
+            mass_per_length_kg_m: require_positive(
+                "cable.mass_per_length_kg_m",
+                mass_per_length_kg_m,
+            )?,
             net_buoyancy_n: require_positive("aerostat.net_buoyancy_n", net_buoyancy_n)?,
             aerostat_mass_kg: require_non_negative("aerostat.mass_kg", aerostat_mass_kg)?,
             initial_length_m: require_positive("initial_length_m", initial_length_m)?,
@@ -92,7 +113,13 @@ impl AerostatSystem {
     }
 
     pub fn with_net_buoyancy(self, net_buoyancy_n: f64) -> Result<Self, InvalidInput> {
-        Self::new(self.mass_per_length_kg_m, net_buoyancy_n, self.aerostat_mass_kg, self.initial_length_m, self.gravity_m_s2)
+        Self::new(
+            self.mass_per_length_kg_m,
+            net_buoyancy_n,
+            self.aerostat_mass_kg,
+            self.initial_length_m,
+            self.gravity_m_s2,
+        )
     }
 
     /// Transverse wave speed at tension `F`: `c = sqrt(F/ρA)` (m/s).
@@ -107,7 +134,8 @@ impl AerostatSystem {
 
     /// `F̃ = F/(ρA g L0)`.
     pub fn buoyancy_ratio(&self) -> f64 {
-        self.net_buoyancy_n / (self.mass_per_length_kg_m * self.gravity_m_s2 * self.initial_length_m)
+        self.net_buoyancy_n
+            / (self.mass_per_length_kg_m * self.gravity_m_s2 * self.initial_length_m)
     }
 
     /// `m̃ = m/(ρA L0)`.
@@ -184,7 +212,9 @@ mod tests {
         assert!((s.buoyancy_ratio() - 1306.92).abs() < 0.01);
         assert!((s.mass_ratio() - 128.205).abs() < 1e-3);
         // the accelerating estimate reduces to the static limit as ã → 0
-        assert!((s.closed_form_elevation_accelerating_m(1e-12) - s.static_lift_limit_m()).abs() < 1e-3);
+        assert!(
+            (s.closed_form_elevation_accelerating_m(1e-12) - s.static_lift_limit_m()).abs() < 1e-3
+        );
     }
 
     #[test]

@@ -61,8 +61,17 @@ impl Spectrum {
     /// part, then by real part descending: the modes in frequency order.
     pub fn modes(&self) -> Vec<Eigenvalue> {
         let tiny = 1e-12 * self.spectral_radius.max(1.0);
-        let mut modes: Vec<Eigenvalue> = self.eigenvalues.iter().copied().filter(|e| e.im >= -tiny).collect();
-        modes.sort_by(|a, b| a.im.abs().total_cmp(&b.im.abs()).then(b.re.total_cmp(&a.re)));
+        let mut modes: Vec<Eigenvalue> = self
+            .eigenvalues
+            .iter()
+            .copied()
+            .filter(|e| e.im >= -tiny)
+            .collect();
+        modes.sort_by(|a, b| {
+            a.im.abs()
+                .total_cmp(&b.im.abs())
+                .then(b.re.total_cmp(&a.re))
+        });
         modes
     }
 }
@@ -71,7 +80,11 @@ impl Spectrum {
 pub fn solve(system: &SecondOrderSystem) -> Result<Spectrum, QepError> {
     let n = system.mass.dim();
     let finite = |t: &crate::numerics::tridiag::Tridiagonal| {
-        t.diag.iter().chain(&t.lower).chain(&t.upper).all(|v| v.is_finite())
+        t.diag
+            .iter()
+            .chain(&t.lower)
+            .chain(&t.upper)
+            .all(|v| v.is_finite())
     };
     if !(finite(&system.mass) && finite(&system.damping) && finite(&system.stiffness)) {
         return Err(QepError::NonFinite);
@@ -94,10 +107,21 @@ pub fn solve(system: &SecondOrderSystem) -> Result<Spectrum, QepError> {
         }
     });
     let (re, im) = eigenvalues_real(&companion)?;
-    let eigenvalues: Vec<Eigenvalue> = re.into_iter().zip(im).map(|(re, im)| Eigenvalue { re, im }).collect();
-    let max_real = eigenvalues.iter().map(|e| e.re).fold(f64::NEG_INFINITY, f64::max);
+    let eigenvalues: Vec<Eigenvalue> = re
+        .into_iter()
+        .zip(im)
+        .map(|(re, im)| Eigenvalue { re, im })
+        .collect();
+    let max_real = eigenvalues
+        .iter()
+        .map(|e| e.re)
+        .fold(f64::NEG_INFINITY, f64::max);
     let spectral_radius = eigenvalues.iter().map(Eigenvalue::abs).fold(0.0, f64::max);
-    Ok(Spectrum { eigenvalues, max_real, spectral_radius })
+    Ok(Spectrum {
+        eigenvalues,
+        max_real,
+        spectral_radius,
+    })
 }
 
 /// Eigenvalues of a real square matrix, sequential faer.
@@ -106,7 +130,13 @@ pub fn eigenvalues_real(a: &Mat<f64>) -> Result<(Vec<f64>, Vec<f64>), QepError> 
     let mut s_re = faer::diag::Diag::<f64>::zeros(n);
     let mut s_im = faer::diag::Diag::<f64>::zeros(n);
     let par = Par::Seq;
-    let scratch = evd::evd_scratch::<f64>(n, ComputeEigenvectors::No, ComputeEigenvectors::No, par, Default::default());
+    let scratch = evd::evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::No,
+        ComputeEigenvectors::No,
+        par,
+        Default::default(),
+    );
     let mut buffer = MemBuffer::new(scratch);
     evd::evd_real(
         a.as_ref(),

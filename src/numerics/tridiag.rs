@@ -144,7 +144,11 @@ impl Tridiagonal {
     /// is the number of negative eigenvalues (Sylvester's law of inertia),
     /// so `0` means positive semidefinite up to the exact-zero pivot.
     pub fn negative_pivots(&self) -> usize {
-        count_negative_pivots(self.dim(), |i| self.diag[i], |i| self.lower[i] * self.upper[i])
+        count_negative_pivots(
+            self.dim(),
+            |i| self.diag[i],
+            |i| self.lower[i] * self.upper[i],
+        )
     }
 }
 
@@ -153,7 +157,11 @@ impl Tridiagonal {
 /// Zero pivots are nudged to a tiny positive value, the usual Sturm-count
 /// convention, so the count is that of the matrix shifted by `+0`.
 #[inline]
-pub fn count_negative_pivots(n: usize, d: impl Fn(usize) -> f64, p: impl Fn(usize) -> f64) -> usize {
+pub fn count_negative_pivots(
+    n: usize,
+    d: impl Fn(usize) -> f64,
+    p: impl Fn(usize) -> f64,
+) -> usize {
     let mut count = 0;
     let mut pivot = 1.0;
     for i in 0..n {
@@ -177,7 +185,11 @@ mod tests {
     use super::*;
 
     fn sample() -> Tridiagonal {
-        Tridiagonal { lower: vec![1.0, -2.0], diag: vec![4.0, 5.0, 6.0], upper: vec![0.5, 1.5] }
+        Tridiagonal {
+            lower: vec![1.0, -2.0],
+            diag: vec![4.0, 5.0, 6.0],
+            upper: vec![0.5, 1.5],
+        }
     }
 
     #[test]
@@ -196,7 +208,11 @@ mod tests {
     #[test]
     fn pivot_count_is_the_inertia_of_a_symmetric_matrix() {
         // eigenvalues of the 1-D Laplacian shifted by s: 2 - 2cos(k pi/4) - s, k = 1..3
-        let lap = |s: f64| Tridiagonal { lower: vec![-1.0; 2], diag: vec![2.0 - s; 3], upper: vec![-1.0; 2] };
+        let lap = |s: f64| Tridiagonal {
+            lower: vec![-1.0; 2],
+            diag: vec![2.0 - s; 3],
+            upper: vec![-1.0; 2],
+        };
         assert_eq!(lap(0.5).negative_pivots(), 0); // smallest eigenvalue 0.586
         assert_eq!(lap(1.0).negative_pivots(), 1);
         assert_eq!(lap(2.5).negative_pivots(), 2);

@@ -52,10 +52,15 @@ pub enum ImmediateCause {
 pub enum Onset {
     Immediate(ImmediateCause),
     /// First unstable at `time_s`, length `length_m`.
-    During { time_s: f64, length_m: f64 },
+    During {
+        time_s: f64,
+        length_m: f64,
+    },
     /// Stable over the whole profile (it stops, or never changes length,
     /// below the critical length); `until_s` is where the search ended.
-    Never { until_s: f64 },
+    Never {
+        until_s: f64,
+    },
 }
 
 /// How the onset was located.
@@ -117,14 +122,24 @@ pub struct SearchConfig {
 
 impl Default for SearchConfig {
     fn default() -> Self {
-        Self { confirm_with_qep: true }
+        Self {
+            confirm_with_qep: true,
+        }
     }
 }
 
 /// Critical time of any profile.
-pub fn critical_time(model: &StringModel, profile: &Profile, config: SearchConfig) -> Result<CriticalTime, QepError> {
+pub fn critical_time(
+    model: &StringModel,
+    profile: &Profile,
+    config: SearchConfig,
+) -> Result<CriticalTime, QepError> {
     match *profile {
-        Profile::ConstantRate { rate_m_s, target_length_m, .. } if rate_m_s > 0.0 => {
+        Profile::ConstantRate {
+            rate_m_s,
+            target_length_m,
+            ..
+        } if rate_m_s > 0.0 => {
             let mut result = constant_rate_lengthening(model, rate_m_s, target_length_m);
             if config.confirm_with_qep {
                 result.probes = probes_around(model, profile, &result.onset)?;
@@ -187,7 +202,11 @@ fn pencil_limit(
 /// Non-dimensional critical length `l*` for constant-rate lengthening at
 /// `ṽ`: `F̃ μ*` of the pencil `(S₀ − ṽ²S₂, S₁)`; `None` when `S₀ − ṽ²S₂`
 /// is already indefinite (rate at or above the discrete wave speed).
-pub fn critical_length_constant_rate(ops: &StringOperators, buoyancy_ratio: f64, rate_nondim: f64) -> Option<f64> {
+pub fn critical_length_constant_rate(
+    ops: &StringOperators,
+    buoyancy_ratio: f64,
+    rate_nondim: f64,
+) -> Option<f64> {
     let v2 = rate_nondim * rate_nondim;
     let (s0, s1, s2) = (&ops.stiff_0, &ops.stiff_1, &ops.stiff_2);
     pencil_limit(
@@ -201,7 +220,11 @@ pub fn critical_length_constant_rate(ops: &StringOperators, buoyancy_ratio: f64,
 }
 
 /// The fast, exact search for constant-rate lengthening (no QEP).
-pub fn constant_rate_lengthening(model: &StringModel, rate_m_s: f64, target_length_m: Option<f64>) -> CriticalTime {
+pub fn constant_rate_lengthening(
+    model: &StringModel,
+    rate_m_s: f64,
+    target_length_m: Option<f64>,
+) -> CriticalTime {
     let sys = &model.system;
     let vt = rate_m_s / sys.wave_speed_m_s();
     let onset = match critical_length_constant_rate(&model.operators, sys.buoyancy_ratio(), vt) {
@@ -210,15 +233,29 @@ pub fn constant_rate_lengthening(model: &StringModel, rate_m_s: f64, target_leng
         Some(l) => {
             let length_m = l * sys.initial_length_m;
             match target_length_m {
-                Some(target) if target <= length_m => Onset::Never { until_s: (target - sys.initial_length_m) / rate_m_s },
-                _ => Onset::During { time_s: (length_m - sys.initial_length_m) / rate_m_s, length_m },
+                Some(target) if target <= length_m => Onset::Never {
+                    until_s: (target - sys.initial_length_m) / rate_m_s,
+                },
+                _ => Onset::During {
+                    time_s: (length_m - sys.initial_length_m) / rate_m_s,
+                    length_m,
+                },
             }
         }
     };
-    CriticalTime { onset, method: SearchMethod::StiffnessInertia, probes: vec![] }
+    CriticalTime {
+        onset,
+        method: SearchMethod::StiffnessInertia,
+        probes: vec![],
+    }
 }
 
-fn probe(model: &StringModel, profile: &Profile, time_s: f64, expected_stable: bool) -> Result<QepProbe, QepError> {
+fn probe(
+    model: &StringModel,
+    profile: &Profile,
+    time_s: f64,
+    expected_stable: bool,
+) -> Result<QepProbe, QepError> {
     let k = profile.kinematics(time_s);
     let spectrum = model.spectrum(model.system.to_nondim(k))?;
     Ok(QepProbe {
@@ -232,7 +269,11 @@ fn probe(model: &StringModel, profile: &Profile, time_s: f64, expected_stable: b
 
 /// QEP probes confirming an onset: stable at the start and just before
 /// `t*`, unstable just after; stable at the start and end for `Never`.
-fn probes_around(model: &StringModel, profile: &Profile, onset: &Onset) -> Result<Vec<QepProbe>, QepError> {
+fn probes_around(
+    model: &StringModel,
+    profile: &Profile,
+    onset: &Onset,
+) -> Result<Vec<QepProbe>, QepError> {
     match *onset {
         Onset::Immediate(_) => Ok(vec![probe(model, profile, 0.0, false)?]),
         Onset::During { time_s, .. } => Ok(vec![
@@ -285,7 +326,11 @@ fn clamp_to_positive_length(model: &StringModel, profile: &Profile, horizon_s: f
     let (mut lo, mut hi) = (0.0, horizon_s);
     for _ in 0..80 {
         let mid = 0.5 * (lo + hi);
-        if profile.kinematics(mid).length_m >= min_length { lo = mid } else { hi = mid }
+        if profile.kinematics(mid).length_m >= min_length {
+            lo = mid
+        } else {
+            hi = mid
+        }
     }
     lo
 }
@@ -316,10 +361,16 @@ fn first_crossing(horizon_s: f64, samples: usize, unstable: impl Fn(f64) -> bool
 
 fn general_profile(model: &StringModel, profile: &Profile) -> Result<CriticalTime, QepError> {
     let horizon = clamp_to_positive_length(model, profile, search_horizon_s(model, profile));
-    let candidate = first_crossing(horizon, 256, |t| looks_unstable(model, profile.kinematics(t)));
+    let candidate = first_crossing(horizon, 256, |t| {
+        looks_unstable(model, profile.kinematics(t))
+    });
     let onset = onset_at(model, profile, candidate, horizon);
     let probes = probes_around(model, profile, &onset)?;
-    let result = CriticalTime { onset, method: SearchMethod::DivergenceConfirmedByQep, probes };
+    let result = CriticalTime {
+        onset,
+        method: SearchMethod::DivergenceConfirmedByQep,
+        probes,
+    };
     if result.confirmed() {
         return Ok(result);
     }
@@ -327,15 +378,27 @@ fn general_profile(model: &StringModel, profile: &Profile) -> Result<CriticalTim
     // search on the QEP verdict itself.
     let qep_unstable = |t: f64| -> bool {
         let k = profile.kinematics(t);
-        model.spectrum(model.system.to_nondim(k)).map(|s| !s.is_stable()).unwrap_or(true)
+        model
+            .spectrum(model.system.to_nondim(k))
+            .map(|s| !s.is_stable())
+            .unwrap_or(true)
     };
     let candidate = first_crossing(horizon, 64, qep_unstable);
     let onset = onset_at(model, profile, candidate, horizon);
     let probes = probes_around(model, profile, &onset)?;
-    Ok(CriticalTime { onset, method: SearchMethod::QepScan, probes })
+    Ok(CriticalTime {
+        onset,
+        method: SearchMethod::QepScan,
+        probes,
+    })
 }
 
-fn onset_at(model: &StringModel, profile: &Profile, candidate: Option<f64>, horizon_s: f64) -> Onset {
+fn onset_at(
+    model: &StringModel,
+    profile: &Profile,
+    candidate: Option<f64>,
+    horizon_s: f64,
+) -> Onset {
     match candidate {
         Some(t) if t == 0.0 => {
             let k = profile.kinematics(0.0);
@@ -345,7 +408,10 @@ fn onset_at(model: &StringModel, profile: &Profile, candidate: Option<f64>, hori
                 ImmediateCause::UnstableInitialState
             })
         }
-        Some(t) => Onset::During { time_s: t, length_m: profile.kinematics(t).length_m },
+        Some(t) => Onset::During {
+            time_s: t,
+            length_m: profile.kinematics(t).length_m,
+        },
         None => {
             let _ = model;
             Onset::Never { until_s: horizon_s }
@@ -374,7 +440,10 @@ pub fn safe_rate(model: &StringModel, target_length_m: f64) -> Result<SafeRate, 
     if !target_length_m.is_finite() || target_length_m <= sys.initial_length_m {
         return Err(InvalidInput::new(
             "target_elevation_m",
-            format!("must be a finite length above initial_length_m = {} m, got {target_length_m}", sys.initial_length_m),
+            format!(
+                "must be a finite length above initial_length_m = {} m, got {target_length_m}",
+                sys.initial_length_m
+            ),
         ));
     }
     let limit = sys.static_lift_limit_m();
@@ -398,11 +467,16 @@ pub fn safe_rate(model: &StringModel, target_length_m: f64) -> Result<SafeRate, 
     );
     Ok(match nu {
         None => SafeRate::NoSafeRate {
-            reason: format!("target {target_length_m} m is beyond the discrete model's static stability limit"),
+            reason: format!(
+                "target {target_length_m} m is beyond the discrete model's static stability limit"
+            ),
         },
         Some(nu) => {
             let vt = nu.sqrt();
-            SafeRate::Rate { rate_m_s: vt * sys.wave_speed_m_s(), rate_nondim: vt }
+            SafeRate::Rate {
+                rate_m_s: vt * sys.wave_speed_m_s(),
+                rate_nondim: vt,
+            }
         }
     })
 }

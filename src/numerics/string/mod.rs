@@ -36,7 +36,10 @@ pub struct StringModel {
 impl StringModel {
     pub fn new(system: AerostatSystem, elements: usize) -> Result<Self, InvalidInput> {
         validate_elements("model.elements", elements)?;
-        Ok(Self { system, operators: Arc::new(StringOperators::new(elements)) })
+        Ok(Self {
+            system,
+            operators: Arc::new(StringOperators::new(elements)),
+        })
     }
 
     /// Shares already assembled operators (sweeps over buoyancy).

@@ -105,7 +105,11 @@ impl StringOperators {
             (c.tension_top, &self.stiff_0),
             (c.tension_slope, &self.stiff_1),
         ]);
-        SecondOrderSystem { mass, damping, stiffness }
+        SecondOrderSystem {
+            mass,
+            damping,
+            stiffness,
+        }
     }
 }
 

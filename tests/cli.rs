@@ -1,0 +1,96 @@
+//! The CLI reads the same JSON as the API and prints JSON.
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+fn run(args: &[&str], stdin: &str) -> (i32, serde_json::Value) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tetherplan"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(stdin.as_bytes())
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let json = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "stdout is JSON ({e}): {}",
+            String::from_utf8_lossy(&out.stdout)
+        )
+    });
+    (out.status.code().unwrap(), json)
+}
+
+const REQUEST: &str = r#"{"cable": {"mass_per_length_kg_m": 0.078},
+ "aerostat": {"net_buoyancy_n": 1000, "mass_kg": 10},
+ "initial_length_m": 1,
+ "model": {"kind": "linear_string", "elements": 50},
+ "profile": {"kind": "constant_rate", "rate_m_s": 10}}"#;
+
+#[test]
+fn critical_from_stdin_and_from_a_file() {
+    let (code, json) = run(&["critical"], REQUEST);
+    assert_eq!(code, 0);
+    let h = json["max_elevation_m"].as_f64().unwrap();
+    assert!((h - 1310.0).abs() < 1.0, "{h}");
+    let path = std::env::temp_dir().join(format!("tetherplan-cli-{}.json", std::process::id()));
+    std::fs::write(&path, REQUEST).unwrap();
+    let (code, from_file) = run(&["critical", "--input", path.to_str().unwrap()], "");
+    std::fs::remove_file(&path).ok();
+    assert_eq!(code, 0);
+    assert_eq!(from_file, json);
+}
+
+#[test]
+fn chart_safe_rate_and_stability() {
+    let chart = REQUEST.replace(
+        r#""profile": {"kind": "constant_rate", "rate_m_s": 10}"#,
+        r#""rates_m_s": {"min": 10, "max": 20, "count": 2}, "net_buoyancies_n": [1000, 2000]"#,
+    );
+    let (code, json) = run(&["chart"], &chart);
+    assert_eq!(code, 0);
+    assert_eq!(json["series"].as_array().unwrap().len(), 2);
+    let h = json["series"][0]["points"][0]["max_elevation_m"]
+        .as_f64()
+        .unwrap();
+    assert!((h - 1310.0).abs() < 1.0);
+
+    let safe = REQUEST.replace(
+        r#""profile": {"kind": "constant_rate", "rate_m_s": 10}"#,
+        r#""target_elevation_m": 1200"#,
+    );
+    let (code, json) = run(&["safe-rate"], &safe);
+    assert_eq!(code, 0);
+    assert!((json["max_rate_m_s"].as_f64().unwrap() - 34.49).abs() < 0.01);
+
+    let stability = REQUEST.replace(
+        r#""profile": {"kind": "constant_rate", "rate_m_s": 10}"#,
+        r#""state": {"length_m": 1320, "rate_m_s": 10}, "modes": 2"#,
+    );
+    let (code, json) = run(&["stability"], &stability);
+    assert_eq!(code, 0);
+    assert_eq!(
+        json["stable"], false,
+        "1320 m at 10 m/s is past h* = 1310 m"
+    );
+}
+
+#[test]
+fn bad_input_prints_the_error_body_and_exits_2() {
+    let (code, json) = run(
+        &["critical"],
+        &REQUEST.replace(r#""elements": 50"#, r#""elements": 1000000"#),
+    );
+    assert_eq!(code, 2);
+    assert_eq!(json["error"]["field"], "model.elements");
+    assert_eq!(json["error"]["code"], "invalid_input");
+    let (code, json) = run(&["critical"], "{not json");
+    assert_eq!(code, 2);
+    assert_eq!(json["error"]["code"], "malformed_json");
+}
