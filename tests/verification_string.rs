@@ -412,3 +412,20 @@ fn chart_in_parallel_equals_serial_bit_for_bit() {
     assert_eq!(f1000.last().unwrap().max_elevation_m, 1.0); // 120 m/s > c = 113.2 m/s
     assert!(serial[2].points[10].max_elevation_m > serial[1].points[10].max_elevation_m);
 }
+
+#[test]
+fn retrieval_from_rest_is_unstable_at_once() {
+    let sys = AerostatSystem {
+        initial_length_m: 1000.0,
+        ..AerostatSystem::thesis()
+    };
+    let model = StringModel::new(sys, 30).unwrap();
+    let profile = Profile::constant_acceleration(1000.0, -0.5, None).unwrap();
+    let result = critical::critical_time(&model, &profile, SearchConfig::default()).unwrap();
+    assert_eq!(result.onset, Onset::Immediate(ImmediateCause::Shortening));
+    assert!(result.confirmed(), "{:?}", result.probes);
+    assert!(
+        Profile::constant_rate(1.0, 0.0, None).is_err(),
+        "a zero rate is not a deployment"
+    );
+}

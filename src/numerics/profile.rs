@@ -28,10 +28,10 @@ impl Profile {
         target_length_m: Option<f64>,
     ) -> Result<Self, InvalidInput> {
         require_finite("profile.rate_m_s", rate_m_s)?;
-        if rate_m_s.abs() > 1e5 {
+        if rate_m_s == 0.0 || rate_m_s.abs() > 1e5 {
             return Err(InvalidInput::new(
                 "profile.rate_m_s",
-                "must lie within ±1e5 m/s",
+                "must be nonzero and within ±1e5 m/s (for a fixed length, ask for the stability of that state)",
             ));
         }
         check_target(initial_length_m, rate_m_s, target_length_m)?;

@@ -361,6 +361,18 @@ fn first_crossing(horizon_s: f64, samples: usize, unstable: impl Fn(f64) -> bool
 
 fn general_profile(model: &StringModel, profile: &Profile) -> Result<CriticalTime, QepError> {
     let horizon = clamp_to_positive_length(model, profile, search_horizon_s(model, profile));
+    // A profile that starts retrieving (e.g. decelerating from rest) is
+    // shortening from its first instant: unstable at once.
+    if profile.kinematics(1e-9 * horizon).rate_m_s < 0.0 {
+        // (probe where the rate has grown enough for Re λ to clear the tolerance)
+        let probes = vec![probe(model, profile, 1e-2 * horizon, false)?];
+        let onset = Onset::Immediate(ImmediateCause::Shortening);
+        return Ok(CriticalTime {
+            onset,
+            method: SearchMethod::NegativeDamping,
+            probes,
+        });
+    }
     let candidate = first_crossing(horizon, 256, |t| {
         looks_unstable(model, profile.kinematics(t))
     });
