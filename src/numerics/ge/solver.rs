@@ -9,7 +9,8 @@
 //! profile; end loads may be held, ramped or pulsed; linear damping may be
 //! switched on at a time. Newton stops when `‖R‖ ≤ atol + rtol·s`, with `s`
 //! the largest of the norms of the inertia, internal, body and aerostat
-//! terms; failure to converge is a [`NewtonFailure`], not a panic.
+//! terms, or when the Newton correction reaches the roundoff level of the
+//! unknowns; failure to converge is a [`NewtonFailure`], not a panic.
 
 use super::banded::Band;
 use super::diagnostics::{self, Energy};
@@ -296,9 +297,19 @@ pub fn static_solve(
                 q[i] += dq[i];
             }
             iterations += 1;
+            if at_roundoff(&dq, &q, kin.length_m) {
+                break;
+            }
         }
     }
     Ok(q)
+}
+
+/// The Newton correction is at the roundoff level of the unknowns: the
+/// residual cannot be reduced further (stiff cables: `EA·ε` per element).
+fn at_roundoff(dq: &[f64], q: &[f64], length: f64) -> bool {
+    let big = q.iter().fold(length, |m, x| m.max(x.abs()));
+    dq.iter().all(|d| d.abs() <= 1e-13 * big)
 }
 
 /// Newmark parameters (average acceleration by default).
@@ -374,6 +385,13 @@ impl<'a> Integrator<'a> {
                 q[i] += dq[i];
             }
             iterations += 1;
+            if at_roundoff(&dq, &q, kin.length_m) {
+                for i in 0..n {
+                    a[i] = alpha_a * (q[i] - qn[i] - dt * vn[i]) - (0.5 / BETA - 1.0) * an[i];
+                    v[i] = vn[i] + dt * ((1.0 - GAMMA) * an[i] + GAMMA * a[i]);
+                }
+                break;
+            }
         }
         self.state = State { time_s: t1, q, v, a };
         Ok(iterations)
