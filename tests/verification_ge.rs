@@ -497,7 +497,7 @@ fn inextensible_limit_matches_the_string_qep() {
     let model = table_7_1(n);
     let string = StringModel::new(AerostatSystem::thesis(), n).unwrap();
     let buoyancy = TipLoad { force_n: [1000.0, 0.0], moment_n_m: 0.0 };
-    for (length, rate) in [(500.0, 0.0), (500.0, 10.0)] {
+    for (length, rate) in [(500.0, 0.0), (500.0, 10.0), (500.0, -10.0)] {
         let kin = Kinematics { length_m: length, rate_m_s: rate, acceleration_m_s2: 0.0 };
         // EI/(F L²) = 4e-6 at 500 m
         let q = solver::static_solve(&model, kin, buoyancy, 2, NewtonConfig::default()).unwrap();
@@ -516,5 +516,10 @@ fn inextensible_limit_matches_the_string_qep() {
             // damping rates agree too (both ~ −l̇/(2l) for a lengthening cable)
             assert!((g.re - sys.eigenvalue_to_si(t.re)).abs() < 0.02 * wt);
         }
+        // verdicts agree: stable at rest and lengthening, unstable shortening
+        println!("L = {length} m, v = {rate} m/s: GE max Re λ {:+.3e} (stable {}), string {:+.3e} (stable {})",
+            ge.max_real, ge.is_stable(), sys.eigenvalue_to_si(st.max_real), st.is_stable());
+        assert_eq!(ge.is_stable(), rate >= 0.0);
+        assert_eq!(st.is_stable(), rate >= 0.0);
     }
 }

@@ -4,6 +4,7 @@
 //! ([`run`]). Everything here is synchronous and CPU-bound.
 
 pub mod dto;
+pub mod ge;
 pub mod run;
 
 pub use run::{Progress, RequestError};

@@ -35,15 +35,22 @@ pub fn local_spectrum(model: &GeModel, kin: Kinematics, load: TipLoad, mu: f64, 
             inv[(i, j)] = col[i];
         }
     }
+    // Scale λ = σ μ with σ² = ‖M⁻¹K‖∞ so the companion has norm ~ 1 (the
+    // stiff axial/shear modes otherwise make it ~ρ² and swamp the
+    // eigenvalues with roundoff).
+    let row_norm = |off: usize| (0..n).map(|i| (0..n).map(|j| inv[(i, j + off)].abs()).sum::<f64>()).fold(0.0, f64::max);
+    let sigma = row_norm(0).sqrt().max(row_norm(n)).max(1e-300);
     let companion = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| {
         if i < n {
             if j == i + n { 1.0 } else { 0.0 }
+        } else if j < n {
+            -inv[(i - n, j)] / (sigma * sigma)
         } else {
-            -inv[(i - n, j)]
+            -inv[(i - n, j)] / sigma
         }
     });
     let (re, im) = qep::eigenvalues_real(&companion)?;
-    let eigenvalues: Vec<Eigenvalue> = re.into_iter().zip(im).map(|(re, im)| Eigenvalue { re, im }).collect();
+    let eigenvalues: Vec<Eigenvalue> = re.into_iter().zip(im).map(|(re, im)| Eigenvalue { re: sigma * re, im: sigma * im }).collect();
     let max_real = eigenvalues.iter().map(|e| e.re).fold(f64::NEG_INFINITY, f64::max);
     let spectral_radius = eigenvalues.iter().map(Eigenvalue::abs).fold(0.0, f64::max);
     Ok(Spectrum { eigenvalues, max_real, spectral_radius })
