@@ -5,7 +5,9 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use tetherplan::numerics::ge::element::TipLoad;
-use tetherplan::numerics::ge::solver::{self, Damping, Drive, EndLoads, LengthHistory, NewtonConfig, RunConfig, RunOutcome, State};
+use tetherplan::numerics::ge::solver::{
+    self, Damping, Drive, EndLoads, LengthHistory, NewtonConfig, RunConfig, RunOutcome, State,
+};
 use tetherplan::numerics::ge::{GeModel, Section, TipBody};
 use tetherplan::numerics::params::Kinematics;
 
@@ -16,7 +18,8 @@ fn setup() -> (GeModel, Drive, State, RunConfig) {
     let kin = Kinematics { length_m: 1.0, rate_m_s: 0.0, acceleration_m_s2: 0.0 };
     let pushed = TipLoad { force_n: [1000.0, 100.0], moment_n_m: 0.0 };
     let q0 = solver::static_solve(&model, kin, pushed, 4, NewtonConfig::default()).unwrap();
-    let drive = Drive { length: LengthHistory::Constant(1.0), loads: EndLoads::steady(buoyancy), damping: Damping::default() };
+    let drive =
+        Drive { length: LengthHistory::Constant(1.0), loads: EndLoads::steady(buoyancy), damping: Damping::default() };
     let v0 = vec![0.0; q0.len()];
     let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &v0).unwrap();
     let time_scale = (section.rotary_inertia_kg_m / section.bending_stiffness_n_m2).sqrt(); // L0 √(I_ρ/EI)

@@ -8,7 +8,7 @@ use tetherplan::numerics::ge::element::TipLoad;
 use tetherplan::numerics::ge::solver::{
     self, Damping, Drive, EndLoads, LengthHistory, LoadShape, NewtonConfig, RunConfig, RunOutcome, RunResult, State,
 };
-use tetherplan::numerics::ge::{stability, GeModel, Section, StiffnessRule, TipBody};
+use tetherplan::numerics::ge::{GeModel, Section, StiffnessRule, TipBody, stability};
 use tetherplan::numerics::params::{AerostatSystem, Kinematics, NondimState};
 use tetherplan::numerics::profile::Profile;
 use tetherplan::numerics::string::StringModel;
@@ -137,7 +137,10 @@ fn pure_bending_closes_a_circle() {
     // one-point rule: the nodes form a regular polygon of side h and
     // circumradius h/(2 sin(π/n)) → 1/(2π) as n grows (0.1618 at n = 10)
     let polygon = 0.1 / (2.0 * (PI / 10.0).sin());
-    println!("4π, 10 el: radius {r:.6} (polygon {polygon:.6}, exact 1/2π = {:.6}), spread {spread:.1e}", 1.0 / (2.0 * PI));
+    println!(
+        "4π, 10 el: radius {r:.6} (polygon {polygon:.6}, exact 1/2π = {:.6}), spread {spread:.1e}",
+        1.0 / (2.0 * PI)
+    );
     assert!((r - polygon).abs() < 1e-6 && spread < 1e-6);
     assert!((r * 2.0 * PI - 1.0).abs() < 0.02);
 
@@ -180,8 +183,11 @@ fn thin_cantilever_does_not_lock_with_reduced_integration() {
     };
     let reduced = deflection(StiffnessRule::Reduced);
     let full = deflection(StiffnessRule::Full);
-    println!("tip deflection: exact {exact:.6e}, reduced {reduced:.6e} ({:+.3} %), full {full:.6e} ({:.4} of exact)",
-        100.0 * (reduced / exact - 1.0), full / exact);
+    println!(
+        "tip deflection: exact {exact:.6e}, reduced {reduced:.6e} ({:+.3} %), full {full:.6e} ({:.4} of exact)",
+        100.0 * (reduced / exact - 1.0),
+        full / exact
+    );
     // 10 reduced-integration elements: error 1/(4n²) = 0.25 %
     assert!((reduced / exact - 1.0).abs() < 0.01);
     // full integration locks: far too stiff
@@ -324,7 +330,13 @@ fn envelope(r: &RunResult, from: f64, to: f64) -> f64 {
 #[test]
 fn damped_cantilever_of_simo_vu_quoc_decays() {
     let model = GeModel::new(svq_section(), 10, TipBody::default(), 0.0).unwrap();
-    let config = RunConfig { time_step_s: 0.01, duration_s: 100.0, newton: NewtonConfig::default(), record_every: 1, eigen_every: 0 };
+    let config = RunConfig {
+        time_step_s: 0.01,
+        duration_s: 100.0,
+        newton: NewtonConfig::default(),
+        record_every: 1,
+        eigen_every: 0,
+    };
     let drive = svq_drive(30.0, 0.1);
     let r = solver::run(&model, &drive, State::at_rest(&model, 0.0), config, &mut |_, _| true);
     assert_eq!(r.outcome, RunOutcome::Completed);
@@ -334,14 +346,22 @@ fn damped_cantilever_of_simo_vu_quoc_decays() {
     let predicted = (-0.05f64 * 88.0).exp();
     println!(
         "damped cantilever: tip amplitude {early:.3} m (t 2–12 s) → {late:.2e} m (t 90–100 s), ratio {:.2e} (e^(−μΔt/2) = {predicted:.2e}); Newton {:.2}/step, max {}",
-        late / early, r.mean_newton_iterations(), r.newton_iterations_max
+        late / early,
+        r.mean_newton_iterations(),
+        r.newton_iterations_max
     );
     assert!(early > 1.0, "large-deflection pulse expected, got {early}");
     assert!(late / early < 0.02);
     assert!((late / early / predicted).ln().abs() < 0.3);
 
     // undamped, the energy after the pulse is conserved (average acceleration)
-    let r = solver::run(&model, &svq_drive(30.0, 0.0), State::at_rest(&model, 0.0), RunConfig { duration_s: 40.0, ..config }, &mut |_, _| true);
+    let r = solver::run(
+        &model,
+        &svq_drive(30.0, 0.0),
+        State::at_rest(&model, 0.0),
+        RunConfig { duration_s: 40.0, ..config },
+        &mut |_, _| true,
+    );
     let e: Vec<f64> = r.samples.iter().filter(|s| s.time_s > 2.05).map(|s| s.energy.total_j()).collect();
     let (lo, hi) = e.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
     println!("undamped after the pulse: energy {lo:.6}..{hi:.6} J");
@@ -355,11 +375,21 @@ fn small_amplitude_run_oscillates_at_the_timoshenko_frequency() {
     // release from the static shape under a small tip force
     let load = TipLoad { force_n: [0.0, 0.01], moment_n_m: 0.0 };
     let q0 = solver::static_solve(&model, still(10.0), load, 1, NewtonConfig::default()).unwrap();
-    let drive = Drive { length: LengthHistory::Constant(10.0), loads: EndLoads::steady(TipLoad::default()), damping: Damping::default() };
+    let drive = Drive {
+        length: LengthHistory::Constant(10.0),
+        loads: EndLoads::steady(TipLoad::default()),
+        damping: Damping::default(),
+    };
     let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &vec![0.0; q0.len()]).unwrap();
     let state = State { time_s: 0.0, v: vec![0.0; q0.len()], q: q0, a: a0 };
     let dt = 0.01;
-    let config = RunConfig { time_step_s: dt, duration_s: 60.0, newton: NewtonConfig::default(), record_every: 1, eigen_every: 0 };
+    let config = RunConfig {
+        time_step_s: dt,
+        duration_s: 60.0,
+        newton: NewtonConfig::default(),
+        record_every: 1,
+        eigen_every: 0,
+    };
     let r = solver::run(&model, &drive, state, config, &mut |_, _| true);
     // downward zero crossings of the tip deflection (linear interpolation)
     let mut crossings = Vec::new();
@@ -373,7 +403,10 @@ fn small_amplitude_run_oscillates_at_the_timoshenko_frequency() {
     let period = (crossings[periods] - crossings[0]) / periods as f64;
     let omega = 2.0 * PI / period;
     // average acceleration lengthens the period by (ωΔt)²/12
-    println!("run: ω = {omega:.5} rad/s over {periods} periods; Timoshenko {reference:.5}; error {:.3} %", 100.0 * (omega / reference - 1.0));
+    println!(
+        "run: ω = {omega:.5} rad/s over {periods} periods; Timoshenko {reference:.5}; error {:.3} %",
+        100.0 * (omega / reference - 1.0)
+    );
     assert!((omega / reference - 1.0).abs() < 0.01);
 }
 
@@ -392,15 +425,17 @@ fn sliding(rate: f64, dt: f64, duration: f64) -> Sliding {
     } else {
         LengthHistory::Profile(Profile::constant_rate(10.0, rate, None).unwrap())
     };
-    let drive = Drive {
-        length,
-        loads: EndLoads::steady(TipLoad::default()),
-        damping: Damping::default(),
-    };
+    let drive = Drive { length, loads: EndLoads::steady(TipLoad::default()), damping: Damping::default() };
     let v0 = vec![0.0; q0.len()];
     let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &v0).unwrap();
     let state = State { time_s: 0.0, q: q0, v: v0, a: a0 };
-    let config = RunConfig { time_step_s: dt, duration_s: duration, newton: NewtonConfig::default(), record_every: 1, eigen_every: 0 };
+    let config = RunConfig {
+        time_step_s: dt,
+        duration_s: duration,
+        newton: NewtonConfig::default(),
+        record_every: 1,
+        eigen_every: 0,
+    };
     let result = solver::run(&model, &drive, state, config, &mut |_, _| true);
     assert_eq!(result.outcome, RunOutcome::Completed);
     Sliding { result }
@@ -410,7 +445,8 @@ fn sliding(rate: f64, dt: f64, duration: f64) -> Sliding {
 fn energy_windows(r: &RunResult, window: f64) -> (f64, f64) {
     let end = r.samples.last().unwrap().time_s;
     let mean = |a: f64, b: f64| {
-        let v: Vec<f64> = r.samples.iter().filter(|s| s.time_s >= a && s.time_s <= b).map(|s| s.energy.oscillation_j).collect();
+        let v: Vec<f64> =
+            r.samples.iter().filter(|s| s.time_s >= a && s.time_s <= b).map(|s| s.energy.oscillation_j).collect();
         v.iter().sum::<f64>() / v.len() as f64
     };
     (mean(0.0, window), mean(end - window, end))
@@ -473,7 +509,8 @@ fn sliding_constant() -> Sliding {
 
 #[test]
 fn sliding_cantilever_converges_as_the_time_step_halves() {
-    let tips: Vec<f64> = [0.02, 0.01, 0.005].iter().map(|&dt| sliding(0.2, dt, 10.0).result.samples.last().unwrap().tip[1]).collect();
+    let tips: Vec<f64> =
+        [0.02, 0.01, 0.005].iter().map(|&dt| sliding(0.2, dt, 10.0).result.samples.last().unwrap().tip[1]).collect();
     let (d1, d2) = ((tips[0] - tips[1]).abs(), (tips[1] - tips[2]).abs());
     println!("tip deflection at t = 10 s: {tips:.6?}; differences {d1:.2e}, {d2:.2e}, ratio {:.2}", d1 / d2);
     // second order: each halving divides the change by about 4
@@ -510,15 +547,26 @@ fn inextensible_limit_matches_the_string_qep() {
         let st_modes: Vec<_> = st.modes().into_iter().filter(|e| e.im > 1e-12).take(4).collect();
         for (g, t) in ge_modes.iter().zip(&st_modes) {
             let (wg, wt) = (g.im, sys.eigenvalue_to_si(t.im));
-            println!("L = {length} m, v = {rate} m/s: GE λ = {:+.3e} {:+.5}i, string λ = {:+.3e} {:+.5}i 1/s ({:+.3} %)",
-                g.re, wg, sys.eigenvalue_to_si(t.re), wt, 100.0 * (wg / wt - 1.0));
+            println!(
+                "L = {length} m, v = {rate} m/s: GE λ = {:+.3e} {:+.5}i, string λ = {:+.3e} {:+.5}i 1/s ({:+.3} %)",
+                g.re,
+                wg,
+                sys.eigenvalue_to_si(t.re),
+                wt,
+                100.0 * (wg / wt - 1.0)
+            );
             assert!((wg / wt - 1.0).abs() < 0.02);
             // damping rates agree too (both ~ −l̇/(2l) for a lengthening cable)
             assert!((g.re - sys.eigenvalue_to_si(t.re)).abs() < 0.02 * wt);
         }
         // verdicts agree: stable at rest and lengthening, unstable shortening
-        println!("L = {length} m, v = {rate} m/s: GE max Re λ {:+.3e} (stable {}), string {:+.3e} (stable {})",
-            ge.max_real, ge.is_stable(), sys.eigenvalue_to_si(st.max_real), st.is_stable());
+        println!(
+            "L = {length} m, v = {rate} m/s: GE max Re λ {:+.3e} (stable {}), string {:+.3e} (stable {})",
+            ge.max_real,
+            ge.is_stable(),
+            sys.eigenvalue_to_si(st.max_real),
+            st.is_stable()
+        );
         assert_eq!(ge.is_stable(), rate >= 0.0);
         assert_eq!(st.is_stable(), rate >= 0.0);
     }
@@ -530,7 +578,13 @@ fn inextensible_limit_matches_the_string_qep() {
 fn aerostat_on_a_link_conserves_energy_and_balances_angular_momentum() {
     // SVQ beam with a 5 kg mass on a 1 m rigid link; a sideways pulse, then free.
     let model = GeModel::new(svq_section(), 10, TipBody { mass_kg: 5.0, link_length_m: 1.0 }, 0.0).unwrap();
-    let config = RunConfig { time_step_s: 0.01, duration_s: 30.0, newton: NewtonConfig::default(), record_every: 1, eigen_every: 0 };
+    let config = RunConfig {
+        time_step_s: 0.01,
+        duration_s: 30.0,
+        newton: NewtonConfig::default(),
+        record_every: 1,
+        eigen_every: 0,
+    };
     let r = solver::run(&model, &svq_drive(30.0, 0.0), State::at_rest(&model, 0.0), config, &mut |_, _| true);
     assert_eq!(r.outcome, RunOutcome::Completed);
     let free: Vec<_> = r.samples.iter().filter(|s| s.time_s > 2.05).collect();

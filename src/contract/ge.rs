@@ -322,7 +322,8 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
     let m = &req.model;
     let mut section = Section::from_ratios(m.bending_stiffness_n_m2, m.stiffness_ratio, m.inertia_ratio, rho_a, l0)?;
     if let Some(gs) = m.shear_stiffness_ratio {
-        section.shear_stiffness_n = require_positive("model.shear_stiffness_ratio", gs)? * section.bending_stiffness_n_m2 / (l0 * l0);
+        section.shear_stiffness_n =
+            require_positive("model.shear_stiffness_ratio", gs)? * section.bending_stiffness_n_m2 / (l0 * l0);
     }
     let tip = TipBody {
         mass_kg: require_non_negative("aerostat.mass_kg", req.aerostat.mass_kg)?,
@@ -337,7 +338,10 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
         return Err(InvalidInput::new("time_step_s", "must not exceed duration_s"));
     }
     if steps > MAX_STEPS as f64 {
-        return Err(InvalidInput::new("duration_s", format!("needs {steps:.0} steps of time_step_s; at most {MAX_STEPS} are allowed")));
+        return Err(InvalidInput::new(
+            "duration_s",
+            format!("needs {steps:.0} steps of time_step_s; at most {MAX_STEPS} are allowed"),
+        ));
     }
     if steps * m.elements as f64 > MAX_WORK {
         return Err(InvalidInput::new(
@@ -359,7 +363,10 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
             ));
         }
         if steps / req.eigenvalues_every_steps as f64 > MAX_SPECTRA as f64 {
-            return Err(InvalidInput::new("eigenvalues_every_steps", format!("would solve more than {MAX_SPECTRA} QEPs")));
+            return Err(InvalidInput::new(
+                "eigenvalues_every_steps",
+                format!("would solve more than {MAX_SPECTRA} QEPs"),
+            ));
         }
     }
     if !(1..=100).contains(&req.modes) {
@@ -371,10 +378,14 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
         Some(p) => LengthHistory::Profile(p.profile(l0)?),
     };
     // the cable must keep a length over the whole run
-    let shortest = (0..=100).map(|k| length.kinematics(duration * k as f64 / 100.0).length_m).fold(f64::INFINITY, f64::min);
+    let shortest =
+        (0..=100).map(|k| length.kinematics(duration * k as f64 / 100.0).length_m).fold(f64::INFINITY, f64::min);
     let end = length.kinematics(duration).length_m;
     if shortest.min(end) < 1e-3 * l0 {
-        return Err(InvalidInput::new("duration_s", format!("the profile shortens the cable to {:.3e} m within the run", shortest.min(end))));
+        return Err(InvalidInput::new(
+            "duration_s",
+            format!("the profile shortens the cable to {:.3e} m within the run", shortest.min(end)),
+        ));
     }
 
     let steady = TipLoad { force_n: [buoyancy, 0.0], moment_n_m: 0.0 };
@@ -382,7 +393,10 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
         None => (TipLoad::default(), LoadShape::Constant),
         Some(e) => {
             let load = TipLoad {
-                force_n: [require_finite("end_load.axial_force_n", e.axial_force_n)?, require_finite("end_load.transverse_force_n", e.transverse_force_n)?],
+                force_n: [
+                    require_finite("end_load.axial_force_n", e.axial_force_n)?,
+                    require_finite("end_load.transverse_force_n", e.transverse_force_n)?,
+                ],
                 moment_n_m: require_finite("end_load.moment_n_m", e.moment_n_m)?,
             };
             let shape = match e.time {
@@ -419,7 +433,10 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
                 return Err(InvalidInput::new("newton.relative_tolerance", "must not exceed 0.1"));
             }
             if !(1..=200).contains(&n.max_iterations) {
-                return Err(InvalidInput::new("newton.max_iterations", format!("must be between 1 and 200, got {}", n.max_iterations)));
+                return Err(InvalidInput::new(
+                    "newton.max_iterations",
+                    format!("must be between 1 and 200, got {}", n.max_iterations),
+                ));
             }
             NewtonConfig {
                 relative_tolerance: rtol,
@@ -557,7 +574,12 @@ fn groups(p: &Prepared) -> GeGroups {
 
 fn failed_before_start(p: &Prepared, f: solver::NewtonFailure) -> GeSimulateResponse {
     GeSimulateResponse {
-        outcome: GeOutcome::NewtonFailed { step: 0, time_s: 0.0, residual_norm_n: f.residual_norm, iterations: f.iterations },
+        outcome: GeOutcome::NewtonFailed {
+            step: 0,
+            time_s: 0.0,
+            residual_norm_n: f.residual_norm,
+            iterations: f.iterations,
+        },
         series: GeSeries::default(),
         spectra: Vec::new(),
         steps: 0,
@@ -638,7 +660,8 @@ mod tests {
     #[test]
     fn newton_failure_is_an_outcome() {
         let mut v = table_7_1();
-        v["newton"] = serde_json::json!({"relative_tolerance": 1e-16, "absolute_tolerance_n": 0.0, "max_iterations": 1});
+        v["newton"] =
+            serde_json::json!({"relative_tolerance": 1e-16, "absolute_tolerance_n": 0.0, "max_iterations": 1});
         v["initial_state"] = serde_json::json!("rest");
         let req: GeSimulateRequest = serde_json::from_value(v).unwrap();
         let out = simulate_ge(&req, &NoProgress).unwrap();

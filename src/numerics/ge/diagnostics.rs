@@ -6,8 +6,8 @@
 //! The integrals are exact for the element interpolation (2-point Gauss),
 //! the strain energy uses the internal-force rule.
 
-use super::element::{self, node};
 use super::GeModel;
+use super::element::{self, node};
 use crate::numerics::params::Kinematics;
 
 /// Energy of a state (J).

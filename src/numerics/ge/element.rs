@@ -293,9 +293,13 @@ pub fn strain_energy(model: &GeModel, length: f64, q: &[f64]) -> f64 {
         let (ua, ub) = (node(q, e), node(q, e + 1));
         for &(xi, wf) in stiffness_points(model.rule) {
             let p = point_state(model, length, ua, ub, xi, h);
-            total += wf * h * length * 0.5 * (s.axial_stiffness_n * p.gamma[0].powi(2)
-                + s.shear_stiffness_n * p.gamma[1].powi(2)
-                + s.bending_stiffness_n_m2 * p.curvature * p.curvature);
+            total += wf
+                * h
+                * length
+                * 0.5
+                * (s.axial_stiffness_n * p.gamma[0].powi(2)
+                    + s.shear_stiffness_n * p.gamma[1].powi(2)
+                    + s.bending_stiffness_n_m2 * p.curvature * p.curvature);
         }
     }
     total
@@ -316,7 +320,12 @@ pub fn element_resultants(model: &GeModel, length: f64, q: &[f64]) -> Vec<[f64; 
 /// `L ∫ W·A_ρ(−g − L̈)E1`, scaled by `factor`: adds to `f` and `root`.
 pub fn body_forces(model: &GeModel, kin: Kinematics, factor: f64, f: &mut [f64], root: &mut [f64; 3]) {
     let h = model.ops.h;
-    let per_node = factor * kin.length_m * model.section.mass_per_length_kg_m * (-model.gravity_m_s2 - kin.acceleration_m_s2) * 0.5 * h;
+    let per_node = factor
+        * kin.length_m
+        * model.section.mass_per_length_kg_m
+        * (-model.gravity_m_s2 - kin.acceleration_m_s2)
+        * 0.5
+        * h;
     root[0] += per_node;
     for e in 0..model.elements {
         for k in [e, e + 1] {

@@ -147,7 +147,14 @@ impl GeModel {
         require_non_negative("aerostat.mass_kg", tip.mass_kg)?;
         require_non_negative("aerostat.link_length_m", tip.link_length_m)?;
         require_non_negative("gravity_m_s2", gravity_m_s2)?;
-        Ok(Self { section, elements, tip, gravity_m_s2, rule: StiffnessRule::Reduced, ops: element::InertiaOperators::new(elements) })
+        Ok(Self {
+            section,
+            elements,
+            tip,
+            gravity_m_s2,
+            rule: StiffnessRule::Reduced,
+            ops: element::InertiaOperators::new(elements),
+        })
     }
 
     pub fn with_rule(mut self, rule: StiffnessRule) -> Self {

@@ -12,11 +12,11 @@
 //! terms, or when the Newton correction reaches the roundoff level of the
 //! unknowns; failure to converge is a [`NewtonFailure`], not a panic.
 
+use super::GeModel;
 use super::banded::Band;
 use super::diagnostics::{self, Energy};
 use super::element::{self, HALF_BAND, TipLoad};
 use super::stability;
-use super::GeModel;
 use crate::numerics::params::Kinematics;
 use crate::numerics::profile::Profile;
 use crate::numerics::qep::Spectrum;
@@ -93,7 +93,10 @@ impl EndLoads {
     pub fn at(&self, t: f64) -> TipLoad {
         let k = self.shape.factor(t);
         TipLoad {
-            force_n: [self.steady.force_n[0] + k * self.varying.force_n[0], self.steady.force_n[1] + k * self.varying.force_n[1]],
+            force_n: [
+                self.steady.force_n[0] + k * self.varying.force_n[0],
+                self.steady.force_n[1] + k * self.varying.force_n[1],
+            ],
             moment_n_m: self.steady.moment_n_m + k * self.varying.moment_n_m,
         }
     }
@@ -215,7 +218,15 @@ fn residual_with(
 }
 
 /// The linearisation about a state (for Newton and the local QEP).
-pub fn system_matrices(model: &GeModel, kin: Kinematics, load: TipLoad, mu: f64, q: &[f64], v: &[f64], a: &[f64]) -> SystemMatrices {
+pub fn system_matrices(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    mu: f64,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+) -> SystemMatrices {
     let lin = element::linear_operators(model, kin, mu);
     system_matrices_with(model, lin, kin, load, q, v, a)
 }
@@ -369,7 +380,14 @@ impl<'a> Integrator<'a> {
             let mut scratch = vec![0.0; n];
             element::internal_forces(model, kin.length_m, &q, &mut scratch, Some(&mut tangent), None);
             let top = model.elements;
-            let tip = element::tip_terms(model, kin, element::node(&q, top), element::node(&v, top), element::node(&a, top), load);
+            let tip = element::tip_terms(
+                model,
+                kin,
+                element::node(&q, top),
+                element::node(&v, top),
+                element::node(&a, top),
+                load,
+            );
             for i in 0..3 {
                 for j in 0..3 {
                     let value = tip.stiffness[i][j] + alpha_v * tip.damping[i][j] + alpha_a * tip.mass[i][j];
@@ -504,7 +522,8 @@ pub fn run(
     let mut spectrum_failures = 0;
     let mut record_spectrum = |state: &State, spectra: &mut Vec<SpectrumSample>| {
         let kin = drive.length.kinematics(state.time_s);
-        match stability::local_spectrum(model, kin, drive.loads.at(state.time_s), drive.damping.at(state.time_s), state) {
+        match stability::local_spectrum(model, kin, drive.loads.at(state.time_s), drive.damping.at(state.time_s), state)
+        {
             Ok(spectrum) => spectra.push(SpectrumSample { time_s: state.time_s, length_m: kin.length_m, spectrum }),
             Err(_) => spectrum_failures += 1,
         }

@@ -7,14 +7,20 @@
 
 use faer::Mat;
 
-use super::solver::{self, State};
-use super::element::TipLoad;
 use super::GeModel;
+use super::element::TipLoad;
+use super::solver::{self, State};
 use crate::numerics::params::Kinematics;
 use crate::numerics::qep::{self, Eigenvalue, QepError, Spectrum};
 
 /// The QEP spectrum of the linearisation about `state`.
-pub fn local_spectrum(model: &GeModel, kin: Kinematics, load: TipLoad, mu: f64, state: &State) -> Result<Spectrum, QepError> {
+pub fn local_spectrum(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    mu: f64,
+    state: &State,
+) -> Result<Spectrum, QepError> {
     let sys = solver::system_matrices(model, kin, load, mu, &state.q, &state.v, &state.a);
     let n = model.dofs();
     let k = sys.stiffness.to_dense();
@@ -38,7 +44,8 @@ pub fn local_spectrum(model: &GeModel, kin: Kinematics, load: TipLoad, mu: f64, 
     // Scale λ = σ μ with σ² = ‖M⁻¹K‖∞ so the companion has norm ~ 1 (the
     // stiff axial/shear modes otherwise make it ~ρ² and swamp the
     // eigenvalues with roundoff).
-    let row_norm = |off: usize| (0..n).map(|i| (0..n).map(|j| inv[(i, j + off)].abs()).sum::<f64>()).fold(0.0, f64::max);
+    let row_norm =
+        |off: usize| (0..n).map(|i| (0..n).map(|j| inv[(i, j + off)].abs()).sum::<f64>()).fold(0.0, f64::max);
     let sigma = row_norm(0).sqrt().max(row_norm(n)).max(1e-300);
     let companion = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| {
         if i < n {
@@ -50,7 +57,8 @@ pub fn local_spectrum(model: &GeModel, kin: Kinematics, load: TipLoad, mu: f64, 
         }
     });
     let (re, im) = qep::eigenvalues_real(&companion)?;
-    let eigenvalues: Vec<Eigenvalue> = re.into_iter().zip(im).map(|(re, im)| Eigenvalue { re: sigma * re, im: sigma * im }).collect();
+    let eigenvalues: Vec<Eigenvalue> =
+        re.into_iter().zip(im).map(|(re, im)| Eigenvalue { re: sigma * re, im: sigma * im }).collect();
     let max_real = eigenvalues.iter().map(|e| e.re).fold(f64::NEG_INFINITY, f64::max);
     let spectral_radius = eigenvalues.iter().map(Eigenvalue::abs).fold(0.0, f64::max);
     Ok(Spectrum { eigenvalues, max_real, spectral_radius })
