@@ -3,6 +3,8 @@
 //! reference (closed form, finite differences, the linear Timoshenko
 //! cantilever, the linear-string QEP) and a stated tolerance.
 
+#![allow(clippy::needless_range_loop)]
+
 use proptest::prelude::*;
 use tetherplan::numerics::ge::element::TipLoad;
 use tetherplan::numerics::ge::solver::{

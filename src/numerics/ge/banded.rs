@@ -90,7 +90,7 @@ impl Band {
                     p = r;
                 }
             }
-            if !(best > 0.0) || !best.is_finite() {
+            if !best.is_finite() || best <= 0.0 {
                 return None;
             }
             pivots[k] = p;

@@ -38,6 +38,9 @@
 //! (energy (6.22)–(6.24), angular momentum (6.27), root moment),
 //! [`stability`] (local QEP (7.3) about a converged state).
 
+// Element and band loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 pub mod banded;
 pub mod diagnostics;
 pub mod element;
