@@ -485,6 +485,15 @@ fn sliding_cantilever_energy_and_angular_momentum() {
     let ps = (s1 / s0).ln() / (ls0 / ls1).ln();
     println!("lengthening 10→15 m: oscillation energy ratio {:.4} (L0/L = {:.4}); E ∝ L^-{pg:.2}", g1 / g0, lg0 / lg1);
     println!("shortening 10→5 m: oscillation energy ratio {:.4} (L0/L = {:.4}); E ∝ L^-{ps:.2}", s1 / s0, ls0 / ls1);
+    let total = |r: &RunResult| {
+        let (a, b) = (r.samples.first().unwrap(), r.samples.last().unwrap());
+        (a.energy.total_j(), b.energy.total_j())
+    };
+    println!(
+        "total energy (6.22)+(6.24), rigid sliding included: lengthening {:.4?} J, shortening {:.4?} J",
+        total(&grow.result),
+        total(&shrink.result)
+    );
     assert!(g1 < 0.9 * g0, "energy must fall while lengthening");
     assert!(s1 > 1.1 * s0, "energy must rise while shortening");
     // about ∝ 1/L (exponent within 0.5..2)
@@ -605,4 +614,45 @@ fn aerostat_on_a_link_conserves_energy_and_balances_angular_momentum() {
     assert!(swing > 0.05, "the link should rotate");
     assert!((hi - lo) / hi < 1e-3);
     assert!(worst / scale < 1e-4);
+}
+
+// ---------------------------------------------------------------- sliding inertia and gravity
+
+#[test]
+fn accelerating_straight_cable_root_force_is_the_momentum_balance() {
+    // Table 7.1 cable and aerostat, winched out at L̈ = 2 m/s² from 10 m. For a
+    // straight cable the support must supply R1 = (A_ρ L + m) L̈ + A_ρ g L − F
+    // (momentum of the cable out of the guide, less the inflow A_ρ L̇² at the root).
+    let model = table_7_1(20);
+    let profile = Profile::constant_acceleration(10.0, 2.0, None).unwrap();
+    let buoyancy = TipLoad { force_n: [1000.0, 0.0], moment_n_m: 0.0 };
+    let drive = Drive {
+        length: LengthHistory::Profile(profile.clone()),
+        loads: EndLoads::steady(buoyancy),
+        damping: Damping::default(),
+    };
+    let q0 = solver::static_solve(&model, profile.kinematics(0.0), buoyancy, 2, NewtonConfig::default()).unwrap();
+    let v0 = vec![0.0; q0.len()];
+    let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &v0).unwrap();
+    let state = State { time_s: 0.0, q: q0, v: v0, a: a0 };
+    let config =
+        RunConfig { time_step_s: 1e-3, duration_s: 2.0, newton: NewtonConfig::default(), record_every: 10, eigen_every: 0 };
+    let r = solver::run(&model, &drive, state, config, &mut |_, _| true);
+    assert_eq!(r.outcome, RunOutcome::Completed);
+    let rho_a = 7800.0 * 1e-5;
+    let mut worst = 0.0f64;
+    for s in &r.samples {
+        let k = s.kinematics;
+        let expected = (rho_a * k.length_m + 10.0) * k.acceleration_m_s2 + rho_a * 9.81 * k.length_m - 1000.0;
+        worst = worst.max((s.root_force_n[0] - expected).abs());
+        assert!(s.tip[1].abs() < 1e-9);
+    }
+    let last = r.samples.last().unwrap();
+    println!(
+        "accelerating cable at L = {:.2} m: root force {:.4} N, expected {:.4} N; worst deviation {worst:.2e} N",
+        last.kinematics.length_m,
+        last.root_force_n[0],
+        (rho_a * last.kinematics.length_m + 10.0) * 2.0 + rho_a * 9.81 * last.kinematics.length_m - 1000.0
+    );
+    assert!(worst < 1e-2, "deviation {worst} N");
 }

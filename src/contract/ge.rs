@@ -632,6 +632,25 @@ mod tests {
     }
 
     #[test]
+    fn lengthening_run_stays_stable_and_follows_the_profile() {
+        let mut v = table_7_1();
+        v["profile"] = serde_json::json!({"kind": "constant_rate", "rate_m_s": 10.0});
+        v["duration_s"] = serde_json::json!(0.5);
+        v["time_step_s"] = serde_json::json!(0.001);
+        v["output_every_steps"] = serde_json::json!(50);
+        v["eigenvalues_every_steps"] = serde_json::json!(250);
+        let req: GeSimulateRequest = serde_json::from_value(v).unwrap();
+        let out = simulate_ge(&req, &NoProgress).unwrap();
+        assert_eq!(out.outcome, GeOutcome::Completed);
+        let last = out.series.length_m.len() - 1;
+        assert!((out.series.length_m[last] - 6.0).abs() < 1e-9);
+        assert!((out.series.rate_m_s[last] - 10.0).abs() < 1e-12);
+        // 10 m/s is far below the wave speed (113 m/s): stable throughout
+        assert_eq!(out.spectra.len(), 3);
+        assert!(out.spectra.iter().all(|s| s.stable), "{:?}", out.spectra);
+    }
+
+    #[test]
     fn rejects_bad_input_naming_the_field() {
         let mut v = table_7_1();
         v["model"]["stiffness_ratio"] = serde_json::json!(-1.0);
