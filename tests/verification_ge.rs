@@ -635,8 +635,13 @@ fn accelerating_straight_cable_root_force_is_the_momentum_balance() {
     let v0 = vec![0.0; q0.len()];
     let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &v0).unwrap();
     let state = State { time_s: 0.0, q: q0, v: v0, a: a0 };
-    let config =
-        RunConfig { time_step_s: 1e-3, duration_s: 2.0, newton: NewtonConfig::default(), record_every: 10, eigen_every: 0 };
+    let config = RunConfig {
+        time_step_s: 1e-3,
+        duration_s: 2.0,
+        newton: NewtonConfig::default(),
+        record_every: 10,
+        eigen_every: 0,
+    };
     let r = solver::run(&model, &drive, state, config, &mut |_, _| true);
     assert_eq!(r.outcome, RunOutcome::Completed);
     let rho_a = 7800.0 * 1e-5;
