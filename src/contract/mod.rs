@@ -4,6 +4,7 @@
 //! ([`run`]). Everything here is synchronous and CPU-bound.
 
 pub mod dto;
+pub mod ge;
 pub mod run;
 
 pub use run::{Progress, RequestError};
@@ -24,6 +25,19 @@ pub fn parse<T: dto::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
     let system = parse_value::<dto::SystemInput>(&value)?;
     let params = parse_value::<T::Params>(&value)?;
     Ok(T::from_parts(system, params))
+}
+
+/// Parses a body that has no flattened parts (one pass, field paths kept).
+pub fn parse_plain<T: serde::de::DeserializeOwned>(body: &[u8]) -> Result<T, RequestError> {
+    let value: serde_json::Value =
+        serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
+    if !value.is_object() {
+        return Err(RequestError::Invalid(InvalidInput::new(
+            "body",
+            "must be a JSON object",
+        )));
+    }
+    parse_value(&value)
 }
 
 /// Deserialises `T` from a JSON value with the error's field path.

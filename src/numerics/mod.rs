@@ -3,6 +3,7 @@
 //! Inputs are SI; inside, the models work non-dimensionally (SPEC §1).
 
 pub mod chart;
+pub mod ge;
 pub mod ge_reduced;
 pub mod mesh;
 pub mod params;

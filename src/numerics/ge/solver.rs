@@ -1,0 +1,699 @@
+//! Time integration: Newmark average acceleration (β = 1/4, γ = 1/2) with
+//! Newton–Raphson on the residual of the semi-discrete equations
+//!
+//! ```text
+//! R(q, q̇, q̈, t) = M q̈ + C q̇ + K q + F_int(q) − F_body + T_aerostat(q, q̇, q̈) = 0
+//! ```
+//!
+//! (thesis ch. 6.5, Fig. 6.1). The length `L(t)` comes from a deployment
+//! profile; end loads may be held, ramped or pulsed; linear damping may be
+//! switched on at a time. Newton stops when `‖R‖ ≤ atol + rtol·s`, with `s`
+//! the largest of the norms of the inertia, internal, body and aerostat
+//! terms, or when the Newton correction reaches the roundoff level of the
+//! unknowns; failure to converge is a [`NewtonFailure`], not a panic.
+
+use super::GeModel;
+use super::banded::Band;
+use super::diagnostics::{self, Energy};
+use super::element::{self, HALF_BAND, TipLoad};
+use super::stability;
+use crate::numerics::params::Kinematics;
+use crate::numerics::profile::Profile;
+use crate::numerics::qep::Spectrum;
+
+/// Largest number of time steps a run may take.
+pub const MAX_STEPS: usize = 2_000_000;
+
+/// Cable length against time.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LengthHistory {
+    Constant(f64),
+    Profile(Profile),
+}
+
+impl LengthHistory {
+    pub fn kinematics(&self, t_s: f64) -> Kinematics {
+        match self {
+            Self::Constant(l) => Kinematics {
+                length_m: *l,
+                rate_m_s: 0.0,
+                acceleration_m_s2: 0.0,
+            },
+            Self::Profile(p) => p.kinematics(t_s),
+        }
+    }
+}
+
+/// Time shape of the varying part of an end load.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LoadShape {
+    /// Always on.
+    Constant,
+    /// Rises linearly over `ramp_s`, held until `hold_s`, then removed.
+    Held { ramp_s: f64, hold_s: f64 },
+    /// Rises linearly to its peak at `peak_s`, back to zero at `end_s`.
+    Triangle { peak_s: f64, end_s: f64 },
+}
+
+impl LoadShape {
+    pub fn factor(&self, t: f64) -> f64 {
+        match *self {
+            Self::Constant => 1.0,
+            Self::Held { ramp_s, hold_s } => {
+                if t > hold_s {
+                    0.0
+                } else if ramp_s > 0.0 && t < ramp_s {
+                    (t / ramp_s).max(0.0)
+                } else {
+                    1.0
+                }
+            }
+            Self::Triangle { peak_s, end_s } => {
+                if t <= 0.0 || t >= end_s {
+                    0.0
+                } else if t <= peak_s {
+                    t / peak_s
+                } else {
+                    (end_s - t) / (end_s - peak_s)
+                }
+            }
+        }
+    }
+}
+
+/// End loads on the aerostat: a steady part (net buoyancy) and a varying one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EndLoads {
+    pub steady: TipLoad,
+    pub varying: TipLoad,
+    pub shape: LoadShape,
+}
+
+impl EndLoads {
+    pub fn steady(load: TipLoad) -> Self {
+        Self {
+            steady: load,
+            varying: TipLoad::default(),
+            shape: LoadShape::Constant,
+        }
+    }
+
+    pub fn at(&self, t: f64) -> TipLoad {
+        let k = self.shape.factor(t);
+        TipLoad {
+            force_n: [
+                self.steady.force_n[0] + k * self.varying.force_n[0],
+                self.steady.force_n[1] + k * self.varying.force_n[1],
+            ],
+            moment_n_m: self.steady.moment_n_m + k * self.varying.moment_n_m,
+        }
+    }
+}
+
+/// Linear viscous damping `μ` (1/s, per unit mass), on from `from_s`.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Damping {
+    pub per_s: f64,
+    pub from_s: f64,
+}
+
+impl Damping {
+    pub fn at(&self, t: f64) -> f64 {
+        if t >= self.from_s { self.per_s } else { 0.0 }
+    }
+}
+
+/// What drives a run: length history, end loads, damping.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Drive {
+    pub length: LengthHistory,
+    pub loads: EndLoads,
+    pub damping: Damping,
+}
+
+/// Newton–Raphson settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonConfig {
+    /// Relative residual tolerance (against the largest force term).
+    pub relative_tolerance: f64,
+    /// Absolute residual tolerance (N).
+    pub absolute_tolerance_n: f64,
+    /// Iteration cap per step.
+    pub max_iterations: usize,
+}
+
+impl Default for NewtonConfig {
+    fn default() -> Self {
+        Self {
+            relative_tolerance: 1e-9,
+            absolute_tolerance_n: 1e-10,
+            max_iterations: 30,
+        }
+    }
+}
+
+/// Newton did not converge.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonFailure {
+    pub time_s: f64,
+    pub iterations: usize,
+    pub residual_norm: f64,
+}
+
+/// Unknowns at one instant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    pub time_s: f64,
+    pub q: Vec<f64>,
+    pub v: Vec<f64>,
+    pub a: Vec<f64>,
+}
+
+impl State {
+    pub fn at_rest(model: &GeModel, time_s: f64) -> Self {
+        let n = model.dofs();
+        Self {
+            time_s,
+            q: vec![0.0; n],
+            v: vec![0.0; n],
+            a: vec![0.0; n],
+        }
+    }
+}
+
+/// `M`, `C`, `K` of the linearised equations about `(q, q̇, q̈)`:
+/// `∂R/∂q̈`, `∂R/∂q̇`, `∂R/∂q`, aerostat included.
+pub struct SystemMatrices {
+    pub mass: Band,
+    pub damping: Band,
+    pub stiffness: Band,
+}
+
+/// Residual pieces at a state, and their sum.
+pub struct Residual {
+    pub total: Vec<f64>,
+    /// Largest norm among the inertia, internal, body and aerostat terms.
+    pub scale: f64,
+}
+
+fn norm(x: &[f64]) -> f64 {
+    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+/// The residual `R(q, q̇, q̈)` at `kin` under `load` with damping `mu`.
+pub fn residual(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    mu: f64,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+) -> Residual {
+    let lin = element::linear_operators(model, kin, mu);
+    residual_with(model, &lin, kin, load, q, v, a)
+}
+
+fn residual_with(
+    model: &GeModel,
+    lin: &element::LinearOperators,
+    kin: Kinematics,
+    load: TipLoad,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+) -> Residual {
+    let n = model.dofs();
+    let mut inertia = vec![0.0; n];
+    lin.mass.mul_add(a, &mut inertia);
+    lin.damping.mul_add(v, &mut inertia);
+    lin.stiffness.mul_add(q, &mut inertia);
+    let mut internal = vec![0.0; n];
+    element::internal_forces(model, kin.length_m, q, &mut internal, None, None);
+    let mut body = vec![0.0; n];
+    element::body_forces(model, kin, 1.0, &mut body, &mut [0.0; 3]);
+    let top = model.elements;
+    let tip = element::tip_terms(
+        model,
+        kin,
+        element::node(q, top),
+        element::node(v, top),
+        element::node(a, top),
+        load,
+    );
+    let mut total: Vec<f64> = (0..n).map(|i| inertia[i] + internal[i] - body[i]).collect();
+    for c in 0..3 {
+        total[GeModel::dof(top, c)] += tip.residual[c];
+    }
+    let scale = norm(&inertia)
+        .max(norm(&internal))
+        .max(norm(&body))
+        .max(norm(&tip.residual));
+    Residual { total, scale }
+}
+
+/// The linearisation about a state (for Newton and the local QEP).
+pub fn system_matrices(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    mu: f64,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+) -> SystemMatrices {
+    let lin = element::linear_operators(model, kin, mu);
+    system_matrices_with(model, lin, kin, load, q, v, a)
+}
+
+fn system_matrices_with(
+    model: &GeModel,
+    lin: element::LinearOperators,
+    kin: Kinematics,
+    load: TipLoad,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+) -> SystemMatrices {
+    let element::LinearOperators {
+        mut mass,
+        mut damping,
+        mut stiffness,
+    } = lin;
+    let mut scratch = vec![0.0; model.dofs()];
+    element::internal_forces(
+        model,
+        kin.length_m,
+        q,
+        &mut scratch,
+        Some(&mut stiffness),
+        None,
+    );
+    let top = model.elements;
+    let tip = element::tip_terms(
+        model,
+        kin,
+        element::node(q, top),
+        element::node(v, top),
+        element::node(a, top),
+        load,
+    );
+    for i in 0..3 {
+        for j in 0..3 {
+            let (r, c) = (GeModel::dof(top, i), GeModel::dof(top, j));
+            mass.add(r, c, tip.mass[i][j]);
+            damping.add(r, c, tip.damping[i][j]);
+            stiffness.add(r, c, tip.stiffness[i][j]);
+        }
+    }
+    SystemMatrices {
+        mass,
+        damping,
+        stiffness,
+    }
+}
+
+/// Consistent initial acceleration: solves `M q̈ = −R(q, q̇, 0)`.
+pub fn initial_acceleration(
+    model: &GeModel,
+    drive: &Drive,
+    time_s: f64,
+    q: &[f64],
+    v: &[f64],
+) -> Option<Vec<f64>> {
+    let kin = drive.length.kinematics(time_s);
+    let load = drive.loads.at(time_s);
+    let mu = drive.damping.at(time_s);
+    let zero = vec![0.0; model.dofs()];
+    let r = residual(model, kin, load, mu, q, v, &zero);
+    let m = system_matrices(model, kin, load, mu, q, v, &zero).mass;
+    let lu = m.factor()?;
+    let mut a: Vec<f64> = r.total.iter().map(|x| -x).collect();
+    lu.solve_in_place(&mut a);
+    Some(a)
+}
+
+/// Static equilibrium at `kin` under `load` and gravity, applied in
+/// `load_steps` equal increments, each solved by Newton from the last.
+pub fn static_solve(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    load_steps: usize,
+    newton: NewtonConfig,
+) -> Result<Vec<f64>, NewtonFailure> {
+    let n = model.dofs();
+    let mut q = vec![0.0; n];
+    let zero = vec![0.0; n];
+    let steps = load_steps.max(1);
+    let mut scaled_model = model.clone();
+    for k in 1..=steps {
+        let lam = k as f64 / steps as f64;
+        scaled_model.gravity_m_s2 = model.gravity_m_s2 * lam;
+        let l = TipLoad {
+            force_n: [lam * load.force_n[0], lam * load.force_n[1]],
+            moment_n_m: lam * load.moment_n_m,
+        };
+        let mut iterations = 0;
+        loop {
+            let r = residual(&scaled_model, kin, l, 0.0, &q, &zero, &zero);
+            let rn = norm(&r.total);
+            if rn <= newton.absolute_tolerance_n + newton.relative_tolerance * r.scale {
+                break;
+            }
+            if iterations >= newton.max_iterations || !rn.is_finite() {
+                return Err(NewtonFailure {
+                    time_s: 0.0,
+                    iterations,
+                    residual_norm: rn,
+                });
+            }
+            let s = system_matrices(&scaled_model, kin, l, 0.0, &q, &zero, &zero).stiffness;
+            let Some(lu) = s.factor() else {
+                return Err(NewtonFailure {
+                    time_s: 0.0,
+                    iterations,
+                    residual_norm: rn,
+                });
+            };
+            let mut dq: Vec<f64> = r.total.iter().map(|x| -x).collect();
+            lu.solve_in_place(&mut dq);
+            for i in 0..n {
+                q[i] += dq[i];
+            }
+            iterations += 1;
+            if at_roundoff(&dq, &q, kin.length_m) {
+                break;
+            }
+        }
+    }
+    Ok(q)
+}
+
+/// The Newton correction is at the roundoff level of the unknowns: the
+/// residual cannot be reduced further (stiff cables: `EA·ε` per element).
+fn at_roundoff(dq: &[f64], q: &[f64], length: f64) -> bool {
+    let big = q.iter().fold(length, |m, x| m.max(x.abs()));
+    dq.iter().all(|d| d.abs() <= 1e-13 * big)
+}
+
+/// Newmark parameters (average acceleration by default).
+pub const BETA: f64 = 0.25;
+pub const GAMMA: f64 = 0.5;
+
+/// Advances one state by Newmark–Newton steps of fixed size.
+pub struct Integrator<'a> {
+    pub model: &'a GeModel,
+    pub drive: &'a Drive,
+    pub state: State,
+    pub time_step_s: f64,
+    pub newton: NewtonConfig,
+}
+
+impl<'a> Integrator<'a> {
+    pub fn new(
+        model: &'a GeModel,
+        drive: &'a Drive,
+        state: State,
+        time_step_s: f64,
+        newton: NewtonConfig,
+    ) -> Self {
+        Self {
+            model,
+            drive,
+            state,
+            time_step_s,
+            newton,
+        }
+    }
+
+    /// One step; returns the number of Newton iterations (linear solves).
+    pub fn step(&mut self) -> Result<usize, NewtonFailure> {
+        let model = self.model;
+        let n = model.dofs();
+        let dt = self.time_step_s;
+        let t1 = self.state.time_s + dt;
+        let kin = self.drive.length.kinematics(t1);
+        let load = self.drive.loads.at(t1);
+        let mu = self.drive.damping.at(t1);
+        let lin = element::linear_operators(model, kin, mu);
+        let (qn, vn, an) = (&self.state.q, &self.state.v, &self.state.a);
+        let alpha_a = 1.0 / (BETA * dt * dt);
+        let alpha_v = GAMMA / (BETA * dt);
+        let mut q: Vec<f64> = (0..n)
+            .map(|i| qn[i] + dt * vn[i] + 0.5 * dt * dt * an[i])
+            .collect();
+        let mut a = vec![0.0; n];
+        let mut v = vec![0.0; n];
+        let mut iterations = 0;
+        let mut tangent = Band::zeros(n, HALF_BAND, HALF_BAND);
+        loop {
+            for i in 0..n {
+                a[i] = alpha_a * (q[i] - qn[i] - dt * vn[i]) - (0.5 / BETA - 1.0) * an[i];
+                v[i] = vn[i] + dt * ((1.0 - GAMMA) * an[i] + GAMMA * a[i]);
+            }
+            let r = residual_with(model, &lin, kin, load, &q, &v, &a);
+            let rn = norm(&r.total);
+            if rn <= self.newton.absolute_tolerance_n + self.newton.relative_tolerance * r.scale {
+                break;
+            }
+            if iterations >= self.newton.max_iterations || !rn.is_finite() {
+                return Err(NewtonFailure {
+                    time_s: t1,
+                    iterations,
+                    residual_norm: rn,
+                });
+            }
+            // S = K + K_int + K_tip + α_v C + α_a M
+            tangent.fill_zero();
+            tangent.add_scaled(1.0, &lin.stiffness);
+            tangent.add_scaled(alpha_v, &lin.damping);
+            tangent.add_scaled(alpha_a, &lin.mass);
+            let mut scratch = vec![0.0; n];
+            element::internal_forces(
+                model,
+                kin.length_m,
+                &q,
+                &mut scratch,
+                Some(&mut tangent),
+                None,
+            );
+            let top = model.elements;
+            let tip = element::tip_terms(
+                model,
+                kin,
+                element::node(&q, top),
+                element::node(&v, top),
+                element::node(&a, top),
+                load,
+            );
+            for i in 0..3 {
+                for j in 0..3 {
+                    let value = tip.stiffness[i][j]
+                        + alpha_v * tip.damping[i][j]
+                        + alpha_a * tip.mass[i][j];
+                    tangent.add(GeModel::dof(top, i), GeModel::dof(top, j), value);
+                }
+            }
+            let Some(lu) = tangent.clone().factor() else {
+                return Err(NewtonFailure {
+                    time_s: t1,
+                    iterations,
+                    residual_norm: rn,
+                });
+            };
+            let mut dq: Vec<f64> = r.total.iter().map(|x| -x).collect();
+            lu.solve_in_place(&mut dq);
+            for i in 0..n {
+                q[i] += dq[i];
+            }
+            iterations += 1;
+            if at_roundoff(&dq, &q, kin.length_m) {
+                for i in 0..n {
+                    a[i] = alpha_a * (q[i] - qn[i] - dt * vn[i]) - (0.5 / BETA - 1.0) * an[i];
+                    v[i] = vn[i] + dt * ((1.0 - GAMMA) * an[i] + GAMMA * a[i]);
+                }
+                break;
+            }
+        }
+        self.state = State {
+            time_s: t1,
+            q,
+            v,
+            a,
+        };
+        Ok(iterations)
+    }
+}
+
+/// Settings of a transient run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunConfig {
+    pub time_step_s: f64,
+    pub duration_s: f64,
+    pub newton: NewtonConfig,
+    /// Record a sample every this many steps (≥ 1); the last step is always recorded.
+    pub record_every: usize,
+    /// Solve the local QEP every this many steps (0: never).
+    pub eigen_every: usize,
+}
+
+/// One recorded instant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sample {
+    pub time_s: f64,
+    pub kinematics: Kinematics,
+    /// Top of the cable (m): along the guide and across it.
+    pub tip: [f64; 2],
+    pub tip_rotation_rad: f64,
+    /// The aerostat's mass point (m).
+    pub aerostat: [f64; 2],
+    pub energy: Energy,
+    /// Angular momentum about the root (6.27) (N m s).
+    pub angular_momentum_n_m_s: f64,
+    /// Support reaction at the root on the cable: force (N), moment (N m).
+    pub root_force_n: [f64; 2],
+    pub root_moment_n_m: f64,
+    /// Newton iterations of the step that produced this sample.
+    pub newton_iterations: usize,
+}
+
+/// How a run ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RunOutcome {
+    Completed,
+    NewtonFailed { step: usize, failure: NewtonFailure },
+    Cancelled { step: usize, time_s: f64 },
+}
+
+/// The local QEP along the run.
+#[derive(Clone, Debug)]
+pub struct SpectrumSample {
+    pub time_s: f64,
+    pub length_m: f64,
+    pub spectrum: Spectrum,
+}
+
+#[derive(Clone, Debug)]
+pub struct RunResult {
+    pub samples: Vec<Sample>,
+    pub spectra: Vec<SpectrumSample>,
+    pub outcome: RunOutcome,
+    pub steps: usize,
+    pub newton_iterations_total: usize,
+    pub newton_iterations_max: usize,
+    pub final_state: State,
+    /// QEP solves that failed (eigenvalue iteration did not converge).
+    pub spectrum_failures: usize,
+}
+
+impl RunResult {
+    pub fn mean_newton_iterations(&self) -> f64 {
+        if self.steps == 0 {
+            0.0
+        } else {
+            self.newton_iterations_total as f64 / self.steps as f64
+        }
+    }
+}
+
+/// Diagnostics of a state.
+pub fn sample(model: &GeModel, drive: &Drive, state: &State, newton_iterations: usize) -> Sample {
+    let t = state.time_s;
+    let kin = drive.length.kinematics(t);
+    let mu = drive.damping.at(t);
+    let top = model.elements;
+    let (qt, vt) = (element::node(&state.q, top), element::node(&state.v, top));
+    let (aerostat, _) = element::tip_point(model, kin, qt, vt);
+    let reaction = diagnostics::root_reaction(model, kin, mu, &state.q, &state.v, &state.a);
+    Sample {
+        time_s: t,
+        kinematics: kin,
+        tip: [kin.length_m + qt[0], qt[1]],
+        tip_rotation_rad: qt[2],
+        aerostat,
+        energy: diagnostics::energy(model, kin, &state.q, &state.v),
+        angular_momentum_n_m_s: diagnostics::angular_momentum(model, kin, &state.q, &state.v),
+        root_force_n: [reaction[0], reaction[1]],
+        root_moment_n_m: reaction[2],
+        newton_iterations,
+    }
+}
+
+/// Runs from `initial` for `config.duration_s`. `observer(done, total)` is
+/// called every few steps; returning `false` cancels.
+pub fn run(
+    model: &GeModel,
+    drive: &Drive,
+    initial: State,
+    config: RunConfig,
+    observer: &mut dyn FnMut(usize, usize) -> bool,
+) -> RunResult {
+    let steps_total = (config.duration_s / config.time_step_s).round() as usize;
+    let every = config.record_every.max(1);
+    let mut samples = vec![sample(model, drive, &initial, 0)];
+    let mut spectra = Vec::new();
+    let mut spectrum_failures = 0;
+    let mut record_spectrum = |state: &State, spectra: &mut Vec<SpectrumSample>| {
+        let kin = drive.length.kinematics(state.time_s);
+        match stability::local_spectrum(
+            model,
+            kin,
+            drive.loads.at(state.time_s),
+            drive.damping.at(state.time_s),
+            state,
+        ) {
+            Ok(spectrum) => spectra.push(SpectrumSample {
+                time_s: state.time_s,
+                length_m: kin.length_m,
+                spectrum,
+            }),
+            Err(_) => spectrum_failures += 1,
+        }
+    };
+    if config.eigen_every > 0 {
+        record_spectrum(&initial, &mut spectra);
+    }
+    let mut integrator = Integrator::new(model, drive, initial, config.time_step_s, config.newton);
+    let (mut total, mut max) = (0, 0);
+    let mut outcome = RunOutcome::Completed;
+    let report_every = (steps_total / 200).max(1);
+    let mut steps = 0;
+    for step in 1..=steps_total {
+        if step % report_every == 0 && !observer(step, steps_total) {
+            outcome = RunOutcome::Cancelled {
+                step,
+                time_s: integrator.state.time_s,
+            };
+            break;
+        }
+        match integrator.step() {
+            Ok(it) => {
+                steps = step;
+                total += it;
+                max = max.max(it);
+                if step % every == 0 || step == steps_total {
+                    samples.push(sample(model, drive, &integrator.state, it));
+                }
+                if config.eigen_every > 0 && step % config.eigen_every == 0 {
+                    record_spectrum(&integrator.state, &mut spectra);
+                }
+            }
+            Err(failure) => {
+                outcome = RunOutcome::NewtonFailed { step, failure };
+                break;
+            }
+        }
+    }
+    observer(steps, steps_total);
+    RunResult {
+        samples,
+        spectra,
+        outcome,
+        steps,
+        newton_iterations_total: total,
+        newton_iterations_max: max,
+        final_state: integrator.state,
+        spectrum_failures,
+    }
+}
