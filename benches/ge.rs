@@ -6,7 +6,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use tetherplan::numerics::ge::element::TipLoad;
 use tetherplan::numerics::ge::solver::{
-    self, Damping, Drive, EndLoads, LengthHistory, NewtonConfig, RunConfig, RunOutcome, State,
+    self, BaseMotion, Damping, Drive, EndLoads, LengthHistory, NewtonConfig, RunConfig, RunOutcome,
+    State,
 };
 use tetherplan::numerics::ge::{GeModel, Section, TipBody};
 use tetherplan::numerics::params::Kinematics;
@@ -41,6 +42,7 @@ fn setup() -> (GeModel, Drive, State, RunConfig) {
         length: LengthHistory::Constant(1.0),
         loads: EndLoads::steady(buoyancy),
         damping: Damping::default(),
+        base: BaseMotion::default(),
     };
     let v0 = vec![0.0; q0.len()];
     let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &v0).unwrap();

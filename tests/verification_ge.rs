@@ -8,8 +8,8 @@
 use proptest::prelude::*;
 use tetherplan::numerics::ge::element::TipLoad;
 use tetherplan::numerics::ge::solver::{
-    self, Damping, Drive, EndLoads, LengthHistory, LoadShape, NewtonConfig, RunConfig, RunOutcome,
-    RunResult, State,
+    self, BaseMotion, Damping, Drive, EndLoads, LengthHistory, LoadShape, NewtonConfig, RunConfig,
+    RunOutcome, RunResult, State,
 };
 use tetherplan::numerics::ge::{GeModel, Section, StiffnessRule, TipBody, stability};
 use tetherplan::numerics::params::{AerostatSystem, Kinematics, NondimState};
@@ -395,6 +395,7 @@ fn svq_drive(peak_n: f64, mu: f64) -> Drive {
             per_s: mu,
             from_s: 2.0,
         },
+        base: BaseMotion::default(),
     }
 }
 
@@ -476,6 +477,7 @@ fn small_amplitude_run_oscillates_at_the_timoshenko_frequency() {
         length: LengthHistory::Constant(10.0),
         loads: EndLoads::steady(TipLoad::default()),
         damping: Damping::default(),
+        base: BaseMotion::default(),
     };
     let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &vec![0.0; q0.len()]).unwrap();
     let state = State {
@@ -534,6 +536,7 @@ fn sliding(rate: f64, dt: f64, duration: f64) -> Sliding {
         length,
         loads: EndLoads::steady(TipLoad::default()),
         damping: Damping::default(),
+        base: BaseMotion::default(),
     };
     let v0 = vec![0.0; q0.len()];
     let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &v0).unwrap();
@@ -829,6 +832,7 @@ fn accelerating_straight_cable_root_force_is_the_momentum_balance() {
         length: LengthHistory::Profile(profile.clone()),
         loads: EndLoads::steady(buoyancy),
         damping: Damping::default(),
+        base: BaseMotion::default(),
     };
     let q0 = solver::static_solve(
         &model,

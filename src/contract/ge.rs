@@ -11,8 +11,8 @@ use crate::contract::dto::{CableInput, EigenvalueOutput, ProfileInput};
 use crate::contract::{Progress, RequestError};
 use crate::numerics::ge::element::TipLoad;
 use crate::numerics::ge::solver::{
-    self, Damping, Drive, EndLoads, LengthHistory, LoadShape, NewtonConfig, RunConfig, RunOutcome,
-    State,
+    self, BaseMotion, Damping, Drive, EndLoads, LengthHistory, LoadShape, NewtonConfig, RunConfig,
+    RunOutcome, State,
 };
 use crate::numerics::ge::{GeModel, Section, TipBody};
 use crate::numerics::params::{
@@ -503,6 +503,7 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
                 shape,
             },
             damping,
+            base: BaseMotion::default(),
         },
         config: RunConfig {
             time_step_s: dt,

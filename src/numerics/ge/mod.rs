@@ -42,6 +42,9 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod banded;
+pub mod base;
+pub mod chart;
+pub mod critical;
 pub mod diagnostics;
 pub mod element;
 pub mod solver;

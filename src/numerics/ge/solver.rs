@@ -123,12 +123,46 @@ impl Damping {
     }
 }
 
-/// What drives a run: length history, end loads, damping.
+/// Transverse motion of the deployment platform, `r(t) = R0 sin(ω0 t)`
+/// along `E2` (thesis ch. 8.2). The equations are written in the
+/// platform-fixed frame, so the motion enters as the inertial load
+/// `−A_ρ r̈` per unit length on the cable's transverse equation (the
+/// `−γ̃ l² r̈` of (8.2) in SI) and `−m r̈` on the aerostat; the unknowns
+/// `u2` are measured from the moving platform.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct BaseMotion {
+    pub amplitude_m: f64,
+    pub circular_frequency_rad_s: f64,
+}
+
+impl BaseMotion {
+    pub fn displacement_m(&self, t: f64) -> f64 {
+        self.amplitude_m * (self.circular_frequency_rad_s * t).sin()
+    }
+
+    pub fn acceleration_m_s2(&self, t: f64) -> f64 {
+        let w = self.circular_frequency_rad_s;
+        -self.amplitude_m * w * w * (w * t).sin()
+    }
+}
+
+/// What drives a run: length history, end loads, damping, platform motion.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Drive {
     pub length: LengthHistory,
     pub loads: EndLoads,
     pub damping: Damping,
+    pub base: BaseMotion,
+}
+
+impl Drive {
+    /// The load on the aerostat at `t`: the end loads plus the inertial
+    /// load `−m r̈` of the platform motion.
+    pub fn tip_load(&self, model: &GeModel, t: f64) -> TipLoad {
+        let mut load = self.loads.at(t);
+        load.force_n[1] -= model.tip.mass_kg * self.base.acceleration_m_s2(t);
+        load
+    }
 }
 
 /// Newton–Raphson settings.
@@ -211,14 +245,18 @@ pub fn residual(
     a: &[f64],
 ) -> Residual {
     let lin = element::linear_operators(model, kin, mu);
-    residual_with(model, &lin, kin, load, q, v, a)
+    residual_with(model, &lin, kin, load, 0.0, q, v, a)
 }
 
+/// The residual with the platform acceleration `base_m_s2` (the cable's
+/// share `A_ρ L ∫ N r̈` on the transverse rows; the aerostat's is in `load`).
+#[allow(clippy::too_many_arguments)]
 fn residual_with(
     model: &GeModel,
     lin: &element::LinearOperators,
     kin: Kinematics,
     load: TipLoad,
+    base_m_s2: f64,
     q: &[f64],
     v: &[f64],
     a: &[f64],
@@ -232,6 +270,14 @@ fn residual_with(
     element::internal_forces(model, kin.length_m, q, &mut internal, None, None);
     let mut body = vec![0.0; n];
     element::body_forces(model, kin, 1.0, &mut body, &mut [0.0; 3]);
+    if base_m_s2 != 0.0 {
+        let per_element =
+            -model.section.mass_per_length_kg_m * kin.length_m * base_m_s2 * model.ops.h;
+        for k in 1..=model.elements {
+            let share = if k == model.elements { 0.5 } else { 1.0 };
+            body[GeModel::dof(k, 1)] += share * per_element;
+        }
+    }
     let top = model.elements;
     let tip = element::tip_terms(
         model,
@@ -322,10 +368,20 @@ pub fn initial_acceleration(
     v: &[f64],
 ) -> Option<Vec<f64>> {
     let kin = drive.length.kinematics(time_s);
-    let load = drive.loads.at(time_s);
+    let load = drive.tip_load(model, time_s);
     let mu = drive.damping.at(time_s);
     let zero = vec![0.0; model.dofs()];
-    let r = residual(model, kin, load, mu, q, v, &zero);
+    let lin = element::linear_operators(model, kin, mu);
+    let r = residual_with(
+        model,
+        &lin,
+        kin,
+        load,
+        drive.base.acceleration_m_s2(time_s),
+        q,
+        v,
+        &zero,
+    );
     let m = system_matrices(model, kin, load, mu, q, v, &zero).mass;
     let lu = m.factor()?;
     let mut a: Vec<f64> = r.total.iter().map(|x| -x).collect();
@@ -434,7 +490,8 @@ impl<'a> Integrator<'a> {
         let dt = self.time_step_s;
         let t1 = self.state.time_s + dt;
         let kin = self.drive.length.kinematics(t1);
-        let load = self.drive.loads.at(t1);
+        let load = self.drive.tip_load(model, t1);
+        let base = self.drive.base.acceleration_m_s2(t1);
         let mu = self.drive.damping.at(t1);
         let lin = element::linear_operators(model, kin, mu);
         let (qn, vn, an) = (&self.state.q, &self.state.v, &self.state.a);
@@ -452,7 +509,7 @@ impl<'a> Integrator<'a> {
                 a[i] = alpha_a * (q[i] - qn[i] - dt * vn[i]) - (0.5 / BETA - 1.0) * an[i];
                 v[i] = vn[i] + dt * ((1.0 - GAMMA) * an[i] + GAMMA * a[i]);
             }
-            let r = residual_with(model, &lin, kin, load, &q, &v, &a);
+            let r = residual_with(model, &lin, kin, load, base, &q, &v, &a);
             let rn = norm(&r.total);
             if rn <= self.newton.absolute_tolerance_n + self.newton.relative_tolerance * r.scale {
                 break;
@@ -639,7 +696,7 @@ pub fn run(
         match stability::local_spectrum(
             model,
             kin,
-            drive.loads.at(state.time_s),
+            drive.tip_load(model, state.time_s),
             drive.damping.at(state.time_s),
             state,
         ) {

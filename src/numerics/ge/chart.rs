@@ -1,0 +1,281 @@
+//! Deployment charts of the GE cable (thesis Figs 7.2–7.4): `t*` and
+//! `h* = L(t*)` against a grid of constant rates, one series per
+//! stiffness ratio `E*`, tip perturbation `F0` and net buoyancy. Every
+//! point is an independent [`critical_time`] search from `L0`; the points
+//! fan out on rayon when asked ([`Parallelism::Rayon`]) and the result is
+//! the same bit for bit as the serial sweep.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use rayon::prelude::*;
+
+use super::critical::{CriticalConfig, CriticalProblem, GeOnset, TipPerturbation, critical_time};
+use super::{GeModel, Section, TipBody};
+use crate::numerics::chart::Parallelism;
+use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
+use crate::numerics::profile::Profile;
+
+/// Largest number of points (rates × series) of one GE chart.
+pub const MAX_GE_CHART_POINTS: usize = 2_000;
+
+/// The cable and aerostat of a GE chart (SI); `E*` varies per series.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GeChartSystem {
+    pub mass_per_length_kg_m: f64,
+    pub bending_stiffness_n_m2: f64,
+    /// `γ̃ = A_ρ L0² / I_ρ`.
+    pub inertia_ratio: f64,
+    pub aerostat_mass_kg: f64,
+    pub link_length_m: f64,
+    pub initial_length_m: f64,
+    pub gravity_m_s2: f64,
+    pub elements: usize,
+}
+
+impl GeChartSystem {
+    /// Table 7.1 with 20 elements.
+    pub fn table_7_1() -> Self {
+        Self {
+            mass_per_length_kg_m: 7800.0 * 1e-5,
+            bending_stiffness_n_m2: 1000.0,
+            inertia_ratio: 1.0,
+            aerostat_mass_kg: 10.0,
+            link_length_m: 0.0,
+            initial_length_m: 1.0,
+            gravity_m_s2: 9.81,
+            elements: 20,
+        }
+    }
+
+    /// The discretised cable for one stiffness ratio.
+    pub fn model(&self, stiffness_ratio: f64) -> Result<GeModel, InvalidInput> {
+        let section = Section::from_ratios(
+            self.bending_stiffness_n_m2,
+            stiffness_ratio,
+            self.inertia_ratio,
+            self.mass_per_length_kg_m,
+            self.initial_length_m,
+        )?;
+        GeModel::new(
+            section,
+            self.elements,
+            TipBody {
+                mass_kg: self.aerostat_mass_kg,
+                link_length_m: self.link_length_m,
+            },
+            self.gravity_m_s2,
+        )
+    }
+}
+
+/// What the chart sweeps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeChartRequest {
+    pub system: GeChartSystem,
+    pub rates_m_s: Vec<f64>,
+    pub stiffness_ratios: Vec<f64>,
+    /// Peak tip perturbations `F0` (N); 0 is the unperturbed cable.
+    pub perturbation_forces_n: Vec<f64>,
+    /// Rise and release times of the perturbation (s).
+    pub perturbation_ramp_s: f64,
+    pub perturbation_hold_s: f64,
+    pub net_buoyancies_n: Vec<f64>,
+    pub config: CriticalConfig,
+}
+
+/// One point of a series.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GeChartPoint {
+    pub rate_m_s: f64,
+    /// `t*` (s): 0 when unstable at once, `None` when stable over the horizon
+    /// or when the march failed (see `onset`).
+    pub critical_time_s: Option<f64>,
+    /// `h* = L(t*)` (m).
+    pub max_elevation_m: Option<f64>,
+    /// `(F/ρA − v²)/g` (m), the string's continuum bound, clipped at zero.
+    pub string_closed_form_m: f64,
+    pub onset: GeOnset,
+    pub steps: usize,
+    pub qep_solves: usize,
+}
+
+/// One series: a stiffness ratio, perturbation and buoyancy.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeChartSeries {
+    pub stiffness_ratio: f64,
+    pub perturbation_force_n: f64,
+    pub net_buoyancy_n: f64,
+    pub points: Vec<GeChartPoint>,
+}
+
+impl GeChartRequest {
+    /// Table 7.1, unperturbed, one buoyancy (1000 N).
+    pub fn table_7_1(rates_m_s: Vec<f64>, stiffness_ratios: Vec<f64>) -> Self {
+        Self {
+            system: GeChartSystem::table_7_1(),
+            rates_m_s,
+            stiffness_ratios,
+            perturbation_forces_n: vec![0.0],
+            perturbation_ramp_s: 0.25,
+            perturbation_hold_s: 1.0,
+            net_buoyancies_n: vec![1000.0],
+            config: CriticalConfig::default(),
+        }
+    }
+
+    pub fn point_count(&self) -> usize {
+        self.rates_m_s
+            .len()
+            .saturating_mul(self.stiffness_ratios.len())
+            .saturating_mul(self.perturbation_forces_n.len())
+            .saturating_mul(self.net_buoyancies_n.len())
+    }
+
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        for (field, list) in [
+            ("rates_m_s", &self.rates_m_s),
+            ("stiffness_ratios", &self.stiffness_ratios),
+            ("perturbation_forces_n", &self.perturbation_forces_n),
+            ("net_buoyancies_n", &self.net_buoyancies_n),
+        ] {
+            if list.is_empty() {
+                return Err(InvalidInput::new(field, "must list at least one value"));
+            }
+        }
+        for (i, &v) in self.rates_m_s.iter().enumerate() {
+            require_positive(&format!("rates_m_s[{i}]"), v)?;
+            if v > 1e4 {
+                return Err(InvalidInput::new(
+                    format!("rates_m_s[{i}]"),
+                    format!("must be at most 1e4 m/s, got {v}"),
+                ));
+            }
+        }
+        for (i, &v) in self.stiffness_ratios.iter().enumerate() {
+            require_positive(&format!("stiffness_ratios[{i}]"), v)?;
+        }
+        for (i, &v) in self.perturbation_forces_n.iter().enumerate() {
+            require_non_negative(&format!("perturbation_forces_n[{i}]"), v)?;
+        }
+        for (i, &v) in self.net_buoyancies_n.iter().enumerate() {
+            require_positive(&format!("net_buoyancies_n[{i}]"), v)?;
+        }
+        TipPerturbation {
+            force_n: 0.0,
+            ramp_s: self.perturbation_ramp_s,
+            hold_s: self.perturbation_hold_s,
+        }
+        .validate()?;
+        self.config.validate()?;
+        let total = self.point_count();
+        if total > MAX_GE_CHART_POINTS {
+            return Err(InvalidInput::new(
+                "rates_m_s",
+                format!(
+                    "the chart would have {total} points; at most {MAX_GE_CHART_POINTS} are allowed"
+                ),
+            ));
+        }
+        for (i, &es) in self.stiffness_ratios.iter().enumerate() {
+            self.system
+                .model(es)
+                .map_err(|e| InvalidInput::new(format!("stiffness_ratios[{i}]"), e.reason))?;
+        }
+        Ok(())
+    }
+}
+
+/// One point: constant-rate lengthening from `L0`, no target.
+pub fn chart_point(
+    model: &GeModel,
+    system: &GeChartSystem,
+    rate_m_s: f64,
+    net_buoyancy_n: f64,
+    perturbation: Option<TipPerturbation>,
+    config: &CriticalConfig,
+    cancel: &(dyn Fn() -> bool + Sync),
+) -> Result<GeChartPoint, InvalidInput> {
+    let profile = Profile::constant_rate(system.initial_length_m, rate_m_s, None)?;
+    let problem = CriticalProblem {
+        profile: profile.clone(),
+        net_buoyancy_n,
+        perturbation,
+    };
+    let r = critical_time(model, &problem, config, cancel)?;
+    let closed =
+        (net_buoyancy_n / system.mass_per_length_kg_m - rate_m_s * rate_m_s) / system.gravity_m_s2;
+    Ok(GeChartPoint {
+        rate_m_s,
+        critical_time_s: r.time_s(),
+        max_elevation_m: r.length_m(&profile),
+        string_closed_form_m: closed.max(0.0),
+        onset: r.onset,
+        steps: r.steps,
+        qep_solves: r.qep_solves,
+    })
+}
+
+/// Computes the chart. `progress(done, total)` is called as points finish
+/// (from worker threads, in no particular order); `cancel()` is polled
+/// during each search.
+pub fn deployment_chart(
+    request: &GeChartRequest,
+    parallelism: Parallelism,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<GeChartSeries>, InvalidInput> {
+    request.validate()?;
+    let models = request
+        .stiffness_ratios
+        .iter()
+        .map(|&es| request.system.model(es))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut series_keys = Vec::new();
+    for (m, &es) in request.stiffness_ratios.iter().enumerate() {
+        for &f0 in &request.perturbation_forces_n {
+            for &fb in &request.net_buoyancies_n {
+                series_keys.push((m, es, f0, fb));
+            }
+        }
+    }
+    let rates = &request.rates_m_s;
+    let total = request.point_count();
+    let done = AtomicUsize::new(0);
+    let point = |index: usize| -> Result<GeChartPoint, InvalidInput> {
+        let (s, r) = (index / rates.len(), index % rates.len());
+        let (m, _, f0, fb) = series_keys[s];
+        let perturbation = (f0 > 0.0).then_some(TipPerturbation {
+            force_n: f0,
+            ramp_s: request.perturbation_ramp_s,
+            hold_s: request.perturbation_hold_s,
+        });
+        let p = chart_point(
+            &models[m],
+            &request.system,
+            rates[r],
+            fb,
+            perturbation,
+            &request.config,
+            cancel,
+        );
+        progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+        p
+    };
+    let flat: Vec<GeChartPoint> = match parallelism {
+        Parallelism::Serial => (0..total).map(point).collect::<Result<_, _>>()?,
+        Parallelism::Rayon => (0..total)
+            .into_par_iter()
+            .map(point)
+            .collect::<Result<_, _>>()?,
+    };
+    Ok(series_keys
+        .iter()
+        .zip(flat.chunks(rates.len()))
+        .map(|(&(_, es, f0, fb), pts)| GeChartSeries {
+            stiffness_ratio: es,
+            perturbation_force_n: f0,
+            net_buoyancy_n: fb,
+            points: pts.to_vec(),
+        })
+        .collect())
+}
