@@ -9,7 +9,7 @@
 //! target length) and a table of `(t, L̇)` interpolated linearly. Both are
 //! piecewise constant-acceleration schedules ([`RateSchedule`]).
 
-use crate::numerics::params::{InvalidInput, Kinematics, require_finite, require_non_negative, require_positive};
+use crate::numerics::params::{InvalidInput, Kinematics, require_finite, require_positive};
 
 /// Largest rate magnitude accepted anywhere (m/s).
 pub const MAX_RATE_M_S: f64 = 1e5;
@@ -173,6 +173,14 @@ impl RateSchedule {
         Some(self.times_s[k])
     }
 
+    /// Shortest knot interval over which the rate changes (s).
+    fn shortest_ramp_s(&self) -> Option<f64> {
+        (0..self.segments().saturating_sub(1))
+            .filter(|&k| self.rates_m_s[k + 1] != self.rates_m_s[k])
+            .map(|k| self.times_s[k + 1] - self.times_s[k])
+            .reduce(f64::min)
+    }
+
     /// Rate held after the table.
     fn final_rate(&self) -> f64 {
         self.rates_m_s[self.segments() - 1]
@@ -232,8 +240,10 @@ impl Profile {
         if cruise_rate_m_s == 0.0 || cruise_rate_m_s.abs() > MAX_RATE_M_S {
             return Err(InvalidInput::new("profile.cruise_rate_m_s", format!("must be nonzero and within ±{MAX_RATE_M_S} m/s")));
         }
-        require_non_negative("profile.ramp_up_s", ramp_up_s)?;
-        require_non_negative("profile.ramp_down_s", ramp_down_s)?;
+        // A ramp of zero length would be an acceleration impulse that a
+        // time-stepped run cannot see; sharp ramps are short, not absent.
+        require_positive("profile.ramp_up_s", ramp_up_s)?;
+        require_positive("profile.ramp_down_s", ramp_down_s)?;
         check_target(initial_length_m, cruise_rate_m_s, Some(target_length_m))?;
         let travel = (target_length_m - initial_length_m) / cruise_rate_m_s; // > 0
         let cruise_s = travel - 0.5 * (ramp_up_s + ramp_down_s);
@@ -248,17 +258,12 @@ impl Profile {
             ));
         }
         let v = cruise_rate_m_s;
-        let mut points = vec![(0.0, if ramp_up_s == 0.0 { v } else { 0.0 })];
-        if ramp_up_s > 0.0 {
-            points.push((ramp_up_s, v));
-        }
+        let mut points = vec![(0.0, 0.0), (ramp_up_s, v)];
         let t_cruise_end = ramp_up_s + cruise_s;
-        if t_cruise_end > points.last().expect("non-empty").0 {
+        if t_cruise_end > ramp_up_s {
             points.push((t_cruise_end, v));
         }
-        if ramp_down_s > 0.0 {
-            points.push((t_cruise_end + ramp_down_s, 0.0));
-        }
+        points.push((t_cruise_end + ramp_down_s, 0.0));
         let schedule = RateSchedule::new(initial_length_m, &points, "profile")?;
         Ok(Self::Trapezoidal { schedule, cruise_rate_m_s, ramp_up_s, ramp_down_s, target_length_m })
     }
@@ -346,7 +351,9 @@ impl Profile {
                 let end = target_length_m.or((acceleration_m_s2 < 0.0).then_some(0.0))?;
                 Some((2.0 * (end - initial_length_m) / acceleration_m_s2).sqrt())
             }
-            Self::Trapezoidal { ref schedule, .. } => schedule.rest_time_s(),
+            Self::Trapezoidal { ref schedule, cruise_rate_m_s, ramp_up_s, ramp_down_s, target_length_m } => {
+                Some((target_length_m - schedule.initial_length_m) / cruise_rate_m_s + 0.5 * (ramp_up_s + ramp_down_s))
+            }
             Self::PiecewiseLinearRate { ref schedule, target_length_m } => {
                 let reach = match target_length_m {
                     Some(target) => schedule.first_crossing(target, (target - schedule.initial_length_m).signum()),
@@ -357,6 +364,16 @@ impl Profile {
                     (a, b) => a.or(b),
                 }
             }
+        }
+    }
+
+    /// Shortest phase of changing rate (s), which a time step must resolve:
+    /// the ramps of a trapezoid, the sloped intervals of a rate table.
+    pub fn shortest_ramp_s(&self) -> Option<f64> {
+        match self {
+            Self::ConstantRate { .. } | Self::ConstantAcceleration { .. } => None,
+            Self::Trapezoidal { ramp_up_s, ramp_down_s, .. } => Some(ramp_up_s.min(*ramp_down_s)),
+            Self::PiecewiseLinearRate { schedule, .. } => schedule.shortest_ramp_s(),
         }
     }
 
@@ -423,5 +440,57 @@ mod tests {
         let p = Profile::constant_rate(100.0, -2.0, None).unwrap();
         assert_eq!(p.stop_time_s(), Some(50.0));
         assert!(Profile::constant_rate(100.0, -2.0, Some(150.0)).is_err());
+    }
+
+    #[test]
+    fn trapezoid_ramps_cruises_and_stops_at_the_target() {
+        // 0 → 10 m/s over 5 s, cruise, 10 → 0 over 5 s, 1 → 2001 m
+        let p = Profile::trapezoidal(1.0, 10.0, 5.0, 5.0, 2001.0).unwrap();
+        assert_eq!(p.stop_time_s(), Some(205.0));
+        let k = p.kinematics(2.0);
+        assert!((k.length_m - (1.0 + 0.5 * 2.0 * 4.0)).abs() < 1e-12 && (k.rate_m_s - 4.0).abs() < 1e-12);
+        assert_eq!(k.acceleration_m_s2, 2.0);
+        let k = p.kinematics(100.0);
+        assert!((k.length_m - (1.0 + 25.0 + 950.0)).abs() < 1e-9 && k.rate_m_s == 10.0 && k.acceleration_m_s2 == 0.0);
+        let k = p.kinematics(203.0); // 2 s before the stop
+        assert!((k.rate_m_s - 4.0).abs() < 1e-12 && k.acceleration_m_s2 == -2.0);
+        assert!((k.length_m - (2001.0 - 0.5 * 2.0 * 4.0)).abs() < 1e-9);
+        let k = p.kinematics(300.0);
+        assert_eq!((k.length_m, k.rate_m_s, k.acceleration_m_s2), (2001.0, 0.0, 0.0));
+        assert!((p.time_to_length_s(976.0).unwrap() - 100.0).abs() < 1e-9);
+        assert_eq!(p.time_to_length_s(3000.0), None);
+        assert_eq!(p.shortest_ramp_s(), Some(5.0));
+        // too short for its ramps, zero ramps, shortening
+        assert_eq!(Profile::trapezoidal(1.0, 10.0, 5.0, 5.0, 20.0).unwrap_err().field, "profile.target_length_m");
+        assert_eq!(Profile::trapezoidal(1.0, 10.0, 0.0, 5.0, 200.0).unwrap_err().field, "profile.ramp_up_s");
+        let s = Profile::trapezoidal(100.0, -2.0, 1.0, 1.0, 50.0).unwrap();
+        assert_eq!(s.stop_time_s(), Some(26.0));
+        assert_eq!(s.kinematics(30.0).length_m, 50.0);
+        assert!(s.kinematics(10.0).rate_m_s == -2.0);
+    }
+
+    #[test]
+    fn rate_table_interpolates_and_stops() {
+        let pts = [(0.0, 0.0), (10.0, 4.0), (20.0, 4.0), (30.0, -2.0)];
+        let p = Profile::piecewise_linear_rate(5.0, &pts, None).unwrap();
+        let k = p.kinematics(5.0);
+        assert!((k.rate_m_s - 2.0).abs() < 1e-12 && (k.length_m - 10.0).abs() < 1e-12 && k.acceleration_m_s2 == 0.4);
+        // after the table the rate is held: −2 m/s until the length reaches zero
+        let l30 = 5.0 + 20.0 + 40.0 + 10.0; // areas: 20, 40, (4 − 2)/2·10 = 10
+        assert!((p.kinematics(30.0).length_m - l30).abs() < 1e-9);
+        assert!((p.stop_time_s().unwrap() - (30.0 + l30 / 2.0)).abs() < 1e-9);
+        // with a target it stops there
+        let p = Profile::piecewise_linear_rate(5.0, &pts, Some(50.0)).unwrap();
+        let t = p.stop_time_s().unwrap();
+        assert!((p.kinematics(t).length_m - 50.0).abs() < 1e-9 && p.kinematics(t + 1.0).rate_m_s == 0.0);
+        assert_eq!(p.time_to_length_s(10.0), Some(5.0));
+        // a table ending at rest stops there
+        let p = Profile::piecewise_linear_rate(5.0, &[(0.0, 1.0), (4.0, 0.0)], None).unwrap();
+        assert_eq!(p.stop_time_s(), Some(4.0));
+        assert!(Profile::piecewise_linear_rate(5.0, &[(1.0, 1.0)], None).is_err());
+        assert!(Profile::piecewise_linear_rate(5.0, &[(0.0, 1.0), (0.0, 2.0)], None).is_err());
+        assert_eq!(Profile::piecewise_linear_rate(5.0, &[(0.0, 1.0)], Some(2.0)).unwrap_err().field, "profile.target_length_m");
+        // a table that would shorten through zero before stopping is rejected
+        assert!(Profile::piecewise_linear_rate(5.0, &[(0.0, -1.0), (10.0, -1.0), (11.0, 1.0)], None).is_err());
     }
 }

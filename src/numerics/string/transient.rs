@@ -49,6 +49,8 @@ pub const MAX_FREQUENCIES: usize = 1_024;
 pub const MAX_RESPONSE_WORK: usize = 20_000_000_000;
 /// Steps per period of the fastest resolved motion when the step is automatic.
 pub const STEPS_PER_PERIOD: f64 = 64.0;
+/// Steps per ramp of the profile when the step is automatic.
+pub const STEPS_PER_RAMP: f64 = 8.0;
 /// The run stops as diverged when `|η|` exceeds this (deflections of
 /// `1e100 L0` are far outside the linear model, and near overflow).
 pub const DIVERGENCE_LIMIT: f64 = 1e100;
@@ -351,9 +353,19 @@ pub fn plan(model: &StringModel, profile: &Profile, config: &TransientConfig) ->
                 omega = omega.max(w);
             }
             let by_period = if omega > 0.0 { 2.0 * std::f64::consts::PI / omega / STEPS_PER_PERIOD } else { f64::INFINITY };
-            by_period.min(duration / 200.0)
+            let by_ramp = profile.shortest_ramp_s().map_or(f64::INFINITY, |r| r / STEPS_PER_RAMP);
+            by_period.min(by_ramp).min(duration / 200.0)
         }
     };
+    if let Some(ramp) = profile.shortest_ramp_s()
+        && dt > 0.5 * ramp
+    {
+        return Err(InvalidInput::new(
+            "time_step_s",
+            format!("{dt} s does not resolve the profile's shortest ramp of {ramp} s (use at most {} s)", 0.5 * ramp),
+        )
+        .into());
+    }
     let steps_f = (duration / dt).ceil();
     if steps_f > MAX_STEPS as f64 || steps_f * model.elements() as f64 > MAX_WORK as f64 {
         return Err(InvalidInput::new(
