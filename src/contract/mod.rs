@@ -5,6 +5,7 @@
 
 pub mod dto;
 pub mod run;
+pub mod transient;
 
 pub use run::{Progress, RequestError};
 

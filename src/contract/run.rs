@@ -84,6 +84,13 @@ impl SystemInput {
 impl ProfileInput {
     pub fn profile(&self, initial_length_m: f64) -> Result<Profile, InvalidInput> {
         match *self {
+            Self::Trapezoidal { cruise_rate_m_s, ramp_up_s, ramp_down_s, target_length_m } => {
+                Profile::trapezoidal(initial_length_m, cruise_rate_m_s, ramp_up_s, ramp_down_s, target_length_m)
+            }
+            Self::PiecewiseLinearRate { ref points, target_length_m } => {
+                let table: Vec<(f64, f64)> = points.iter().map(|p| (p.time_s, p.rate_m_s)).collect();
+                Profile::piecewise_linear_rate(initial_length_m, &table, target_length_m)
+            }
             Self::ConstantRate { rate_m_s, target_length_m } => {
                 Profile::constant_rate(initial_length_m, rate_m_s, target_length_m)
             }
