@@ -369,7 +369,7 @@ pub fn plan(model: &StringModel, profile: &Profile, config: &TransientConfig) ->
     let steps_f = (duration / dt).ceil();
     if steps_f > MAX_STEPS as f64 || steps_f * model.elements() as f64 > MAX_WORK as f64 {
         return Err(InvalidInput::new(
-            "time_step_s",
+            if config.time_step_s.is_some() { "time_step_s" } else { "duration_s" },
             format!(
                 "the run would take {steps_f:.0} steps of {dt:.3e} s on {} elements; at most {MAX_STEPS} steps and \
                  {MAX_WORK} step-elements are allowed (shorten duration_s, lengthen the step or use fewer elements)",
@@ -613,6 +613,7 @@ fn run_planned(
 /// load `tip_load` (non-dim, `F/F_net`): `(ω_k [1/t̄], E_k [F L0])`, by
 /// frequency. They sum to `½q̇ᵀMq̇ + ½(q−q_s)ᵀK(q−q_s)` and are constant in
 /// time once the length is fixed and the load steady and undamped.
+/// `None` if `length ≤ 0` or the state has the wrong size.
 pub fn modal_energies(
     model: &StringModel,
     length: f64,
@@ -620,8 +621,11 @@ pub fn modal_energies(
     tip_load: f64,
     q: &[f64],
     qd: &[f64],
-) -> Vec<(f64, f64)> {
+) -> Option<Vec<(f64, f64)>> {
     let n = model.elements();
+    if !(length > 0.0) || q.len() != n || qd.len() != n {
+        return None;
+    }
     let s = NondimState { length, rate: 0.0, acceleration: 0.0 };
     let mut c = model.coefficients(s);
     c.tip_mass = tip_mass_nondim;
@@ -632,9 +636,8 @@ pub fn modal_energies(
     let mut qs = vec![0.0; n];
     qs[n - 1] = tip_load;
     sys.stiffness.solve_columns_in_place(&mut qs, 1);
-    let chol = nalgebra::Cholesky::new(m).expect("the mass matrix is positive definite");
-    let l = chol.l();
-    let l_inv = l.clone().try_inverse().expect("triangular factor is invertible");
+    let l = nalgebra::Cholesky::new(m)?.l();
+    let l_inv = l.clone().try_inverse()?;
     let a = &l_inv * &k * l_inv.transpose();
     let a = (&a + a.transpose()) * 0.5;
     let eig = nalgebra::SymmetricEigen::new(a);
@@ -649,7 +652,7 @@ pub fn modal_energies(
         })
         .collect();
     out.sort_by(|a, b| a.0.total_cmp(&b.0));
-    out
+    Some(out)
 }
 
 /// Frequency response: one run per forcing frequency of a uniform flow
@@ -802,5 +805,39 @@ mod tests {
             "eigenvalues.interval_s"
         );
         assert_eq!(field(TransientConfig { initial: InitialState::Mode { mode: 0, tip_deflection_m: 0.1 }, ..base }), "initial.mode");
+    }
+
+    /// A tip force switched on at t = 0 on a cable of fixed length: the tip
+    /// swings about the static deflection `K⁻¹f` (up to about twice it, the
+    /// step response of the dominant first mode) and, once released,
+    /// oscillates about zero.
+    #[test]
+    fn held_tip_force_swings_about_the_static_deflection() {
+        let model = StringModel::new(AerostatSystem::thesis(), 20).unwrap();
+        let profile = Profile::constant_rate(1.0, 0.0, None).unwrap();
+        let (force, hold) = (10.0, 3.0);
+        let cfg = TransientConfig {
+            duration_s: 6.0,
+            time_step_s: Some(1e-3),
+            samples: 6001,
+            initial: InitialState::TipForce { force_n: force, duration_s: hold },
+            aero: None,
+            eigen: None,
+        };
+        let r = simulate(&model, &profile, &cfg, &Silent).unwrap();
+        let sys = model.matrices(NondimState { length: 1.0, rate: 0.0, acceleration: 0.0 });
+        let mut q = vec![0.0; 20];
+        q[19] = force / 1000.0;
+        sys.stiffness.solve_columns_in_place(&mut q, 1);
+        let static_m = q[19];
+        let held: Vec<f64> = r.samples.iter().filter(|s| s.time_s < hold).map(|s| s.tip_deflection_m).collect();
+        let max = held.iter().cloned().fold(f64::MIN, f64::max);
+        let min = held.iter().cloned().fold(f64::MAX, f64::min);
+        assert!(min > -0.05 * static_m && (max / (2.0 * static_m) - 1.0).abs() < 0.05, "{min} {max} {static_m}");
+        assert!(r.samples.iter().filter(|s| s.time_s < hold).all(|s| s.tip_force_n == force));
+        assert!(r.samples.iter().filter(|s| s.time_s > hold).all(|s| s.tip_force_n == 0.0));
+        let released: Vec<f64> = r.samples.iter().filter(|s| s.time_s > hold).map(|s| s.tip_deflection_m).collect();
+        let mean = released.iter().sum::<f64>() / released.len() as f64;
+        assert!(mean.abs() < 0.3 * static_m, "released mean {mean}");
     }
 }
