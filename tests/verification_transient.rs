@@ -503,6 +503,11 @@ fn critical_time_accepts_trapezoidal_and_table_profiles() {
         assert!((length_m / exact_length - 1.0).abs() < 5e-3);
         assert!((time_s - (2.5 + (exact_length - 1.0) / 10.0)).abs() < 0.5);
     }
+    // Shortening (negative cruise rate) is unstable as soon as it moves.
+    let retrieval = Profile::trapezoidal(100.0, -2.0, 1.0, 1.0, 50.0).unwrap();
+    let ct = critical_time(&model, &retrieval, SearchConfig::default()).unwrap();
+    println!("retrieval: {:?} via {:?}", ct.onset, ct.method);
+    assert!(ct.time_s().is_some_and(|t| t < 0.01), "{:?}", ct.onset);
 }
 
 /// The one-mode model itself (thesis ch. 3): its numerical solution at

@@ -101,11 +101,10 @@ impl Newmark {
         load: &[f64],
         state: &mut NewmarkState,
     ) -> Result<(), StepError> {
-        let n = mass.dim();
         damping.mul_vec(&state.velocity, &mut self.work);
         stiffness.mul_vec(&state.displacement, &mut self.rhs);
-        for i in 0..n {
-            self.rhs[i] = load[i] - self.work[i] - self.rhs[i];
+        for ((r, f), w) in self.rhs.iter_mut().zip(load).zip(&self.work) {
+            *r = f - w - *r;
         }
         self.effective.clone_from(mass);
         solve_in_place(&self.effective, &mut self.rhs, &mut self.pivots, &mut self.ratios)
@@ -144,8 +143,8 @@ impl Newmark {
         }
         damping.mul_vec(&self.predicted_v, &mut self.work);
         stiffness.mul_vec(&self.predicted_u, &mut self.rhs);
-        for i in 0..n {
-            self.rhs[i] = load[i] - self.work[i] - self.rhs[i];
+        for ((r, f), w) in self.rhs.iter_mut().zip(load).zip(&self.work) {
+            *r = f - w - *r;
         }
         let (cg, kb) = (gamma * dt, beta * dt * dt);
         combine_into(&mut self.effective, mass, (cg, damping), (kb, stiffness));
@@ -176,9 +175,13 @@ fn combine_into(out: &mut Tridiagonal, m: &Tridiagonal, (c1, a): (f64, &Tridiago
     }
 }
 
+/// A zero or non-finite pivot in a tridiagonal solve.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SingularPivot;
+
 /// Thomas solve of `A x = b` in place, with caller-provided scratch; fails
 /// on a zero or non-finite pivot.
-pub fn solve_in_place(a: &Tridiagonal, b: &mut [f64], pivots: &mut [f64], ratios: &mut [f64]) -> Result<(), ()> {
+pub fn solve_in_place(a: &Tridiagonal, b: &mut [f64], pivots: &mut [f64], ratios: &mut [f64]) -> Result<(), SingularPivot> {
     let n = a.dim();
     if n == 0 {
         return Ok(());
@@ -189,7 +192,7 @@ pub fn solve_in_place(a: &Tridiagonal, b: &mut [f64], pivots: &mut [f64], ratios
             p -= a.lower[i - 1] * ratios[i - 1];
         }
         if p == 0.0 || !p.is_finite() {
-            return Err(());
+            return Err(SingularPivot);
         }
         pivots[i] = p;
         if i + 1 < n {

@@ -561,7 +561,7 @@ fn run_planned(
         if step == plan.steps || !matches!(outcome, RunOutcome::Completed) {
             break;
         }
-        if step % report_every == 0 {
+        if step.is_multiple_of(report_every) {
             if report_progress {
                 observer.report(step, plan.steps);
             }
@@ -623,7 +623,7 @@ pub fn modal_energies(
     qd: &[f64],
 ) -> Option<Vec<(f64, f64)>> {
     let n = model.elements();
-    if !(length > 0.0) || q.len() != n || qd.len() != n {
+    if length.is_nan() || length <= 0.0 || q.len() != n || qd.len() != n {
         return None;
     }
     let s = NondimState { length, rate: 0.0, acceleration: 0.0 };
