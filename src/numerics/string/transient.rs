@@ -43,6 +43,9 @@ pub const MAX_WORK: usize = 500_000_000;
 pub const MAX_SAMPLES: usize = 100_000;
 /// Most eigenvalue evaluations along one run.
 pub const MAX_EIGEN_EVALUATIONS: usize = 10_000;
+/// Most `evaluations × (2n)³` of the eigenvalue tracking of one run (dense
+/// QEP solves cost `O((2n)³)`: about a minute at this bound).
+pub const MAX_EIGEN_WORK: f64 = 5e10;
 /// Most forcing frequencies of one frequency response.
 pub const MAX_FREQUENCIES: usize = 1_024;
 /// Most `steps × elements × frequencies` of one frequency response.
@@ -273,19 +276,52 @@ pub fn energy_nondim(ops: &StringOperators, c: &MatrixCoefficients, s: NondimSta
     (vib + axial, vib)
 }
 
-/// First `Im λ > 0` (1/s) of the system at rest at `length_m`, or of the
-/// moving state — used to pick the automatic step.
-fn first_frequency_1_s(model: &StringModel, k: Kinematics, added_mass_nondim: f64) -> Result<Option<f64>, QepError> {
-    let s = model.system.to_nondim(k);
-    let mut c = model.coefficients(s);
+/// The `k`-th (1-based) eigenvalue `ω²` of the symmetric pencil `(K, M)` of
+/// a cable at rest (`l̇ = l̈ = 0`), by bisection on the inertia of
+/// `K − σM` (the number of negative pivots is the number of eigenvalues
+/// below `σ`): `O(n)` per step, no dense solve.
+pub fn rest_eigenvalue(sys: &SecondOrderSystem, k: usize) -> Option<f64> {
+    let n = sys.mass.dim();
+    if k == 0 || k > n {
+        return None;
+    }
+    let below = |sigma: f64| Tridiagonal::combination(&[(1.0, &sys.stiffness), (-sigma, &sys.mass)]).negative_pivots();
+    let (mut lo, mut hi) = (-1.0, 1.0);
+    while below(lo) >= k {
+        lo *= 2.0;
+        if lo < -1e300 {
+            return None;
+        }
+    }
+    while below(hi) < k {
+        hi *= 2.0;
+        if hi > 1e300 {
+            return None;
+        }
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi || hi - lo <= 1e-15 * hi.abs().max(lo.abs()) {
+            break;
+        }
+        if below(mid) >= k { hi = mid } else { lo = mid }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+fn rest_system(model: &StringModel, length: f64, added_mass_nondim: f64) -> SecondOrderSystem {
+    let mut c = model.coefficients(NondimState { length, rate: 0.0, acceleration: 0.0 });
     c.tip_mass += added_mass_nondim;
-    let spectrum = qep::solve(&model.operators.assemble(&c))?;
-    let tiny = 1e-9 * spectrum.spectral_radius.max(1e-300);
-    Ok(spectrum
-        .modes()
-        .into_iter()
-        .find(|e| e.im > tiny)
-        .map(|e| model.system.eigenvalue_to_si(e.im)))
+    model.operators.assemble(&c)
+}
+
+/// First natural frequency (rad/s) of the cable at rest at `length_m`;
+/// `None` if the cable cannot hold that length at rest. Used to pick the
+/// automatic step.
+fn first_frequency_1_s(model: &StringModel, k: Kinematics, added_mass_nondim: f64) -> Result<Option<f64>, QepError> {
+    let length = k.length_m / model.system.initial_length_m;
+    let lambda = rest_eigenvalue(&rest_system(model, length, added_mass_nondim), 1);
+    Ok(lambda.filter(|&l| l > 0.0).map(|l| model.system.eigenvalue_to_si(l.sqrt())))
 }
 
 /// Validates the configuration and fixes the time step.
@@ -304,6 +340,19 @@ pub fn plan(model: &StringModel, profile: &Profile, config: &TransientConfig) ->
             .into());
         }
         let evaluations = duration / e.interval_s;
+        let per_solve = (2.0 * model.elements() as f64).powi(3);
+        if (evaluations + 1.0) * per_solve > MAX_EIGEN_WORK {
+            return Err(InvalidInput::new(
+                "eigenvalues.interval_s",
+                format!(
+                    "{:.0} eigenvalue solves on {} elements exceed the work limit; use an interval of at least {:.4} s or fewer elements",
+                    evaluations + 1.0,
+                    model.elements(),
+                    duration / (MAX_EIGEN_WORK / per_solve - 1.0).max(1e-300)
+                ),
+            )
+            .into());
+        }
         if evaluations > MAX_EIGEN_EVALUATIONS as f64 {
             return Err(InvalidInput::new(
                 "eigenvalues.interval_s",
@@ -391,22 +440,19 @@ fn added_mass_nondim(model: &StringModel, aero: Option<&Aerodynamics>) -> f64 {
 /// (`l̇ = l̈ = 0`, `K` symmetric), by shifted inverse iteration; normalised
 /// to a unit tip deflection. Returns the shape and `ω` (1/t̄).
 pub fn rest_mode_shape(model: &StringModel, length: f64, added_mass_nondim: f64, mode: usize) -> Result<(Vec<f64>, f64), QepError> {
-    let s = NondimState { length, rate: 0.0, acceleration: 0.0 };
-    let mut c = model.coefficients(s);
-    c.tip_mass += added_mass_nondim;
-    let sys = model.operators.assemble(&c);
-    let spectrum = qep::solve(&sys)?;
-    let modes = spectrum.modes();
-    let target = modes.get(mode - 1).ok_or(QepError::NoConvergence)?;
-    let omega = target.im;
-    // Nearest other squared frequency decides the shift offset.
-    let w2 = omega * omega;
-    let gap = modes
-        .iter()
-        .filter(|e| (e.im - omega).abs() > 1e-12 * omega.abs().max(1e-300))
-        .map(|e| (e.im * e.im - w2).abs())
+    let sys = rest_system(model, length, added_mass_nondim);
+    let eig = |k: usize| rest_eigenvalue(&sys, k);
+    let w2 = eig(mode).ok_or(QepError::NoConvergence)?;
+    // Shift just below the target, by a small fraction of the gap to its
+    // neighbours, so inverse iteration converges to this mode alone.
+    let gap = [mode.checked_sub(1).and_then(eig), eig(mode + 1)]
+        .into_iter()
+        .flatten()
+        .map(|v| (v - w2).abs())
+        .filter(|g| *g > 0.0)
         .fold(f64::INFINITY, f64::min);
     let shift = w2 - 1e-3 * gap.min(w2.abs().max(1e-300));
+    let omega = w2.max(0.0).sqrt();
     let shifted = Tridiagonal::combination(&[(1.0, &sys.stiffness), (-shift, &sys.mass)]);
     let n = model.elements();
     let mut x = vec![1.0; n];
@@ -839,5 +885,26 @@ mod tests {
         let released: Vec<f64> = r.samples.iter().filter(|s| s.time_s > hold).map(|s| s.tip_deflection_m).collect();
         let mean = released.iter().sum::<f64>() / released.len() as f64;
         assert!(mean.abs() < 0.3 * static_m, "released mean {mean}");
+    }
+
+    #[test]
+    fn rest_eigenvalues_by_inertia_match_the_qep() {
+        let model = StringModel::new(AerostatSystem::thesis(), 30).unwrap();
+        let sys = rest_system(&model, 250.0, 0.3);
+        let spectrum = qep::solve(&sys).unwrap();
+        for (k, mode) in spectrum.modes().iter().take(4).enumerate() {
+            let w = rest_eigenvalue(&sys, k + 1).unwrap().sqrt();
+            assert!((w / mode.im - 1.0).abs() < 1e-9, "mode {}: {w} vs {}", k + 1, mode.im);
+        }
+        let (shape, w) = rest_mode_shape(&model, 250.0, 0.3, 2).unwrap();
+        assert!((w / spectrum.modes()[1].im - 1.0).abs() < 1e-9);
+        // K φ = ω² M φ
+        let (mut kx, mut mx) = (vec![0.0; 30], vec![0.0; 30]);
+        sys.stiffness.mul_vec(&shape, &mut kx);
+        sys.mass.mul_vec(&shape, &mut mx);
+        let scale = kx.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        for (a, b) in kx.iter().zip(&mx) {
+            assert!((a - w * w * b).abs() < 1e-8 * scale);
+        }
     }
 }
