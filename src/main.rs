@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
-use tetherplan::contract::{self, Progress, RequestError, dto, run};
+use tetherplan::contract::{self, Progress, RequestError, dto, run, simulate, transient};
 use tetherplan::numerics::chart::Parallelism;
 
 #[derive(Parser)]
@@ -40,6 +40,23 @@ enum Command {
     SafeRate(InputArg),
     /// Deployment chart: t* and h* against rate, one series per buoyancy.
     Chart(InputArg),
+    /// Transient run (linear string, or `"model": {"kind": "geometrically_exact"}`).
+    Simulate(InputArg),
+    /// Tip-amplitude envelope against wind forcing frequency (linear string).
+    FrequencyResponse(InputArg),
+}
+
+/// A progress bar on standard error for `total` units of `what`.
+fn progress_bar(total: u64, what: &str) -> Bar {
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template(&format!(
+            "{{spinner}} {what} [{{bar:40}}] {{pos}}/{{len}} ({{eta}})"
+        ))
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    Bar(bar)
 }
 
 fn read_input(arg: &InputArg) -> Result<Vec<u8>, String> {
@@ -68,6 +85,14 @@ fn answer<Req: dto::SystemRequest, Resp: Serialize>(
     arg: &InputArg,
     run: impl FnOnce(&Req) -> Result<Resp, RequestError>,
 ) -> ExitCode {
+    answer_with(arg, contract::parse::<Req>, run)
+}
+
+fn answer_with<Req, Resp: Serialize>(
+    arg: &InputArg,
+    parse: impl FnOnce(&[u8]) -> Result<Req, RequestError>,
+    run: impl FnOnce(&Req) -> Result<Resp, RequestError>,
+) -> ExitCode {
     let body = match read_input(arg) {
         Ok(b) => b,
         Err(msg) => {
@@ -75,7 +100,7 @@ fn answer<Req: dto::SystemRequest, Resp: Serialize>(
             return ExitCode::from(2);
         }
     };
-    match contract::parse::<Req>(&body).and_then(|req| run(&req)) {
+    match parse(&body).and_then(|req| run(&req)) {
         Ok(resp) => {
             print_json(&resp);
             ExitCode::SUCCESS
@@ -110,18 +135,27 @@ fn main() -> ExitCode {
         Command::Critical(arg) => answer(arg, run::critical),
         Command::SafeRate(arg) => answer(arg, run::safe_rate),
         Command::Chart(arg) => answer(arg, |req: &dto::ChartRequest| {
-            let bar = ProgressBar::new(run::chart_points(req) as u64);
-            bar.set_style(
-                ProgressStyle::with_template(
-                    "{spinner} chart [{bar:40}] {pos}/{len} points ({eta})",
-                )
-                .expect("valid template")
-                .progress_chars("=> "),
-            );
-            let bar = Bar(bar);
+            let bar = progress_bar(run::chart_points(req) as u64, "chart points");
             let out = run::chart(req, Parallelism::Rayon, &bar);
             bar.0.finish_and_clear();
             out
         }),
+        Command::Simulate(arg) => answer_with(arg, simulate::parse_simulate, |req| {
+            let bar = progress_bar(0, "steps");
+            let out = simulate::simulate_any(req, &bar);
+            bar.0.finish_and_clear();
+            out
+        }),
+        Command::FrequencyResponse(arg) => {
+            answer(arg, |req: &transient::FrequencyResponseRequest| {
+                let bar = progress_bar(
+                    transient::frequency_response_runs(req) as u64,
+                    "frequencies",
+                );
+                let out = transient::frequency_response(req, Parallelism::Rayon, &bar);
+                bar.0.finish_and_clear();
+                out
+            })
+        }
     }
 }

@@ -94,3 +94,48 @@ fn bad_input_prints_the_error_body_and_exits_2() {
     assert_eq!(code, 2);
     assert_eq!(json["error"]["code"], "malformed_json");
 }
+
+#[test]
+fn simulate_dispatches_on_the_model_kind() {
+    // linear string: fixed length 100 m, tip shape released from rest
+    let string = r#"{"cable": {"mass_per_length_kg_m": 0.078},
+        "aerostat": {"net_buoyancy_n": 1000, "mass_kg": 10}, "initial_length_m": 100,
+        "profile": {"kind": "constant_rate", "rate_m_s": 0}, "duration_s": 5, "samples": 50,
+        "initial": {"kind": "shape", "tip_deflection_m": 0.1}}"#;
+    let (code, json) = run(&["simulate"], string);
+    assert_eq!(code, 0, "{json}");
+    assert_eq!(json["outcome"], "completed");
+    let tip = json["tip_deflection_m"].as_array().unwrap();
+    assert_eq!(tip.len(), 50);
+    assert!((tip[0].as_f64().unwrap() - 0.1).abs() < 1e-9);
+    let energy: Vec<f64> = json["energy_j"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e.as_f64().unwrap())
+        .collect();
+    let drift = (energy.last().unwrap() - energy[0]).abs() / energy[0];
+    assert!(
+        drift < 1e-6,
+        "energy at fixed length is conserved: drift {drift}"
+    );
+
+    // geometrically exact: Table 7.1 data, a held tip force
+    let ge = r#"{"cable": {"density_kg_m3": 7800.0, "area_m2": 1e-5},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0}, "initial_length_m": 1.0,
+        "model": {"kind": "geometrically_exact", "elements": 10, "bending_stiffness_n_m2": 1000.0,
+                  "stiffness_ratio": 1e5, "inertia_ratio": 1.0},
+        "time_step_s": 0.000883, "duration_s": 0.0883,
+        "end_load": {"transverse_force_n": 400.0, "time": {"kind": "held", "ramp_s": 0.01, "hold_s": 0.03}}}"#;
+    let (code, json) = run(&["simulate"], ge);
+    assert_eq!(code, 0, "{json}");
+    assert_eq!(json["outcome"]["status"], "completed");
+    assert_eq!(json["steps"], 100);
+
+    let (code, json) = run(
+        &["simulate"],
+        &ge.replace(r#""elements": 10"#, r#""elements": 0"#),
+    );
+    assert_eq!(code, 2);
+    assert_eq!(json["error"]["field"], "model.elements");
+}

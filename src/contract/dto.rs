@@ -111,6 +111,42 @@ pub enum ProfileInput {
         #[serde(default)]
         target_length_m: Option<f64>,
     },
+    /// Rate ramps linearly from 0 to the cruise rate, holds, and ramps back
+    /// to 0, arriving at rest at the target length (thesis Figs 4.8–4.9).
+    Trapezoidal {
+        /// Cruise rate (m/s); negative retrieves.
+        #[schema(example = 10.0)]
+        cruise_rate_m_s: f64,
+        /// Ramp-up time (s), > 0: short is sharp, long is gradual.
+        #[schema(example = 5.0, exclusive_minimum = 0.0)]
+        ramp_up_s: f64,
+        /// Ramp-down time (s), > 0.
+        #[schema(example = 5.0, exclusive_minimum = 0.0)]
+        ramp_down_s: f64,
+        /// Length at which the winch comes to rest (m).
+        #[schema(example = 1100.0, exclusive_minimum = 0.0)]
+        target_length_m: f64,
+    },
+    /// Rate interpolated linearly in a table of (time, rate), first time 0;
+    /// the last rate is held after the table.
+    PiecewiseLinearRate {
+        /// The table, times strictly increasing (at most 10000 points).
+        points: Vec<RatePointInput>,
+        /// Length at which the winch stops (m); none: the table decides.
+        #[serde(default)]
+        target_length_m: Option<f64>,
+    },
+}
+
+/// One point of a rate table.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct RatePointInput {
+    /// Time (s).
+    #[schema(example = 0.0, minimum = 0.0)]
+    pub time_s: f64,
+    /// Winch rate at that time (m/s).
+    #[schema(example = 10.0)]
+    pub rate_m_s: f64,
 }
 
 /// Instantaneous deployment state for a stability query.
@@ -413,4 +449,6 @@ system_request!(
     CriticalRequest => CriticalParams,
     SafeRateRequest => SafeRateParams,
     ChartRequest => ChartParams,
+    crate::contract::transient::SimulateRequest => crate::contract::transient::SimulateParams,
+    crate::contract::transient::FrequencyResponseRequest => crate::contract::transient::FrequencyResponseParams,
 );

@@ -6,6 +6,8 @@
 pub mod dto;
 pub mod ge;
 pub mod run;
+pub mod simulate;
+pub mod transient;
 
 pub use run::{Progress, RequestError};
 

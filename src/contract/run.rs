@@ -96,6 +96,26 @@ impl SystemInput {
 impl ProfileInput {
     pub fn profile(&self, initial_length_m: f64) -> Result<Profile, InvalidInput> {
         match *self {
+            Self::Trapezoidal {
+                cruise_rate_m_s,
+                ramp_up_s,
+                ramp_down_s,
+                target_length_m,
+            } => Profile::trapezoidal(
+                initial_length_m,
+                cruise_rate_m_s,
+                ramp_up_s,
+                ramp_down_s,
+                target_length_m,
+            ),
+            Self::PiecewiseLinearRate {
+                ref points,
+                target_length_m,
+            } => {
+                let table: Vec<(f64, f64)> =
+                    points.iter().map(|p| (p.time_s, p.rate_m_s)).collect();
+                Profile::piecewise_linear_rate(initial_length_m, &table, target_length_m)
+            }
             Self::ConstantRate {
                 rate_m_s,
                 target_length_m,
@@ -182,6 +202,15 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
     let model = req.system.model()?;
     let sys = model.system;
     let profile = req.params.profile.profile(sys.initial_length_m)?;
+    if let ProfileInput::ConstantRate { rate_m_s, .. } = req.params.profile {
+        if rate_m_s == 0.0 {
+            return Err(InvalidInput::new(
+                "profile.rate_m_s",
+                "must be nonzero: a zero rate never changes the length (ask for the stability of that state instead)",
+            )
+            .into());
+        }
+    }
     let result = critical::critical_time(
         &model,
         &profile,

@@ -2,12 +2,15 @@
 //! serialisation, no async (a test in `tests/tidy.rs` keeps it so).
 //! Inputs are SI; inside, the models work non-dimensionally (SPEC §1).
 
+pub mod aero;
 pub mod chart;
 pub mod ge;
 pub mod ge_reduced;
 pub mod mesh;
+pub mod newmark;
 pub mod params;
 pub mod profile;
 pub mod qep;
+pub mod reduced;
 pub mod string;
 pub mod tridiag;

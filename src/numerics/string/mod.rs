@@ -4,6 +4,7 @@
 
 pub mod critical;
 pub mod operators;
+pub mod transient;
 
 use std::sync::Arc;
 
