@@ -43,6 +43,7 @@ fn setup() -> (GeModel, Drive, State, RunConfig) {
         loads: EndLoads::steady(buoyancy),
         damping: Damping::default(),
         base: BaseMotion::default(),
+        aero: None,
     };
     let v0 = vec![0.0; q0.len()];
     let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &v0).unwrap();

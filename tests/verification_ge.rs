@@ -396,6 +396,7 @@ fn svq_drive(peak_n: f64, mu: f64) -> Drive {
             from_s: 2.0,
         },
         base: BaseMotion::default(),
+        aero: None,
     }
 }
 
@@ -478,6 +479,7 @@ fn small_amplitude_run_oscillates_at_the_timoshenko_frequency() {
         loads: EndLoads::steady(TipLoad::default()),
         damping: Damping::default(),
         base: BaseMotion::default(),
+        aero: None,
     };
     let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &vec![0.0; q0.len()]).unwrap();
     let state = State {
@@ -537,6 +539,7 @@ fn sliding(rate: f64, dt: f64, duration: f64) -> Sliding {
         loads: EndLoads::steady(TipLoad::default()),
         damping: Damping::default(),
         base: BaseMotion::default(),
+        aero: None,
     };
     let v0 = vec![0.0; q0.len()];
     let a0 = solver::initial_acceleration(&model, &drive, 0.0, &q0, &v0).unwrap();
@@ -833,6 +836,7 @@ fn accelerating_straight_cable_root_force_is_the_momentum_balance() {
         loads: EndLoads::steady(buoyancy),
         damping: Damping::default(),
         base: BaseMotion::default(),
+        aero: None,
     };
     let q0 = solver::static_solve(
         &model,

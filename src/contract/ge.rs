@@ -504,6 +504,7 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
             },
             damping,
             base: BaseMotion::default(),
+            aero: None,
         },
         config: RunConfig {
             time_step_s: dt,

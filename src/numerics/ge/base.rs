@@ -129,6 +129,7 @@ impl BaseExcitationProblem {
                 amplitude_m: self.amplitude_m,
                 circular_frequency_rad_s: frequency_rad_s,
             },
+            aero: None,
         }
     }
 

@@ -1,6 +1,7 @@
-//! Deployment charts of the GE cable (thesis Figs 7.2–7.4): `t*` and
-//! `h* = L(t*)` against a grid of constant rates, one series per
-//! stiffness ratio `E*`, tip perturbation `F0` and net buoyancy. Every
+//! Deployment charts of the GE cable (thesis Figs 7.2–7.4, 7.6–7.7): `t*`
+//! and `h* = L(t*)` against a grid of constant rates, one series per
+//! stiffness ratio `E*`, tip perturbation `F0`, net buoyancy and (with
+//! wind) amplitude `A0` of the perturbed flow (7.4). Every
 //! point is an independent [`critical_time`] search from `L0`; the points
 //! fan out on rayon when asked ([`Parallelism::Rayon`]) and the result is
 //! the same bit for bit as the serial sweep.
@@ -11,6 +12,7 @@ use rayon::prelude::*;
 
 use super::critical::{CriticalConfig, CriticalProblem, GeOnset, TipPerturbation, critical_time};
 use super::{GeModel, Section, TipBody};
+use crate::numerics::aero::{Aerodynamics, AerostatBody, AirFlow, ForceModel, SteadyFlow};
 use crate::numerics::chart::Parallelism;
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 use crate::numerics::profile::Profile;
@@ -68,6 +70,58 @@ impl GeChartSystem {
     }
 }
 
+/// Air flow on the aerostat for a chart (thesis ch. 7.5): a steady
+/// profile `u0(z)`, perturbed as (7.4) `u0 (1 + A0 sin(k z))` with one
+/// series per amplitude `A0` (0: the steady profile itself).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeChartWind {
+    pub base_flow: SteadyFlow,
+    pub force_model: ForceModel,
+    pub body: AerostatBody,
+    pub amplitudes: Vec<f64>,
+    /// `k` of (7.4) (1/m); the thesis uses 0.01.
+    pub wavenumber_1_m: f64,
+}
+
+impl GeChartWind {
+    /// An illustrative tabulated boundary-layer profile (speed rising from
+    /// 0 at the ground to 8 m/s at 600 m, then uniform) — the shape of the
+    /// thesis's Fig. 7.5(a), *not* its data (Teixeira et al. 2008, which is
+    /// not reproduced here). Thesis aerostat: sphere of radius 1 m in air
+    /// of 1.12 kg/m³, inviscid (thesis) force model; `k = 0.01 /m`.
+    pub fn illustrative(amplitudes: Vec<f64>) -> Self {
+        let table = [
+            (0.0, 0.0),
+            (50.0, 3.0),
+            (100.0, 4.2),
+            (200.0, 5.6),
+            (400.0, 7.2),
+            (600.0, 8.0),
+            (2000.0, 8.0),
+        ];
+        Self {
+            base_flow: SteadyFlow::tabulated(&table, "wind.profile").expect("valid table"),
+            force_model: ForceModel::Thesis,
+            body: AerostatBody::new(1.0, 1.12, None).expect("valid body"),
+            amplitudes,
+            wavenumber_1_m: 0.01,
+        }
+    }
+
+    fn aerodynamics(
+        &self,
+        amplitude: f64,
+        aerostat_mass_kg: f64,
+    ) -> Result<Aerodynamics, InvalidInput> {
+        let flow = if amplitude == 0.0 {
+            AirFlow::Steady(self.base_flow.clone())
+        } else {
+            AirFlow::perturbed(self.base_flow.clone(), amplitude, self.wavenumber_1_m)?
+        };
+        Aerodynamics::new(flow, self.force_model, self.body, aerostat_mass_kg)
+    }
+}
+
 /// What the chart sweeps.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GeChartRequest {
@@ -80,6 +134,8 @@ pub struct GeChartRequest {
     pub perturbation_ramp_s: f64,
     pub perturbation_hold_s: f64,
     pub net_buoyancies_n: Vec<f64>,
+    /// Air flow; `None`: still air.
+    pub wind: Option<GeChartWind>,
     pub config: CriticalConfig,
 }
 
@@ -99,12 +155,14 @@ pub struct GeChartPoint {
     pub qep_solves: usize,
 }
 
-/// One series: a stiffness ratio, perturbation and buoyancy.
+/// One series: a stiffness ratio, perturbation, buoyancy and flow amplitude.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GeChartSeries {
     pub stiffness_ratio: f64,
     pub perturbation_force_n: f64,
     pub net_buoyancy_n: f64,
+    /// `A0` of (7.4); `None` in still air.
+    pub wind_amplitude: Option<f64>,
     pub points: Vec<GeChartPoint>,
 }
 
@@ -119,13 +177,22 @@ impl GeChartRequest {
             perturbation_ramp_s: 0.25,
             perturbation_hold_s: 1.0,
             net_buoyancies_n: vec![1000.0],
+            wind: None,
             config: CriticalConfig::default(),
+        }
+    }
+
+    fn wind_amplitudes(&self) -> Vec<Option<f64>> {
+        match &self.wind {
+            None => vec![None],
+            Some(w) => w.amplitudes.iter().map(|&a| Some(a)).collect(),
         }
     }
 
     pub fn point_count(&self) -> usize {
         self.rates_m_s
             .len()
+            .saturating_mul(self.wind_amplitudes().len())
             .saturating_mul(self.stiffness_ratios.len())
             .saturating_mul(self.perturbation_forces_n.len())
             .saturating_mul(self.net_buoyancies_n.len())
@@ -166,6 +233,20 @@ impl GeChartRequest {
             hold_s: self.perturbation_hold_s,
         }
         .validate()?;
+        if let Some(w) = &self.wind {
+            if w.amplitudes.is_empty() {
+                return Err(InvalidInput::new(
+                    "wind.amplitudes",
+                    "must list at least one value",
+                ));
+            }
+            crate::numerics::params::require_finite("wind.wavenumber_1_m", w.wavenumber_1_m)?;
+            for (i, &a) in w.amplitudes.iter().enumerate() {
+                crate::numerics::params::require_finite(&format!("wind.amplitudes[{i}]"), a)?;
+                w.aerodynamics(a, self.system.aerostat_mass_kg)
+                    .map_err(|e| InvalidInput::new(format!("wind.amplitudes[{i}]"), e.reason))?;
+            }
+        }
         self.config.validate()?;
         let total = self.point_count();
         if total > MAX_GE_CHART_POINTS {
@@ -192,6 +273,7 @@ pub fn chart_point(
     rate_m_s: f64,
     net_buoyancy_n: f64,
     perturbation: Option<TipPerturbation>,
+    aero: Option<Aerodynamics>,
     config: &CriticalConfig,
     cancel: &(dyn Fn() -> bool + Sync),
 ) -> Result<GeChartPoint, InvalidInput> {
@@ -200,6 +282,7 @@ pub fn chart_point(
         profile: profile.clone(),
         net_buoyancy_n,
         perturbation,
+        aero,
     };
     let r = critical_time(model, &problem, config, cancel)?;
     let closed =
@@ -234,7 +317,9 @@ pub fn deployment_chart(
     for (m, &es) in request.stiffness_ratios.iter().enumerate() {
         for &f0 in &request.perturbation_forces_n {
             for &fb in &request.net_buoyancies_n {
-                series_keys.push((m, es, f0, fb));
+                for a0 in request.wind_amplitudes() {
+                    series_keys.push((m, es, f0, fb, a0));
+                }
             }
         }
     }
@@ -243,7 +328,11 @@ pub fn deployment_chart(
     let done = AtomicUsize::new(0);
     let point = |index: usize| -> Result<GeChartPoint, InvalidInput> {
         let (s, r) = (index / rates.len(), index % rates.len());
-        let (m, _, f0, fb) = series_keys[s];
+        let (m, _, f0, fb, a0) = series_keys[s];
+        let aero = match (&request.wind, a0) {
+            (Some(w), Some(a)) => Some(w.aerodynamics(a, request.system.aerostat_mass_kg)?),
+            _ => None,
+        };
         let perturbation = (f0 > 0.0).then_some(TipPerturbation {
             force_n: f0,
             ramp_s: request.perturbation_ramp_s,
@@ -255,6 +344,7 @@ pub fn deployment_chart(
             rates[r],
             fb,
             perturbation,
+            aero,
             &request.config,
             cancel,
         );
@@ -271,10 +361,11 @@ pub fn deployment_chart(
     Ok(series_keys
         .iter()
         .zip(flat.chunks(rates.len()))
-        .map(|(&(_, es, f0, fb), pts)| GeChartSeries {
+        .map(|(&(_, es, f0, fb, a0), pts)| GeChartSeries {
             stiffness_ratio: es,
             perturbation_force_n: f0,
             net_buoyancy_n: fb,
+            wind_amplitude: a0,
             points: pts.to_vec(),
         })
         .collect())

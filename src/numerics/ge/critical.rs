@@ -31,6 +31,7 @@ use super::solver::{
     NewtonFailure, State,
 };
 use super::stability;
+use crate::numerics::aero::Aerodynamics;
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 use crate::numerics::profile::Profile;
 use crate::numerics::qep::Spectrum;
@@ -78,10 +79,12 @@ pub struct CriticalProblem {
     /// Net buoyancy `F` (N), along the cable at the aerostat.
     pub net_buoyancy_n: f64,
     pub perturbation: Option<TipPerturbation>,
+    /// Air flow on the aerostat (ch. 7.5), if any.
+    pub aero: Option<Aerodynamics>,
 }
 
 impl CriticalProblem {
-    /// The run's drive (length, end loads; no damping, fixed platform).
+    /// The run's drive (length, end loads, air flow; no damping, fixed platform).
     pub fn drive(&self) -> Drive {
         let steady = TipLoad {
             force_n: [self.net_buoyancy_n, 0.0],
@@ -106,6 +109,7 @@ impl CriticalProblem {
             loads,
             damping: Damping::default(),
             base: BaseMotion::default(),
+            aero: self.aero.clone(),
         }
     }
 }
@@ -258,14 +262,7 @@ fn growth(
 ) -> Option<GrowthSample> {
     let t = state.time_s;
     let kin = drive.length.kinematics(t);
-    let spectrum: Spectrum = stability::local_spectrum(
-        model,
-        kin,
-        drive.tip_load(model, t),
-        drive.damping.at(t),
-        state,
-    )
-    .ok()?;
+    let spectrum: Spectrum = stability::drive_spectrum(model, drive, state).ok()?;
     let top = model.elements;
     Some(GrowthSample {
         time_s: t,

@@ -17,6 +17,7 @@ use super::banded::Band;
 use super::diagnostics::{self, Energy};
 use super::element::{self, HALF_BAND, TipLoad};
 use super::stability;
+use crate::numerics::aero::Aerodynamics;
 use crate::numerics::params::Kinematics;
 use crate::numerics::profile::Profile;
 use crate::numerics::qep::Spectrum;
@@ -146,16 +147,49 @@ impl BaseMotion {
     }
 }
 
-/// What drives a run: length history, end loads, damping, platform motion.
+/// What drives a run: length history, end loads, damping, platform
+/// motion and air flow on the aerostat.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Drive {
     pub length: LengthHistory,
     pub loads: EndLoads,
     pub damping: Damping,
     pub base: BaseMotion,
+    /// Horizontal air flow on the aerostat (thesis ch. 7.5, [`crate::numerics::aero`]):
+    /// evaluated at the top of the cable, elevation `L + u1(1)`, against its
+    /// sideways velocity `u̇2(1)`; the added mass `½ m_f` moves with `ü2(1)`.
+    /// (With a rigid link the flow still acts at the cable's top node.)
+    pub aero: Option<Aerodynamics>,
+}
+
+/// The aerostat's air load at one iterate, along `E2` on the top node.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AeroTip {
+    /// Force at the iterate's velocity (N).
+    pub force_n: f64,
+    /// `−∂F/∂u̇2` (N s/m).
+    pub damping_n_s_m: f64,
+    /// Added mass on `ü2` (kg).
+    pub added_mass_kg: f64,
 }
 
 impl Drive {
+    /// The air load at time `t` for the cable state `(q, v)`.
+    pub fn aero_tip(&self, model: &GeModel, t: f64, q: &[f64], v: &[f64]) -> AeroTip {
+        let Some(aero) = &self.aero else {
+            return AeroTip::default();
+        };
+        let top = model.elements;
+        let (qt, vt) = (element::node(q, top), element::node(v, top));
+        let z = self.length.kinematics(t).length_m + qt[0];
+        let l = aero.tip_load(z, t, vt[1]);
+        AeroTip {
+            force_n: l.force_n - l.damping_n_s_m * vt[1],
+            damping_n_s_m: l.damping_n_s_m,
+            added_mass_kg: aero.added_mass_kg(),
+        }
+    }
+
     /// The load on the aerostat at `t`: the end loads plus the inertial
     /// load `−m r̈` of the platform motion.
     pub fn tip_load(&self, model: &GeModel, t: f64) -> TipLoad {
@@ -215,6 +249,27 @@ impl State {
     }
 }
 
+/// The linearisation about a state of a run: [`system_matrices`] with the
+/// drive's loads at the state's time, plus the air load's damping and
+/// added mass.
+pub fn drive_matrices(model: &GeModel, drive: &Drive, state: &State) -> SystemMatrices {
+    let t = state.time_s;
+    let mut sys = system_matrices(
+        model,
+        drive.length.kinematics(t),
+        drive.tip_load(model, t),
+        drive.damping.at(t),
+        &state.q,
+        &state.v,
+        &state.a,
+    );
+    let aero = drive.aero_tip(model, t, &state.q, &state.v);
+    let y = GeModel::dof(model.elements, 1);
+    sys.mass.add(y, y, aero.added_mass_kg);
+    sys.damping.add(y, y, aero.damping_n_s_m);
+    sys
+}
+
 /// `M`, `C`, `K` of the linearised equations about `(q, q̇, q̈)`:
 /// `∂R/∂q̈`, `∂R/∂q̇`, `∂R/∂q`, aerostat included.
 pub struct SystemMatrices {
@@ -245,11 +300,12 @@ pub fn residual(
     a: &[f64],
 ) -> Residual {
     let lin = element::linear_operators(model, kin, mu);
-    residual_with(model, &lin, kin, load, 0.0, q, v, a)
+    residual_with(model, &lin, kin, load, 0.0, AeroTip::default(), q, v, a)
 }
 
 /// The residual with the platform acceleration `base_m_s2` (the cable's
-/// share `A_ρ L ∫ N r̈` on the transverse rows; the aerostat's is in `load`).
+/// share `A_ρ L ∫ N r̈` on the transverse rows; the aerostat's is in `load`)
+/// and the air load `aero` on the top node.
 #[allow(clippy::too_many_arguments)]
 fn residual_with(
     model: &GeModel,
@@ -257,6 +313,7 @@ fn residual_with(
     kin: Kinematics,
     load: TipLoad,
     base_m_s2: f64,
+    aero: AeroTip,
     q: &[f64],
     v: &[f64],
     a: &[f64],
@@ -291,10 +348,13 @@ fn residual_with(
     for c in 0..3 {
         total[GeModel::dof(top, c)] += tip.residual[c];
     }
+    let air = aero.added_mass_kg * a[GeModel::dof(top, 1)] - aero.force_n;
+    total[GeModel::dof(top, 1)] += air;
     let scale = norm(&inertia)
         .max(norm(&internal))
         .max(norm(&body))
-        .max(norm(&tip.residual));
+        .max(norm(&tip.residual))
+        .max(air.abs());
     Residual { total, scale }
 }
 
@@ -372,17 +432,21 @@ pub fn initial_acceleration(
     let mu = drive.damping.at(time_s);
     let zero = vec![0.0; model.dofs()];
     let lin = element::linear_operators(model, kin, mu);
+    let aero = drive.aero_tip(model, time_s, q, v);
     let r = residual_with(
         model,
         &lin,
         kin,
         load,
         drive.base.acceleration_m_s2(time_s),
+        aero,
         q,
         v,
         &zero,
     );
-    let m = system_matrices(model, kin, load, mu, q, v, &zero).mass;
+    let mut m = system_matrices(model, kin, load, mu, q, v, &zero).mass;
+    let top = GeModel::dof(model.elements, 1);
+    m.add(top, top, aero.added_mass_kg);
     let lu = m.factor()?;
     let mut a: Vec<f64> = r.total.iter().map(|x| -x).collect();
     lu.solve_in_place(&mut a);
@@ -509,7 +573,8 @@ impl<'a> Integrator<'a> {
                 a[i] = alpha_a * (q[i] - qn[i] - dt * vn[i]) - (0.5 / BETA - 1.0) * an[i];
                 v[i] = vn[i] + dt * ((1.0 - GAMMA) * an[i] + GAMMA * a[i]);
             }
-            let r = residual_with(model, &lin, kin, load, base, &q, &v, &a);
+            let aero = self.drive.aero_tip(model, t1, &q, &v);
+            let r = residual_with(model, &lin, kin, load, base, aero, &q, &v, &a);
             let rn = norm(&r.total);
             if rn <= self.newton.absolute_tolerance_n + self.newton.relative_tolerance * r.scale {
                 break;
@@ -552,6 +617,12 @@ impl<'a> Integrator<'a> {
                     tangent.add(GeModel::dof(top, i), GeModel::dof(top, j), value);
                 }
             }
+            let y = GeModel::dof(top, 1);
+            tangent.add(
+                y,
+                y,
+                alpha_v * aero.damping_n_s_m + alpha_a * aero.added_mass_kg,
+            );
             let Some(lu) = tangent.clone().factor() else {
                 return Err(NewtonFailure {
                     time_s: t1,
@@ -693,13 +764,7 @@ pub fn run(
     let mut spectrum_failures = 0;
     let mut record_spectrum = |state: &State, spectra: &mut Vec<SpectrumSample>| {
         let kin = drive.length.kinematics(state.time_s);
-        match stability::local_spectrum(
-            model,
-            kin,
-            drive.tip_load(model, state.time_s),
-            drive.damping.at(state.time_s),
-            state,
-        ) {
+        match stability::drive_spectrum(model, drive, state) {
             Ok(spectrum) => spectra.push(SpectrumSample {
                 time_s: state.time_s,
                 length_m: kin.length_m,

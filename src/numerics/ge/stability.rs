@@ -9,7 +9,7 @@ use faer::Mat;
 
 use super::GeModel;
 use super::element::TipLoad;
-use super::solver::{self, State};
+use super::solver::{self, Drive, State, SystemMatrices};
 use crate::numerics::params::Kinematics;
 use crate::numerics::qep::{self, Eigenvalue, QepError, Spectrum};
 
@@ -22,6 +22,16 @@ pub fn local_spectrum(
     state: &State,
 ) -> Result<Spectrum, QepError> {
     let sys = solver::system_matrices(model, kin, load, mu, &state.q, &state.v, &state.a);
+    spectrum_of(model, sys)
+}
+
+/// The QEP spectrum about a state of a run under `drive` (its loads at the
+/// state's time, air load included).
+pub fn drive_spectrum(model: &GeModel, drive: &Drive, state: &State) -> Result<Spectrum, QepError> {
+    spectrum_of(model, solver::drive_matrices(model, drive, state))
+}
+
+fn spectrum_of(model: &GeModel, sys: SystemMatrices) -> Result<Spectrum, QepError> {
     let n = model.dofs();
     let k = sys.stiffness.to_dense();
     let c = sys.damping.to_dense();
