@@ -133,6 +133,15 @@
     input.removeAttribute("aria-describedby");
   }
 
+  // The API's message starts with the field path, which the label already says:
+  // keep the reason, and say which entry of a list is meant.
+  function fieldMessage(field, message) {
+    let text = message.startsWith(`${field}: `) ? message.slice(field.length + 2) : message;
+    const index = /\[(\d+)\]$/.exec(field);
+    if (index) text = `entry ${Number(index[1]) + 1}: ${text}`;
+    return text;
+  }
+
   // Shows `message` under the input that `field` names; returns false when no input matches.
   function showFieldError(field, message) {
     const input = inputFor(field);
@@ -142,7 +151,7 @@
     p.className = "field-error";
     p.id = `${input.id}-error`;
     p.dataset.errorFor = field;
-    p.textContent = message;
+    p.textContent = fieldMessage(field, message);
     input.closest(".field").append(p);
     input.setAttribute("aria-invalid", "true");
     input.setAttribute("aria-describedby", p.id);
@@ -192,6 +201,9 @@
   }
 
   function setStatus(kind, text) {
+    // Plots of an earlier request are dimmed until a new answer replaces them.
+    if (kind === "ready") delete $("#results").dataset.stale;
+    else $("#results").dataset.stale = "";
     statusEl.dataset.state = kind;
     statusEl.textContent = text;
   }

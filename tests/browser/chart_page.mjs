@@ -146,12 +146,28 @@ try {
   const fieldError = page.locator('#mass-per-length ~ .field-error, .field:has(#mass-per-length) .field-error');
   await fieldError.first().waitFor({ timeout: 30_000 });
   const msg = await fieldError.first().textContent();
-  check(/mass_per_length_kg_m/.test(msg) && /greater than zero|positive/.test(msg), `error next to ρA: “${msg}”`);
+  const errorFor = await fieldError.first().getAttribute("data-error-for");
+  check(errorFor === "cable.mass_per_length_kg_m" && /greater than zero|positive/.test(msg), `error for ${errorFor} next to ρA: “${msg}”`);
   check((await page.getAttribute("#mass-per-length", "aria-invalid")) === "true", "ρA input marked invalid");
   check((await page.getAttribute("#status", "data-state")) === "error", "status shows the error");
   await page.screenshot({ path: path.join(artifacts, "chart_page_error.png"), fullPage: false });
   await page.fill("#mass-per-length", "0.078");
   check((await fieldError.count()) === 0, "error clears when the field is edited");
+
+  // An error inside the buoyancy list (`net_buoyancies_n[1]`) lands on the list input.
+  await page.fill("#buoyancies", "500, -1000");
+  await page.click("#plot-button");
+  const listError = page.locator(".field:has(#buoyancies) .field-error");
+  await listError.waitFor({ timeout: 30_000 });
+  check((await listError.getAttribute("data-error-for")) === "net_buoyancies_n[1]" && /^entry 2:/.test(await listError.textContent()), `error for net_buoyancies_n[1] next to the buoyancy list: “${await listError.textContent()}”`);
+  await page.fill("#buoyancies", "500, 1000, 2000");
+
+  // The safe-rate calculator's own field.
+  await page.fill("#target", "-5");
+  await page.click("#safe-button");
+  const targetError = page.locator(".field:has(#target) .field-error");
+  await targetError.waitFor({ timeout: 30_000 });
+  check((await targetError.getAttribute("data-error-for")) === "target_elevation_m", `error next to the target elevation: “${await targetError.textContent()}”`);
   await context.close();
 
   // ---------- phone width ----------
@@ -170,7 +186,7 @@ try {
   await phone.close();
 
   // ---------- console ----------
-  const unexpected = consoleErrors.filter((e) => !(e.phase === "invalid" && /status of 422/.test(e.text)));
+  const unexpected = consoleErrors.filter((e) => !(e.phase === "invalid" && /status of 4\d\d/.test(e.text)));
   for (const e of unexpected) console.log(`  console error (${e.phase}): ${e.text}`);
   check(unexpected.length === 0, `no console errors (${unexpected.length})`);
 } catch (e) {
