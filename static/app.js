@@ -5,8 +5,10 @@
 "use strict";
 
 (function () {
-  // Charts with more points than this run as a background job with progress.
-  const SYNC_POINT_LIMIT = 2000;
+  // Charts with more work than this (points × elements; 5000 points at 50 elements)
+  // run as a background job with progress; so does any chart the direct route
+  // refuses as too large (422 `too_large`) or while the server is busy (503).
+  const JOB_WORK_THRESHOLD = 250_000;
   const POLL_MS = 400;
   const COLORS = ["#0072b2", "#d55e00", "#009e73", "#cc79a7", "#e69f00", "#56b4e9", "#000000", "#999933"];
 
@@ -16,7 +18,7 @@
   const statusEl = $("#status");
 
   // Shared with the browser test and the console: the last request, answer and plots.
-  const state = { request: null, chart: null, plots: { time: null, elevation: null }, job: null };
+  const state = { request: null, chart: null, via: null, jobProgress: [], plots: { time: null, elevation: null }, job: null };
   window.tetherplan = state;
 
   // ---------- reading the form ----------
@@ -91,6 +93,10 @@
 
   function chartPoints(req) {
     return (req.rates_m_s.count || 0) * Math.max(1, (req.net_buoyancies_n || []).length);
+  }
+
+  function wantsJob(req) {
+    return chartPoints(req) * (req.model.elements || 0) > JOB_WORK_THRESHOLD;
   }
 
   // ---------- errors next to fields ----------
@@ -222,6 +228,7 @@
     if (!submitted.ok) return { status: submitted.status, error: submitted.body };
     const id = submitted.body.id;
     state.job = id;
+    state.jobProgress = [];
     jobBox.hidden = false;
     jobProgress.value = 0;
     jobText.textContent = "queued";
@@ -232,9 +239,10 @@
         const job = r.body;
         const progress = Number(job.progress) || 0;
         jobProgress.value = progress;
+        state.jobProgress.push([job.status, progress]);
         jobText.textContent = `${job.status} · ${(progress * 100).toFixed(0)} %`;
         setStatus("busy", `Job ${id}: ${job.status}, ${(progress * 100).toFixed(0)} % of ${chartPoints(req)} points`);
-        if (job.status === "done") return { chart: job.result };
+        if (job.status === "done") return { chart: job.result, via: `job ${id}` };
         if (job.status === "failed" || job.status === "cancelled") {
           return { status: 200, error: job.error && job.error.error ? job.error : { error: job.error || { code: job.status, field: null, message: `the job was ${job.status}` } } };
         }
@@ -317,9 +325,10 @@
     );
   }
 
-  function render(chart, req) {
+  function render(chart, req, via = state.via) {
     state.chart = chart;
     state.request = req;
+    state.via = via;
     const L0 = req.initial_length_m;
     const timeSpec = plotSpec(chart, "time", L0, $("#log-time").checked);
     const elevSpec = plotSpec(chart, "elevation", L0);
@@ -331,7 +340,7 @@
     $("#download-png").disabled = false;
     const pts = chart.series.reduce((n, s) => n + s.points.length, 0);
     statusEl.dataset.series = String(chart.series.length);
-    setStatus("ready", `${chart.series.length} curves, ${pts} points, ${chart.elements} elements.`);
+    setStatus("ready", `${chart.series.length} curves, ${pts} points, ${chart.elements} elements${via && via !== "direct" ? ` (${via})` : ""}.`);
   }
 
   $("#log-time").addEventListener("change", () => {
@@ -359,7 +368,7 @@
       return;
     }
     const n = chartPoints(req);
-    hint.textContent = `${n} points${n > SYNC_POINT_LIMIT ? " · runs as a background job" : ""}`;
+    hint.textContent = `${n} points${wantsJob(req) ? " · runs as a background job" : ""}`;
   }
 
   let busy = false;
@@ -381,21 +390,21 @@
     try {
       const n = chartPoints(req);
       let outcome;
-      if (n > SYNC_POINT_LIMIT) {
+      if (wantsJob(req)) {
         setStatus("busy", `Submitting a job for ${n} points…`);
         outcome = await runChartJob(req);
       } else {
         setStatus("busy", `Computing ${n} points…`);
         const r = await api("POST", "/api/v1/charts", req);
         // The direct route may refuse a chart as too large or the server as busy: use a job.
-        if (!r.ok && (r.status === 413 || r.status === 503 || r.status === 429) && r.body?.error?.field == null) {
+        if (!r.ok && (r.body?.error?.code === "too_large" || r.status === 503)) {
           setStatus("busy", "The server asked for a background job…");
           outcome = await runChartJob(req);
         } else {
-          outcome = r.ok ? { chart: r.body } : { status: r.status, error: r.body };
+          outcome = r.ok ? { chart: r.body, via: "direct" } : { status: r.status, error: r.body };
         }
       }
-      if (outcome.chart) render(outcome.chart, req);
+      if (outcome.chart) render(outcome.chart, req, outcome.via);
       else setStatus("error", renderApiError(outcome.status, outcome.error, $("#form-error")));
     } finally {
       busy = false;

@@ -170,6 +170,27 @@ try {
   check((await targetError.getAttribute("data-error-for")) === "target_elevation_m", `error next to the target elevation: “${await targetError.textContent()}”`);
   await context.close();
 
+  // ---------- a large chart runs as a job, with progress ----------
+  phase = "job";
+  {
+    const jobs = await browser.newContext({ viewport: { width: 900, height: 1000 } });
+    const jp = await jobs.newPage();
+    watch(jp);
+    await jp.goto(url, { waitUntil: "load" });
+    await jp.fill("#rate-count", "2000"); // 3 × 2000 points × 50 elements: above the page's job threshold
+    check(/background job/.test(await jp.textContent("#points-hint")), `hint announces a job: “${await jp.textContent("#points-hint")}”`);
+    await jp.click("#plot-button");
+    await jp.waitForSelector("#job:not([hidden])", { timeout: 10_000 }).catch(() => {});
+    await jp.waitForSelector('#status[data-state="ready"], #status[data-state="error"]', { timeout: 120_000 });
+    const j = await jp.evaluate(() => ({ via: window.tetherplan.via, progress: window.tetherplan.jobProgress, n: window.tetherplan.chart?.series.reduce((a, s) => a + s.points.length, 0) }));
+    check((await jp.getAttribute("#status", "data-state")) === "ready", `job chart computed (status: ${await jp.textContent("#status")})`);
+    check(/^job /.test(j.via ?? "") && j.n === 6000, `chart came from a ${j.via} with ${j.n} points`);
+    const last = j.progress.at(-1);
+    check(j.progress.length > 0 && last[0] === "done" && last[1] === 1, `job progress reported (${j.progress.map(([s, p]) => `${s} ${p.toFixed(2)}`).join(", ")})`);
+    check(await jp.isHidden("#job"), "progress bar hidden once the job is done");
+    await jobs.close();
+  }
+
   // ---------- phone width ----------
   phase = "phone";
   const phone = await browser.newContext({ viewport: { width: 375, height: 800 }, deviceScaleFactor: 2, isMobile: true, hasTouch: true });
