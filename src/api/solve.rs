@@ -125,6 +125,9 @@ macro_rules! solve_path {
         pub async fn $name(State(app): State<AppState>, JsonBody(body): JsonBody) -> Result<Response, ApiError> {
             app.solve(move |$limits: &Limits| {
                 let $r: $req = contract::parse(&body)?;
+                // The system's own errors (elements out of range…) come
+                // before the synchronous limits.
+                $r.system.model().map_err(contract::RequestError::from)?;
                 $body
             })
             .await
