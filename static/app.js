@@ -221,11 +221,21 @@
   const jobText = $("#job-text");
   const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
+  // A submission names fields inside its `request` (`request.rates_m_s.count`):
+  // drop that prefix so the error lands on the form's input.
+  function unwrapJobError(body) {
+    const err = body?.error;
+    if (!err || typeof err.field !== "string" || !err.field.startsWith("request.")) return body;
+    const field = err.field.slice("request.".length);
+    const message = err.message.startsWith(`${err.field}: `) ? `${field}: ${err.message.slice(err.field.length + 2)}` : err.message;
+    return { error: { ...err, field, message } };
+  }
+
   // Runs a chart as a background job, showing its progress; resolves to the chart
   // answer, or to {error} when the job fails, is cancelled, or cannot be submitted.
   async function runChartJob(req) {
     const submitted = await api("POST", "/api/v1/jobs", { kind: "chart", request: req });
-    if (!submitted.ok) return { status: submitted.status, error: submitted.body };
+    if (!submitted.ok) return { status: submitted.status, error: unwrapJobError(submitted.body) };
     const id = submitted.body.id;
     state.job = id;
     state.jobProgress = [];
@@ -244,7 +254,8 @@
         setStatus("busy", `Job ${id}: ${job.status}, ${(progress * 100).toFixed(0)} % of ${chartPoints(req)} points`);
         if (job.status === "done") return { chart: job.result, via: `job ${id}` };
         if (job.status === "failed" || job.status === "cancelled") {
-          return { status: 200, error: job.error && job.error.error ? job.error : { error: job.error || { code: job.status, field: null, message: `the job was ${job.status}` } } };
+          const body = job.error?.error ? job.error : { error: { code: job.status, field: null, message: `the job was ${job.status}` } };
+          return { status: 200, error: unwrapJobError(body) };
         }
         await sleep(POLL_MS);
       }

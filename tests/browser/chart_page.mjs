@@ -179,6 +179,15 @@ try {
     await jp.goto(url, { waitUntil: "load" });
     await jp.fill("#rate-count", "2000"); // 3 × 2000 points × 50 elements: above the page's job threshold
     check(/background job/.test(await jp.textContent("#points-hint")), `hint announces a job: “${await jp.textContent("#points-hint")}”`);
+    // A submission the server refuses: its error (`request.cable.…`) lands on the ρA input.
+    phase = "invalid";
+    await jp.fill("#mass-per-length", "0");
+    await jp.click("#plot-button");
+    const jobError = jp.locator(".field:has(#mass-per-length) .field-error");
+    await jobError.waitFor({ timeout: 30_000 });
+    check((await jobError.getAttribute("data-error-for")) === "cable.mass_per_length_kg_m", `job submission error next to ρA: “${await jobError.textContent()}”`);
+    await jp.fill("#mass-per-length", "0.078");
+    phase = "job";
     await jp.click("#plot-button");
     await jp.waitForSelector("#job:not([hidden])", { timeout: 10_000 }).catch(() => {});
     await jp.waitForSelector('#status[data-state="ready"], #status[data-state="error"]', { timeout: 120_000 });
