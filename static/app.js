@@ -9,6 +9,8 @@
   // run as a background job with progress; so does any chart the direct route
   // refuses as too large (422 `too_large`) or while the server is busy (503).
   const JOB_WORK_THRESHOLD = 250_000;
+  // The server's own limit for a direct chart (config.rs, max_sync_chart_points).
+  const SYNC_POINT_LIMIT = 20_000;
   const POLL_MS = 400;
   const COLORS = ["#0072b2", "#d55e00", "#009e73", "#cc79a7", "#e69f00", "#56b4e9", "#000000", "#999933"];
 
@@ -96,7 +98,7 @@
   }
 
   function wantsJob(req) {
-    return chartPoints(req) * (req.model.elements || 0) > JOB_WORK_THRESHOLD;
+    return chartPoints(req) > SYNC_POINT_LIMIT || chartPoints(req) * (req.model.elements || 0) > JOB_WORK_THRESHOLD;
   }
 
   // ---------- errors next to fields ----------
