@@ -379,14 +379,38 @@ impl JobSubmission {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::json;
+
+    fn valid(kind: &str) -> Value {
+        let mut v = json!({"cable": {"mass_per_length_kg_m": 0.078}, "aerostat": {"net_buoyancy_n": 1000.0}});
+        let extra = match kind {
+            "stability" => json!({"state": {"length_m": 10.0}}),
+            "critical" => json!({"profile": {"kind": "constant_rate", "rate_m_s": 10.0}}),
+            "safe_rate" => json!({"target_elevation_m": 100.0}),
+            "chart" => json!({"rates_m_s": {"min": 1.0, "max": 2.0, "count": 2}}),
+            other => panic!("a new kind needs a valid request here: {other}"),
+        };
+        v.as_object_mut().unwrap().extend(extra.as_object().unwrap().clone());
+        v
+    }
 
     #[test]
-    fn kind_names_match_serde_names() {
+    fn kind_names_are_the_serde_tags() {
         for kind in JobItem::KINDS {
-            let v = serde_json::json!({"kind": kind, "request": {}});
-            let err = JobItem::parse(&v, "body").unwrap_err();
-            // Known kinds fail on the request's fields, not on the kind.
-            assert!(!err.body().error.field.unwrap().starts_with("kind"), "{kind}");
+            let item = JobItem::parse(&json!({"kind": kind, "request": valid(kind)}), "body").unwrap();
+            assert_eq!(item.kind(), *kind);
+            assert_eq!(serde_json::to_value(&item).unwrap()["kind"], *kind);
         }
+    }
+
+    #[test]
+    fn errors_name_the_field_inside_the_submission() {
+        let limits = Limits::default();
+        let body = json!({"kind": "batch", "request": [
+            {"kind": "critical", "request": valid("critical")},
+            {"kind": "chart", "request": {"cable": {}, "aerostat": {"net_buoyancy_n": 1000.0}, "rates_m_s": {"min": 1.0, "max": 2.0, "count": 2}}},
+        ]});
+        let err = JobSubmission::parse(&serde_json::to_vec(&body).unwrap(), &limits).unwrap_err();
+        assert_eq!(err.body().error.field.as_deref(), Some("request[1].request.cable.mass_per_length_kg_m"));
     }
 }

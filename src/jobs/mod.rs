@@ -52,6 +52,7 @@ impl JobQueue {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.max(1))
             .thread_name(|i| format!("job-{i}"))
+            .start_handler(|_| lower_thread_priority())
             .build()
             .expect("the job pool starts");
         Self {
@@ -133,6 +134,23 @@ impl JobQueue {
                 }
             })
             .expect("the job worker starts")
+    }
+}
+
+/// Niceness of the job threads: batch work yields the CPU to the threads
+/// that answer requests (about 10:1 under contention with CFS), so
+/// `/healthz` and synchronous answers stay fast while a job runs.
+pub const JOB_NICENESS: i32 = 10;
+
+/// Lowers the calling thread's scheduling priority to [`JOB_NICENESS`].
+fn lower_thread_priority() {
+    #[cfg(target_os = "linux")]
+    {
+        // SAFETY: setpriority on the calling thread's id only reads its arguments.
+        let rc = unsafe { libc::setpriority(libc::PRIO_PROCESS, libc::gettid() as libc::id_t, JOB_NICENESS) };
+        if rc != 0 {
+            tracing::warn!("could not lower the priority of a job thread");
+        }
     }
 }
 
