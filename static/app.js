@@ -418,6 +418,7 @@
         }
       }
       if (outcome.chart) render(outcome.chart, req, outcome.via);
+      else if (outcome.error?.error?.code === "cancelled") setStatus("idle", "Job cancelled.");
       else setStatus("error", renderApiError(outcome.status, outcome.error, $("#form-error")));
     } finally {
       busy = false;
