@@ -403,6 +403,11 @@ async fn a_chart_job_runs_to_the_synchronous_answer() {
     let bad = get(&app, "/api/v1/jobs?status=sleeping").await;
     assert_eq!(bad.status, StatusCode::BAD_REQUEST);
     bad.error();
+    for limit in ["0", "1001", "-1", "many"] {
+        let bad = get(&app, &format!("/api/v1/jobs?limit={limit}")).await;
+        assert_eq!(bad.status, StatusCode::BAD_REQUEST, "limit={limit}");
+        assert_eq!(bad.error().code, "invalid_query");
+    }
 }
 
 #[tokio::test]

@@ -161,7 +161,15 @@ pub async fn create_job(State(app): State<AppState>, JsonBody(body): JsonBody) -
 )]
 pub async fn list_jobs(State(app): State<AppState>, query: Result<Query<ListQuery>, axum::extract::rejection::QueryRejection>) -> Result<Response, ApiError> {
     let Query(q) = query.map_err(|e| ApiError::new(StatusCode::BAD_REQUEST, "invalid_query", Some("query"), e.body_text()))?;
-    let limit = q.limit.unwrap_or(100).clamp(1, 1000);
+    let limit = q.limit.unwrap_or(100);
+    if !(1..=1000).contains(&limit) {
+        return Err(ApiError::new(
+            StatusCode::BAD_REQUEST,
+            "invalid_query",
+            Some("limit"),
+            format!("limit: must be between 1 and 1000, got {limit}"),
+        ));
+    }
     let queue = app.queue.clone();
     let jobs = blocking(move || Ok(queue.store.list(q.status, limit)?)).await?;
     Ok(json_response(StatusCode::OK, &JobList { jobs: jobs.into_iter().map(JobView::new).collect() }))
