@@ -1039,3 +1039,121 @@ async fn docs_and_openapi_are_served() {
         &a.text[..a.text.len().min(300)]
     );
 }
+
+fn simulate_body() -> Value {
+    with(
+        with(system(30), json!({"initial_length_m": 100.0})),
+        json!({"profile": {"kind": "constant_rate", "rate_m_s": 1.0}, "duration_s": 5.0, "samples": 20,
+               "initial": {"kind": "shape", "tip_deflection_m": 0.1}}),
+    )
+}
+
+fn ge_simulate_body() -> Value {
+    json!({"cable": {"density_kg_m3": 7800.0, "area_m2": 1e-5},
+           "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0}, "initial_length_m": 1.0,
+           "model": {"kind": "geometrically_exact", "elements": 10, "bending_stiffness_n_m2": 1000.0,
+                     "stiffness_ratio": 1e5, "inertia_ratio": 1.0},
+           "time_step_s": 0.000883, "duration_s": 0.0883})
+}
+
+fn frequency_response_body(count: usize) -> Value {
+    with(
+        system(20),
+        json!({"profile": {"kind": "constant_rate", "rate_m_s": 1.0}, "duration_s": 10.0, "samples": 10,
+               "aero": {"radius_m": 0.5}, "wind_amplitude_m_s": 10.0,
+               "frequencies_rad_s": {"min": 1.0, "max": 4.0, "count": count}}),
+    )
+}
+
+#[tokio::test]
+async fn simulate_answers_for_both_models_and_names_bad_fields() {
+    let (app, _) = app();
+    let a = post(&app, "/api/v1/simulate", &simulate_body()).await;
+    assert_eq!(a.status, StatusCode::OK, "{}", a.text);
+    let v: Value = serde_json::from_str(&a.text).unwrap();
+    assert_eq!(v["outcome"], "completed");
+    let length = v["length_m"].as_array().unwrap();
+    assert_eq!(length.len(), 20);
+    assert!(
+        (length[19].as_f64().unwrap() - 105.0).abs() < 1e-6,
+        "100 m + 1 m/s × 5 s"
+    );
+    let direct = contract::transient::simulate(&parse(&simulate_body()), &NoProgress).unwrap();
+    assert_same_json(&a.text, &direct);
+
+    let a = post(&app, "/api/v1/simulate", &ge_simulate_body()).await;
+    assert_eq!(a.status, StatusCode::OK, "{}", a.text);
+    let v: Value = serde_json::from_str(&a.text).unwrap();
+    assert_eq!(v["outcome"]["status"], "completed");
+    assert_eq!(v["steps"], 100);
+
+    let mut bad = ge_simulate_body();
+    bad["model"]["stiffness_ratio"] = json!(-1.0);
+    let a = post(&app, "/api/v1/simulate", &bad).await;
+    assert_eq!(a.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(a.error().field.as_deref(), Some("model.stiffness_ratio"));
+    let mut bad = simulate_body();
+    bad["duration_s"] = json!("long");
+    let a = post(&app, "/api/v1/simulate", &bad).await;
+    assert_eq!(a.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(a.error().field.as_deref(), Some("duration_s"));
+}
+
+#[tokio::test]
+async fn frequency_response_answers_and_large_sweeps_go_to_jobs() {
+    let (app, queue) = app();
+    let a = post(
+        &app,
+        "/api/v1/frequency-response",
+        &frequency_response_body(4),
+    )
+    .await;
+    assert_eq!(a.status, StatusCode::OK, "{}", a.text);
+    let v: Value = serde_json::from_str(&a.text).unwrap();
+    assert_eq!(v["frequencies_rad_s"], json!([1.0, 2.0, 3.0, 4.0]));
+    assert_eq!(v["envelope_m"].as_array().unwrap().len(), 4);
+
+    let a = post(
+        &app,
+        "/api/v1/frequency-response",
+        &frequency_response_body(64),
+    )
+    .await;
+    assert_eq!(a.status, StatusCode::UNPROCESSABLE_ENTITY);
+    let e = a.error();
+    assert_eq!(e.code, "too_large");
+    assert_eq!(e.field.as_deref(), Some("frequencies_rad_s.count"));
+
+    // the same sweep, and a simulation, as jobs: results equal the direct answers
+    let fr = frequency_response_body(6);
+    let id = submit(&app, &json!({"kind": "frequency_response", "request": fr})).await;
+    let sim = submit(
+        &app,
+        &json!({"kind": "simulate", "request": simulate_body()}),
+    )
+    .await;
+    while try_execute_next(&queue).unwrap().is_some() {}
+    let text = get(&app, &format!("/api/v1/jobs/{id}")).await.text;
+    let direct =
+        contract::transient::frequency_response(&parse(&fr), Parallelism::Serial, &NoProgress)
+            .unwrap();
+    assert_same_json(&result_text(&text), &direct);
+    let text = get(&app, &format!("/api/v1/jobs/{sim}")).await.text;
+    let direct = contract::transient::simulate(&parse(&simulate_body()), &NoProgress).unwrap();
+    assert_same_json(&result_text(&text), &direct);
+
+    // bad input is refused at submission, naming the field inside the request
+    let mut bad = frequency_response_body(6);
+    bad["frequencies_rad_s"]["max"] = json!(0.5);
+    let a = post(
+        &app,
+        "/api/v1/jobs",
+        &json!({"kind": "frequency_response", "request": bad}),
+    )
+    .await;
+    assert_eq!(a.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(
+        a.error().field.as_deref(),
+        Some("request.frequencies_rad_s.max")
+    );
+}
