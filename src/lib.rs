@@ -6,10 +6,16 @@
 //! * [`contract`]: the JSON request/response types shared by the CLI, the
 //!   HTTP API and the job queue (SI units, field names end in their unit),
 //!   and the functions that run one request.
+//! * [`api`]: the HTTP service (axum), its OpenAPI document and error body.
+//! * [`jobs`]: persisted batch jobs (SQLite) and their worker.
+//! * [`config`]: settings of `serve` (flags with `TETHERPLAN_*` fallbacks).
 //!
 //! Invariants: `numerics` never touches serde, tokio, axum or SQLite;
 //! invalid input is an `Err` naming the field; physical outcomes
 //! ("unstable at t = 0", "no safe rate") are answers, not errors.
 
+pub mod api;
+pub mod config;
 pub mod contract;
+pub mod jobs;
 pub mod numerics;

@@ -1,6 +1,7 @@
-//! The `tetherplan` binary: CLI subcommands over the JSON contract.
-//! Each reads a request (file or stdin), prints the JSON answer on stdout,
-//! and on bad input prints the error body and exits with status 2.
+//! The `tetherplan` binary: `serve` (the default with no subcommand) runs
+//! the HTTP service; the other subcommands answer one request over the JSON
+//! contract: each reads a request (file or stdin), prints the JSON answer
+//! on stdout, and on bad input prints the error body and exits with status 2.
 
 use std::io::Read;
 use std::path::PathBuf;
@@ -9,6 +10,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
+use tetherplan::config::ServeArgs;
 use tetherplan::contract::{self, Progress, RequestError, dto, run, simulate, transient};
 use tetherplan::numerics::chart::Parallelism;
 
@@ -18,9 +20,13 @@ use tetherplan::numerics::chart::Parallelism;
     version,
     about = "Deployment planning for tethered aerostats"
 )]
+#[command(args_conflicts_with_subcommands = true)]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
+    /// `serve` flags, also accepted without the subcommand.
+    #[command(flatten)]
+    serve: ServeArgs,
 }
 
 #[derive(clap::Args)]
@@ -32,6 +38,8 @@ struct InputArg {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Run the HTTP service (the default).
+    Serve(ServeArgs),
     /// Eigenvalues and stability verdict at one state.
     Stability(InputArg),
     /// Critical time and maximum safe elevation of a deployment profile.
@@ -128,9 +136,42 @@ impl Progress for Bar {
     }
 }
 
+/// Runs the server on a multi-threaded tokio runtime (I/O only: solves
+/// run on rayon).
+fn serve(args: ServeArgs) -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    let runtime = match tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+    {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("cannot start the async runtime: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    match runtime.block_on(tetherplan::api::serve(args.into())) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            tracing::error!("{e}");
+            eprintln!("tetherplan serve: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match &cli.command {
+    let Some(command) = cli.command else {
+        return serve(cli.serve);
+    };
+    match &command {
+        Command::Serve(args) => serve(args.clone()),
         Command::Stability(arg) => answer(arg, run::stability),
         Command::Critical(arg) => answer(arg, run::critical),
         Command::SafeRate(arg) => answer(arg, run::safe_rate),

@@ -1,0 +1,72 @@
+//! The OpenAPI document (utoipa): every route, status and schema. Served at
+//! `GET /openapi.json`, committed as `openapi/openapi.json` (written by
+//! `cargo run --release --bin gen_openapi`; a test fails when it is stale).
+
+use utoipa::OpenApi;
+
+use crate::api::{Health, jobs, solve};
+use crate::contract::dto::*;
+use crate::jobs::kinds::{
+    BatchItemOutcome, BatchKind, BatchOutcome, BatchSubmission, JobItem, JobSubmission,
+};
+use crate::jobs::store::JobStatus;
+
+#[derive(OpenApi)]
+#[openapi(
+    info(
+        title = "tetherplan",
+        description = "Deployment planning for tethered aerostats: stability, critical time, safe rates and \
+            deployment charts of a lengthening heavy cable. JSON in SI units; every field name ends in its unit \
+            (`_m`, `_s`, `_m_s`, `_n`, `_kg`), non-dimensional values end in `_nondim`.\n\n\
+            Every error is `{\"error\": {\"code\", \"field\", \"message\"}}`: 400 malformed JSON, 404 unknown \
+            job or path, 405 wrong method, 409 cancelling a finished job, 413 oversize body, 415 not JSON, \
+            422 invalid input or too large for a synchronous answer (`field` names the culprit), 429 job \
+            queue full and 503 too many solves in flight (both with `Retry-After`), 504 no answer within the \
+            solve timeout, 500 a bug."
+    ),
+    paths(
+        solve::compute_stability,
+        solve::compute_critical,
+        solve::compute_safe_rate,
+        solve::create_chart,
+        solve::run_simulation,
+        solve::compute_frequency_response,
+        jobs::create_job,
+        jobs::list_jobs,
+        jobs::get_job,
+        jobs::delete_job,
+        crate::api::get_health,
+        get_openapi,
+    ),
+    components(schemas(
+        ErrorBody, ErrorDetail, JobStatus, JobItem, JobSubmission, BatchSubmission, BatchKind,
+        BatchOutcome, BatchItemOutcome, StabilityResponse, CriticalResponse, SafeRateResponse, ChartResponse,
+        Health,
+    )),
+    tags(
+        (name = "solve", description = "Synchronous answers (about a second at most)"),
+        (name = "jobs", description = "Persisted batch jobs for large or many requests"),
+        (name = "meta", description = "Liveness and this document"),
+    )
+)]
+pub struct ApiDoc;
+
+/// The OpenAPI document of this service (JSON).
+#[utoipa::path(
+    get, path = "/openapi.json", operation_id = "get_openapi", tag = "meta",
+    responses((status = 200, description = "This document (OpenAPI 3.1)", content_type = "application/json"))
+)]
+#[allow(dead_code)]
+fn get_openapi() {}
+
+/// The document.
+pub fn openapi() -> utoipa::openapi::OpenApi {
+    ApiDoc::openapi()
+}
+
+/// The document as committed in `openapi/openapi.json` (pretty, newline-terminated).
+pub fn openapi_json() -> String {
+    let mut s = openapi().to_pretty_json().expect("the document serialises");
+    s.push('\n');
+    s
+}

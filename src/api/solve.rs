@@ -1,0 +1,263 @@
+//! The synchronous routes: one request, one answer, computed on the global
+//! rayon pool while the handler awaits a oneshot (with a timeout). At most
+//! `max_in_flight` solves run or wait at once; beyond: 503 + Retry-After.
+//! Requests too large to answer in about a second are refused (422,
+//! `too_large`) with a pointer to the job queue.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+use axum::extract::State;
+use axum::http::{StatusCode, header};
+use axum::response::{IntoResponse, Response};
+use serde::Serialize;
+
+use crate::api::AppState;
+use crate::api::error::{ApiError, JsonBody};
+use crate::config::Limits;
+use crate::contract;
+use crate::contract::dto::*;
+use crate::contract::run::{self, NoProgress};
+use crate::contract::simulate::{self, AnySimulateRequest, AnySimulateResponse};
+use crate::contract::transient::{self, FrequencyResponseRequest, FrequencyResponseResponse};
+use crate::numerics::chart::Parallelism;
+
+impl AppState {
+    /// Runs `work` on the rayon pool; the in-flight permit is held until the
+    /// work ends (even if the caller has timed out), so the bound is real.
+    pub(crate) async fn solve(
+        &self,
+        work: impl FnOnce(&Limits) -> Result<Vec<u8>, ApiError> + Send + 'static,
+    ) -> Result<Response, ApiError> {
+        let permit = self.solves.clone().try_acquire_owned().map_err(|_| {
+            ApiError::new(
+                StatusCode::SERVICE_UNAVAILABLE,
+                "overloaded",
+                None,
+                format!(
+                    "{} solves are already in flight; retry shortly",
+                    self.limits.max_in_flight
+                ),
+            )
+            .retry_after(1)
+        })?;
+        let (tx, rx) = tokio::sync::oneshot::channel();
+        let limits = self.limits.clone();
+        let span = tracing::Span::current();
+        rayon::spawn(move || {
+            let _permit = permit;
+            let _enter = span.enter();
+            let out = catch_unwind(AssertUnwindSafe(|| work(&limits)))
+                .unwrap_or_else(|_| Err(ApiError::internal("the solver panicked")));
+            let _ = tx.send(out);
+        });
+        let timeout = self.limits.solve_timeout;
+        let body = match tokio::time::timeout(timeout, rx).await {
+            Ok(Ok(out)) => out?,
+            Ok(Err(_)) => return Err(ApiError::internal("the solver ended without an answer")),
+            Err(_) => {
+                return Err(ApiError::new(
+                    StatusCode::GATEWAY_TIMEOUT,
+                    "timeout",
+                    None,
+                    format!(
+                        "no answer within {:.1} s; submit it as a batch job instead: POST /api/v1/jobs",
+                        timeout.as_secs_f64()
+                    ),
+                ));
+            }
+        };
+        Ok((
+            StatusCode::OK,
+            [(header::CONTENT_TYPE, "application/json")],
+            body,
+        )
+            .into_response())
+    }
+}
+
+fn to_json(value: &impl Serialize) -> Result<Vec<u8>, ApiError> {
+    Ok(serde_json::to_vec(value).expect("responses serialise"))
+}
+
+fn limit_qep_elements(system: &SystemInput, limits: &Limits, why: &str) -> Result<(), ApiError> {
+    let n = system.model.elements;
+    if n > limits.max_sync_qep_elements {
+        return Err(ApiError::too_large(
+            "model.elements",
+            format!(
+                "{why} with {n} elements takes too long to answer synchronously (at most {})",
+                limits.max_sync_qep_elements
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Checks a chart against the synchronous limits.
+pub fn check_sync_chart(req: &ChartRequest, limits: &Limits) -> Result<(), ApiError> {
+    let points = run::chart_points(req);
+    let work = points.saturating_mul(req.system.model.elements);
+    if points > limits.max_sync_chart_points {
+        return Err(ApiError::too_large(
+            "rates_m_s.count",
+            format!(
+                "the chart has {points} points; synchronous charts have at most {}",
+                limits.max_sync_chart_points
+            ),
+        ));
+    }
+    if work > limits.max_sync_chart_work {
+        return Err(ApiError::too_large(
+            "rates_m_s.count",
+            format!(
+                "the chart has {points} points × {} elements = {work}; synchronous charts have at most {}",
+                req.system.model.elements, limits.max_sync_chart_work
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Progress that gives up once the solve timeout has passed, so a request
+/// whose caller got a 504 stops using the CPU.
+struct Deadline {
+    end: std::time::Instant,
+}
+
+impl Deadline {
+    fn after(limits: &Limits) -> Self {
+        Self {
+            end: std::time::Instant::now() + limits.solve_timeout,
+        }
+    }
+}
+
+impl contract::Progress for Deadline {
+    fn report(&self, _: usize, _: usize) {}
+    fn cancelled(&self) -> bool {
+        std::time::Instant::now() >= self.end
+    }
+}
+
+/// A synchronous route: parse, check the synchronous limits, solve; with
+/// its OpenAPI operation (every status listed).
+macro_rules! solve_path {
+    ($(#[$doc:meta])* $name:ident, $path:literal, $req:ty, $resp:ty, |$r:ident, $limits:ident| $body:expr) => {
+        solve_path!($(#[$doc])* $name, $path, $req, $resp, parse = |body| {
+            let req: $req = contract::parse(body)?;
+            // The system's own errors (elements out of range…) come
+            // before the synchronous limits.
+            req.system.model().map_err(contract::RequestError::from)?;
+            Ok::<$req, contract::RequestError>(req)
+        }, |$r, $limits| $body);
+    };
+    ($(#[$doc:meta])* $name:ident, $path:literal, $req:ty, $resp:ty, parse = |$b:ident| $parse:expr, |$r:ident, $limits:ident| $body:expr) => {
+        $(#[$doc])*
+        #[utoipa::path(
+            post, path = $path, tag = "solve",
+            request_body(content = $req, description = "The system and the question (SI units)"),
+            responses(
+                (status = 200, description = "The answer", body = $resp),
+                (status = 400, description = "Malformed JSON", body = ErrorBody),
+                (status = 413, description = "Body larger than the limit", body = ErrorBody),
+                (status = 415, description = "Content type is not JSON", body = ErrorBody),
+                (status = 422, description = "Invalid input (`invalid_input`) or too large for a synchronous answer (`too_large`: use /api/v1/jobs); `field` names the culprit", body = ErrorBody),
+                (status = 500, description = "Numerical failure on valid input (a bug)", body = ErrorBody),
+                (status = 503, description = "Too many solves in flight", body = ErrorBody,
+                    headers(("Retry-After" = u32, description = "Seconds to wait before retrying"))),
+                (status = 504, description = "No answer within the solve timeout", body = ErrorBody),
+            )
+        )]
+        pub async fn $name(State(app): State<AppState>, JsonBody(body): JsonBody) -> Result<Response, ApiError> {
+            app.solve(move |$limits: &Limits| {
+                let $b: &[u8] = &body;
+                let $r: $req = $parse?;
+                $body
+            })
+            .await
+        }
+    };
+}
+
+solve_path!(
+    /// Eigenvalues and stability verdict at one deployment state.
+    ///
+    /// Solves the quadratic eigenvalue problem λ²M + λC + K = 0 of the
+    /// discretised cable. At most 400 elements synchronously.
+    compute_stability, "/api/v1/stability", StabilityRequest, StabilityResponse,
+    |req, limits| {
+        limit_qep_elements(&req.system, limits, "a stability analysis")?;
+        to_json(&run::stability(&req)?)
+    }
+);
+
+solve_path!(
+    /// Critical time t* and maximum safe elevation h* of a deployment profile.
+    ///
+    /// With the closed-form continuum bound beside it. QEP-based searches
+    /// (accelerating profiles, `confirm_with_qep`) take at most 400
+    /// elements synchronously.
+    compute_critical, "/api/v1/critical", CriticalRequest, CriticalResponse,
+    |req, limits| {
+        if req.params.confirm_with_qep || matches!(req.params.profile, ProfileInput::ConstantAcceleration { .. }) {
+            limit_qep_elements(&req.system, limits, "a QEP-based critical-time search")?;
+        }
+        to_json(&run::critical(&req)?)
+    }
+);
+
+solve_path!(
+    /// Largest safe constant winch rate to reach a target elevation.
+    compute_safe_rate, "/api/v1/safe-rate", SafeRateRequest, SafeRateResponse,
+    |req, _limits| to_json(&run::safe_rate(&req)?)
+);
+
+solve_path!(
+    /// Deployment chart: t* and h* against rate, one series per buoyancy.
+    ///
+    /// Synchronously at most 20 000 points and 2 000 000 points × elements;
+    /// larger charts (up to 1 000 000 points) go to `POST /api/v1/jobs`
+    /// with `"kind": "chart"`.
+    create_chart, "/api/v1/charts", ChartRequest, ChartResponse,
+    |req, limits| {
+        check_sync_chart(&req, limits)?;
+        to_json(&run::chart(&req, Parallelism::Rayon, &NoProgress)?)
+    }
+);
+
+solve_path!(
+    /// Transient run of either cable model: tip deflection, energy and
+    /// eigenvalues along a deployment, with wind on the aerostat.
+    ///
+    /// `model.kind` picks the model: `linear_string` (default) or
+    /// `geometrically_exact`. Runs longer than the solve timeout are
+    /// stopped (504): submit them as jobs with `"kind": "simulate"`.
+    run_simulation, "/api/v1/simulate", AnySimulateRequest, AnySimulateResponse,
+    parse = |body| simulate::parse_simulate(body),
+    |req, limits| to_json(&simulate::simulate_any(&req, &Deadline::after(limits))?)
+);
+
+solve_path!(
+    /// Envelope of the tip amplitude against wind forcing frequency and time.
+    ///
+    /// One transient run per frequency of u = U0 sin(ω t), in parallel.
+    /// Synchronously at most 16 frequencies; more go to `POST /api/v1/jobs`
+    /// with `"kind": "frequency_response"`.
+    compute_frequency_response, "/api/v1/frequency-response", FrequencyResponseRequest, FrequencyResponseResponse,
+    parse = |body| contract::parse::<FrequencyResponseRequest>(body),
+    |req, limits| {
+        if req.frequencies_rad_s.count > MAX_SYNC_FREQUENCIES {
+            return Err(ApiError::too_large(
+                "frequencies_rad_s.count",
+                format!(
+                    "{} frequencies take too long to answer synchronously (at most {MAX_SYNC_FREQUENCIES})",
+                    req.frequencies_rad_s.count
+                ),
+            ));
+        }
+        to_json(&transient::frequency_response(&req, Parallelism::Rayon, &Deadline::after(limits))?)
+    }
+);
+
+/// Frequencies a synchronous frequency response may have.
+pub const MAX_SYNC_FREQUENCIES: usize = 16;

@@ -1,0 +1,106 @@
+//! Settings of `tetherplan serve`: bind address, database, static files and
+//! the limits that keep the server responsive. Each is a flag with an
+//! environment fallback (`TETHERPLAN_*`), so the same binary runs from a
+//! shell, a test harness or a container.
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// `tetherplan serve` flags.
+#[derive(Clone, Debug, clap::Args)]
+pub struct ServeArgs {
+    /// Address to listen on (`host:port`; port 0 picks a free one).
+    #[arg(long, env = "TETHERPLAN_ADDR", default_value = "127.0.0.1:8080")]
+    pub addr: SocketAddr,
+    /// SQLite database of batch jobs (created if missing; WAL mode).
+    #[arg(long, env = "TETHERPLAN_DB", default_value = "./tetherplan.db")]
+    pub db: PathBuf,
+    /// Directory served at `GET /` (the chart page).
+    #[arg(long, env = "TETHERPLAN_STATIC_DIR", default_value = "./static")]
+    pub static_dir: PathBuf,
+    /// Largest request body (bytes); larger bodies get 413.
+    #[arg(long, env = "TETHERPLAN_MAX_BODY_BYTES", default_value_t = Limits::default().max_body_bytes)]
+    pub max_body_bytes: usize,
+    /// Synchronous solves running or waiting at once; beyond: 503 with Retry-After.
+    #[arg(long, env = "TETHERPLAN_MAX_IN_FLIGHT", default_value_t = Limits::default().max_in_flight)]
+    pub max_in_flight: usize,
+    /// Seconds a synchronous request waits for its answer; beyond: 504.
+    #[arg(long, env = "TETHERPLAN_SOLVE_TIMEOUT_S", default_value_t = Limits::default().solve_timeout.as_secs_f64())]
+    pub solve_timeout_s: f64,
+    /// Jobs queued or running at once; beyond: 429 with Retry-After.
+    #[arg(long, env = "TETHERPLAN_MAX_PENDING_JOBS", default_value_t = Limits::default().max_pending_jobs)]
+    pub max_pending_jobs: usize,
+    /// Threads of the job pool (0: one per core).
+    #[arg(long, env = "TETHERPLAN_JOB_THREADS", default_value_t = 0)]
+    pub job_threads: usize,
+}
+
+/// Limits of the HTTP service.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Limits {
+    pub max_body_bytes: usize,
+    pub max_in_flight: usize,
+    pub solve_timeout: Duration,
+    pub max_pending_jobs: usize,
+    /// Largest chart answered synchronously (points = rates × buoyancies).
+    pub max_sync_chart_points: usize,
+    /// Largest synchronous chart work, points × elements.
+    pub max_sync_chart_work: usize,
+    /// Largest model answered synchronously when the answer needs a dense
+    /// QEP solve (stability; critical time with QEP confirmation or an
+    /// accelerating profile). 400 elements ≈ 0.4 s per solve.
+    pub max_sync_qep_elements: usize,
+    /// Largest number of requests in one batch job.
+    pub max_batch_items: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self {
+            max_body_bytes: 1 << 20,
+            max_in_flight: 64,
+            solve_timeout: Duration::from_secs(30),
+            max_pending_jobs: 1000,
+            max_sync_chart_points: 20_000,
+            max_sync_chart_work: 2_000_000,
+            max_sync_qep_elements: 400,
+            max_batch_items: 1000,
+        }
+    }
+}
+
+/// Everything `serve` needs.
+#[derive(Clone, Debug)]
+pub struct Config {
+    pub addr: SocketAddr,
+    pub db: PathBuf,
+    pub static_dir: PathBuf,
+    pub job_threads: usize,
+    pub limits: Limits,
+}
+
+impl From<ServeArgs> for Config {
+    fn from(a: ServeArgs) -> Self {
+        let job_threads = if a.job_threads == 0 {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(2)
+        } else {
+            a.job_threads
+        };
+        Self {
+            addr: a.addr,
+            db: a.db,
+            static_dir: a.static_dir,
+            job_threads,
+            limits: Limits {
+                max_body_bytes: a.max_body_bytes,
+                max_in_flight: a.max_in_flight,
+                solve_timeout: Duration::from_secs_f64(a.solve_timeout_s.clamp(0.001, 86_400.0)),
+                max_pending_jobs: a.max_pending_jobs,
+                ..Limits::default()
+            },
+        }
+    }
+}

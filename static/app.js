@@ -1,0 +1,597 @@
+// The deployment-chart page: reads the form, asks the API for a chart
+// (directly, or as a background job when it is large), plots t* and h*
+// against rate with uPlot, and renders API errors next to the field they
+// name. No build step: plain browser JavaScript.
+"use strict";
+
+(function () {
+  // Charts with more work than this (points × elements; 5000 points at 50 elements)
+  // run as a background job with progress; so does any chart the direct route
+  // refuses as too large (422 `too_large`) or while the server is busy (503).
+  const JOB_WORK_THRESHOLD = 250_000;
+  // The server's own limit for a direct chart (config.rs, max_sync_chart_points).
+  const SYNC_POINT_LIMIT = 20_000;
+  const POLL_MS = 400;
+  const COLORS = ["#0072b2", "#d55e00", "#009e73", "#cc79a7", "#e69f00", "#56b4e9", "#000000", "#999933"];
+
+  const $ = (sel) => document.querySelector(sel);
+  const chartForm = $("#chart-form");
+  const safeForm = $("#safe-form");
+  const statusEl = $("#status");
+
+  // Shared with the browser test and the console: the last request, answer and plots.
+  const state = { request: null, chart: null, via: null, jobProgress: [], plots: { time: null, elevation: null }, job: null };
+  window.tetherplan = state;
+
+  // ---------- reading the form ----------
+
+  // Parses every input of `fields` ([data-field, kind]) into numbers; collects errors
+  // ({field, message}) for anything that is not a number, so they render like API errors.
+  function readNumber(field, errors, { integer = false } = {}) {
+    const input = document.querySelector(`[data-field="${field}"]`);
+    const text = input.value.trim();
+    const value = Number(text);
+    if (text === "" || !Number.isFinite(value)) {
+      errors.push({ field, message: text === "" ? "enter a number" : `“${text}” is not a number` });
+      return null;
+    }
+    if (integer && !Number.isInteger(value)) {
+      errors.push({ field, message: `must be a whole number, got ${text}` });
+      return null;
+    }
+    return value;
+  }
+
+  function readBuoyancies(errors) {
+    const input = $("#buoyancies");
+    const parts = input.value.split(/[,;\s]+/).filter((s) => s !== "");
+    if (parts.length === 0) {
+      errors.push({ field: "net_buoyancies_n", message: "list at least one net buoyancy (N)" });
+      return null;
+    }
+    const values = [];
+    for (const [i, p] of parts.entries()) {
+      const v = Number(p);
+      if (!Number.isFinite(v)) {
+        errors.push({ field: `net_buoyancies_n[${i}]`, message: `“${p}” is not a number` });
+        return null;
+      }
+      values.push(v);
+    }
+    return values;
+  }
+
+  // The system part common to every request (SystemInput in the API).
+  function readSystem(errors) {
+    const cable = {};
+    if ($("#cable-mode").value === "density") {
+      cable.density_kg_m3 = readNumber("cable.density_kg_m3", errors);
+      cable.area_m2 = readNumber("cable.area_m2", errors);
+    } else {
+      cable.mass_per_length_kg_m = readNumber("cable.mass_per_length_kg_m", errors);
+    }
+    return {
+      cable,
+      aerostat: {
+        net_buoyancy_n: readNumber("aerostat.net_buoyancy_n", errors),
+        mass_kg: readNumber("aerostat.mass_kg", errors),
+      },
+      initial_length_m: readNumber("initial_length_m", errors),
+      gravity_m_s2: readNumber("gravity_m_s2", errors),
+      model: { kind: "linear_string", elements: readNumber("model.elements", errors, { integer: true }) },
+    };
+  }
+
+  function readChartRequest(errors) {
+    const req = readSystem(errors);
+    req.rates_m_s = {
+      min: readNumber("rates_m_s.min", errors),
+      max: readNumber("rates_m_s.max", errors),
+      count: readNumber("rates_m_s.count", errors, { integer: true }),
+    };
+    req.net_buoyancies_n = readBuoyancies(errors);
+    return req;
+  }
+
+  function chartPoints(req) {
+    return (req.rates_m_s.count || 0) * Math.max(1, (req.net_buoyancies_n || []).length);
+  }
+
+  function wantsJob(req) {
+    return chartPoints(req) > SYNC_POINT_LIMIT || chartPoints(req) * (req.model.elements || 0) > JOB_WORK_THRESHOLD;
+  }
+
+  // ---------- errors next to fields ----------
+
+  // The input an API field path names: exact match, else without a list index
+  // (`net_buoyancies_n[1]`), else the nearest named parent.
+  function inputFor(field) {
+    if (!field) return null;
+    let path = field.replace(/^\./, "");
+    while (path) {
+      const exact = document.querySelector(`[data-field="${CSS.escape(path)}"]`);
+      if (exact && !exact.closest("[hidden]")) return exact;
+      const unindexed = path.replace(/\[\d+\]$/, "");
+      if (unindexed !== path) {
+        path = unindexed;
+        continue;
+      }
+      const dot = path.lastIndexOf(".");
+      if (dot < 0) break;
+      path = path.slice(0, dot);
+      // A parent such as `cable` or `rates_m_s`: its first visible input.
+      const child = [...document.querySelectorAll(`[data-field^="${CSS.escape(path)}."]`)].find((el) => !el.closest("[hidden]"));
+      if (child) return child;
+    }
+    return null;
+  }
+
+  function clearErrors(form) {
+    for (const el of form.querySelectorAll(".field-error")) el.remove();
+    for (const el of form.querySelectorAll("[aria-invalid]")) {
+      el.removeAttribute("aria-invalid");
+      el.removeAttribute("aria-describedby");
+    }
+  }
+
+  function clearFieldError(input) {
+    const box = input.closest(".field");
+    box?.querySelector(".field-error")?.remove();
+    input.removeAttribute("aria-invalid");
+    input.removeAttribute("aria-describedby");
+  }
+
+  // The API's message starts with the field path, which the label already says:
+  // keep the reason, and say which entry of a list is meant.
+  function fieldMessage(field, message) {
+    let text = message.startsWith(`${field}: `) ? message.slice(field.length + 2) : message;
+    const index = /\[(\d+)\]$/.exec(field);
+    if (index) text = `entry ${Number(index[1]) + 1}: ${text}`;
+    return text;
+  }
+
+  // Shows `message` under the input that `field` names; returns false when no input matches.
+  function showFieldError(field, message) {
+    const input = inputFor(field);
+    if (!input) return false;
+    clearFieldError(input);
+    const p = document.createElement("p");
+    p.className = "field-error";
+    p.id = `${input.id}-error`;
+    p.dataset.errorFor = field;
+    p.textContent = fieldMessage(field, message);
+    input.closest(".field").append(p);
+    input.setAttribute("aria-invalid", "true");
+    input.setAttribute("aria-describedby", p.id);
+    return true;
+  }
+
+  function showFormError(el, message) {
+    el.textContent = message;
+    el.hidden = !message;
+  }
+
+  // Renders an API error body ({error: {code, field, message}}): next to its field
+  // when one is named and shown, else in `fallback`. Returns a one-line summary.
+  function renderApiError(status, body, fallback) {
+    const err = body && body.error ? body.error : { code: "http_" + status, field: null, message: `HTTP ${status}` };
+    const placed = showFieldError(err.field, err.message);
+    if (placed) {
+      showFormError(fallback, "");
+      inputFor(err.field).focus({ preventScroll: false });
+      return `Fix the highlighted field: ${err.message}`;
+    }
+    showFormError(fallback, err.message);
+    return err.message;
+  }
+
+  // ---------- HTTP ----------
+
+  async function api(method, path, body) {
+    let res;
+    try {
+      res = await fetch(path, {
+        method,
+        headers: body === undefined ? {} : { "content-type": "application/json" },
+        body: body === undefined ? undefined : JSON.stringify(body),
+      });
+    } catch (e) {
+      return { ok: false, status: 0, body: { error: { code: "network", field: null, message: `cannot reach the server (${e.message})` } } };
+    }
+    let data = null;
+    const text = await res.text();
+    try {
+      data = text ? JSON.parse(text) : null;
+    } catch {
+      data = { error: { code: "bad_response", field: null, message: `HTTP ${res.status}: ${text.slice(0, 200)}` } };
+    }
+    return { ok: res.ok, status: res.status, body: data, headers: res.headers };
+  }
+
+  function setStatus(kind, text) {
+    // Plots of an earlier request are dimmed until a new answer replaces them.
+    if (kind === "ready") delete $("#results").dataset.stale;
+    else $("#results").dataset.stale = "";
+    statusEl.dataset.state = kind;
+    statusEl.textContent = text;
+  }
+
+  // ---------- jobs ----------
+
+  const jobBox = $("#job");
+  const jobProgress = $("#job-progress");
+  const jobText = $("#job-text");
+  const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+  // A submission names fields inside its `request` (`request.rates_m_s.count`):
+  // drop that prefix so the error lands on the form's input.
+  function unwrapJobError(body) {
+    const err = body?.error;
+    if (!err || typeof err.field !== "string" || !err.field.startsWith("request.")) return body;
+    const field = err.field.slice("request.".length);
+    const message = err.message.startsWith(`${err.field}: `) ? `${field}: ${err.message.slice(err.field.length + 2)}` : err.message;
+    return { error: { ...err, field, message } };
+  }
+
+  // Runs a chart as a background job, showing its progress; resolves to the chart
+  // answer, or to {error} when the job fails, is cancelled, or cannot be submitted.
+  async function runChartJob(req) {
+    const submitted = await api("POST", "/api/v1/jobs", { kind: "chart", request: req });
+    if (!submitted.ok) return { status: submitted.status, error: unwrapJobError(submitted.body) };
+    const id = submitted.body.id;
+    state.job = id;
+    state.jobProgress = [];
+    jobBox.hidden = false;
+    jobProgress.value = 0;
+    jobText.textContent = "queued";
+    try {
+      for (;;) {
+        const r = await api("GET", `/api/v1/jobs/${encodeURIComponent(id)}`);
+        if (!r.ok) return { status: r.status, error: r.body };
+        const job = r.body;
+        const progress = Number(job.progress) || 0;
+        jobProgress.value = progress;
+        state.jobProgress.push([job.status, progress]);
+        jobText.textContent = `${job.status} · ${(progress * 100).toFixed(0)} %`;
+        setStatus("busy", `Job ${id}: ${job.status}, ${(progress * 100).toFixed(0)} % of ${chartPoints(req)} points`);
+        if (job.status === "done") return { chart: job.result, via: `job ${id}` };
+        if (job.status === "failed" || job.status === "cancelled") {
+          const body = job.error?.error ? job.error : { error: { code: job.status, field: null, message: `the job was ${job.status}` } };
+          return { status: 200, error: unwrapJobError(body) };
+        }
+        await sleep(POLL_MS);
+      }
+    } finally {
+      state.job = null;
+      jobBox.hidden = true;
+    }
+  }
+
+  $("#job-cancel").addEventListener("click", async () => {
+    if (state.job) await api("DELETE", `/api/v1/jobs/${encodeURIComponent(state.job)}`);
+  });
+
+  // ---------- plotting ----------
+
+  function closedFormTime(p, initialLength) {
+    const t = (p.closed_form_elevation_m - initialLength) / p.rate_m_s;
+    return t > 0 ? t : 0;
+  }
+
+  function fmt(v, digits) {
+    if (v == null || !Number.isFinite(v)) return "–";
+    return Math.abs(v) >= 1e5 ? v.toExponential(3) : v.toFixed(digits);
+  }
+
+  // uPlot data and series for one quantity: x = rates, then per buoyancy the model
+  // curve (solid) and the closed-form estimate (dashed).
+  function plotSpec(chart, quantity, initialLength, log = false) {
+    const x = chart.series[0].points.map((p) => p.rate_m_s);
+    const data = [x];
+    const series = [{ label: "v (m/s)", value: (u, v) => fmt(v, 2) }];
+    const unit = quantity === "time" ? "s" : "m";
+    const sym = quantity === "time" ? "t*" : "h*";
+    chart.series.forEach((s, i) => {
+      const color = COLORS[i % COLORS.length];
+      // On a log axis, t* = 0 (unstable at once) has no place: leave a gap.
+      const shown = (v) => (log && !(v > 0) ? null : v);
+      const model = s.points.map((p) => shown(quantity === "time" ? p.critical_time_s : p.max_elevation_m));
+      const closed = s.points.map((p) => shown(quantity === "time" ? closedFormTime(p, initialLength) : p.closed_form_elevation_m));
+      data.push(model, closed);
+      series.push(
+        { label: `${sym}, ${s.net_buoyancy_n} N (${unit})`, color, stroke: color, width: 2, value: (u, v) => fmt(v, 1) },
+        { label: `closed form, ${s.net_buoyancy_n} N (${unit})`, color, stroke: color, width: 1.5, dash: [6, 4], value: (u, v) => fmt(v, 1) },
+      );
+    });
+    return { data, series, unit, sym, log };
+  }
+
+  function plotSize(el) {
+    const width = Math.max(260, Math.floor(el.clientWidth));
+    return { width, height: Math.round(Math.min(380, Math.max(240, width * 0.6))) };
+  }
+
+  // On a log axis, grid lines and ticks at the decades only (uPlot draws 1..9 × 10^k).
+  const decadesOnly = (u, splits) =>
+    splits.map((v) => (v != null && Math.abs(Math.log10(v) - Math.round(Math.log10(v))) < 1e-9 ? v : null));
+
+  function makePlot(el, spec, yLabel) {
+    el.textContent = "";
+    const axis = { stroke: "#333", grid: { stroke: "#e5e5e5" }, ticks: { stroke: "#ccc" } };
+    const yAxis = spec.log
+      ? { ...axis, grid: { ...axis.grid, filter: decadesOnly }, ticks: { ...axis.ticks, filter: decadesOnly }, filter: decadesOnly }
+      : axis;
+    return new uPlot(
+      {
+        ...plotSize(el),
+        series: spec.series,
+        scales: { x: { time: false }, y: spec.log ? { distr: 3 } : {} },
+        axes: [
+          { ...axis, label: "Deployment rate v (m/s)" },
+          { ...yAxis, label: yLabel, size: 60 },
+        ],
+        legend: { live: true, markers: { dash: (u, i) => (u.series[i].dash ? "dashed" : "solid"), fill: () => "transparent" } },
+        cursor: { drag: { x: true, y: false } },
+      },
+      spec.data,
+      el,
+    );
+  }
+
+  function render(chart, req, via = state.via) {
+    state.chart = chart;
+    state.request = req;
+    state.via = via;
+    const L0 = req.initial_length_m;
+    const timeSpec = plotSpec(chart, "time", L0, $("#log-time").checked);
+    const elevSpec = plotSpec(chart, "elevation", L0);
+    state.plots.time?.destroy();
+    state.plots.elevation?.destroy();
+    state.plots.time = makePlot($("#plot-time"), timeSpec, "t* (s)");
+    state.plots.elevation = makePlot($("#plot-elevation"), elevSpec, "h* (m)");
+    $("#download-csv").disabled = false;
+    $("#download-png").disabled = false;
+    const pts = chart.series.reduce((n, s) => n + s.points.length, 0);
+    statusEl.dataset.series = String(chart.series.length);
+    setStatus("ready", `${chart.series.length} curves, ${pts} points, ${chart.elements} elements${via && via !== "direct" ? ` (${via})` : ""}.`);
+  }
+
+  $("#log-time").addEventListener("change", () => {
+    if (state.chart) render(state.chart, state.request);
+  });
+
+  let resizeTimer = null;
+  window.addEventListener("resize", () => {
+    clearTimeout(resizeTimer);
+    resizeTimer = setTimeout(() => {
+      for (const [key, el] of [["time", "#plot-time"], ["elevation", "#plot-elevation"]]) {
+        state.plots[key]?.setSize(plotSize($(el)));
+      }
+    }, 100);
+  });
+
+  // ---------- chart form ----------
+
+  function updateHint() {
+    const errors = [];
+    const req = readChartRequest(errors);
+    const hint = $("#points-hint");
+    if (errors.length || !req.net_buoyancies_n) {
+      hint.textContent = "";
+      return;
+    }
+    const n = chartPoints(req);
+    hint.textContent = `${n} points${wantsJob(req) ? " · runs as a background job" : ""}`;
+  }
+
+  let busy = false;
+  chartForm.addEventListener("submit", async (ev) => {
+    ev.preventDefault();
+    if (busy) return;
+    clearErrors(chartForm);
+    showFormError($("#form-error"), "");
+    const errors = [];
+    const req = readChartRequest(errors);
+    if (errors.length) {
+      for (const e of errors) showFieldError(e.field, e.message);
+      inputFor(errors[0].field)?.focus();
+      setStatus("error", "Fix the highlighted fields.");
+      return;
+    }
+    busy = true;
+    $("#plot-button").disabled = true;
+    try {
+      const n = chartPoints(req);
+      let outcome;
+      if (wantsJob(req)) {
+        setStatus("busy", `Submitting a job for ${n} points…`);
+        outcome = await runChartJob(req);
+      } else {
+        setStatus("busy", `Computing ${n} points…`);
+        const r = await api("POST", "/api/v1/charts", req);
+        // The direct route may refuse a chart as too large or the server as busy: use a job.
+        if (!r.ok && (r.body?.error?.code === "too_large" || r.status === 503)) {
+          setStatus("busy", "The server asked for a background job…");
+          outcome = await runChartJob(req);
+        } else {
+          outcome = r.ok ? { chart: r.body, via: "direct" } : { status: r.status, error: r.body };
+        }
+      }
+      if (outcome.chart) render(outcome.chart, req, outcome.via);
+      else if (outcome.error?.error?.code === "cancelled") setStatus("idle", "Job cancelled.");
+      else setStatus("error", renderApiError(outcome.status, outcome.error, $("#form-error")));
+    } finally {
+      busy = false;
+      $("#plot-button").disabled = false;
+    }
+  });
+
+  chartForm.addEventListener("input", (ev) => {
+    if (ev.target.matches("input")) clearFieldError(ev.target);
+    updateHint();
+  });
+
+  $("#cable-mode").addEventListener("change", (ev) => {
+    for (const el of document.querySelectorAll("[data-cable]")) el.hidden = el.dataset.cable !== ev.target.value;
+    clearErrors(chartForm);
+  });
+
+  // ---------- safe rate ----------
+
+  safeForm.addEventListener("submit", async (ev) => {
+    ev.preventDefault();
+    clearErrors(safeForm);
+    clearErrors(chartForm);
+    showFormError($("#safe-error"), "");
+    const out = $("#safe-result");
+    out.hidden = true;
+    const errors = [];
+    const req = readSystem(errors);
+    req.target_elevation_m = readNumber("target_elevation_m", errors);
+    if (errors.length) {
+      for (const e of errors) showFieldError(e.field, e.message);
+      showFormError($("#safe-error"), "Fix the highlighted fields.");
+      return;
+    }
+    $("#safe-button").disabled = true;
+    try {
+      const r = await api("POST", "/api/v1/safe-rate", req);
+      if (!r.ok) {
+        const msg = renderApiError(r.status, r.body, $("#safe-error"));
+        if (!$("#safe-error").textContent) showFormError($("#safe-error"), msg);
+        return;
+      }
+      const a = r.body;
+      const rows = [];
+      if (a.max_rate_m_s != null) {
+        rows.push(["Largest safe rate", `${fmt(a.max_rate_m_s, 2)} m/s`]);
+        rows.push(["Time to reach H", `${fmt(a.time_to_target_s, 1)} s`]);
+      } else {
+        rows.push(["Largest safe rate", "none"]);
+        rows.push(["Why", a.reason || "no constant rate reaches the target safely"]);
+      }
+      rows.push(["Closed-form estimate √(F/ρA − gH)", a.closed_form_rate_m_s != null ? `${fmt(a.closed_form_rate_m_s, 2)} m/s` : "none (above the static limit)"]);
+      if (a.groups) rows.push(["Static lift limit F/(ρA g)", `${fmt(a.groups.static_lift_limit_m, 1)} m`]);
+      out.replaceChildren(
+        ...rows.flatMap(([k, v]) => {
+          const dt = document.createElement("dt");
+          dt.textContent = k;
+          const dd = document.createElement("dd");
+          dd.textContent = v;
+          return [dt, dd];
+        }),
+      );
+      out.dataset.maxRate = a.max_rate_m_s ?? "";
+      out.hidden = false;
+    } finally {
+      $("#safe-button").disabled = false;
+    }
+  });
+
+  safeForm.addEventListener("input", (ev) => {
+    if (ev.target.matches("input")) clearFieldError(ev.target);
+  });
+
+  // ---------- downloads ----------
+
+  function download(blob, name) {
+    const url = URL.createObjectURL(blob);
+    const a = document.createElement("a");
+    a.href = url;
+    a.download = name;
+    document.body.append(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(url), 1000);
+  }
+
+  function chartCsv(chart) {
+    const lines = ["net_buoyancy_n,rate_m_s,critical_time_s,max_elevation_m,closed_form_elevation_m"];
+    for (const s of chart.series) {
+      for (const p of s.points) {
+        lines.push([s.net_buoyancy_n, p.rate_m_s, p.critical_time_s, p.max_elevation_m, p.closed_form_elevation_m].join(","));
+      }
+    }
+    return lines.join("\n") + "\n";
+  }
+
+  $("#download-csv").addEventListener("click", () => {
+    if (state.chart) download(new Blob([chartCsv(state.chart)], { type: "text/csv" }), "deployment-chart.csv");
+  });
+
+  // Splits `text` into lines no wider than `max` pixels in the context's font.
+  function wrap(ctx, text, max) {
+    const rows = [];
+    let row = "";
+    for (const word of text.split(" ")) {
+      const next = row ? `${row} ${word}` : word;
+      if (row && ctx.measureText(next).width > max) {
+        rows.push(row);
+        row = word;
+      } else {
+        row = next;
+      }
+    }
+    if (row) rows.push(row);
+    return rows;
+  }
+
+  // Both plots on one white canvas, each with its caption and a drawn legend.
+  function chartPng() {
+    const ratio = window.devicePixelRatio || 1;
+    const pad = 12 * ratio;
+    const line = 18 * ratio;
+    const blocks = [
+      [state.plots.time, `Critical time t* (s) against deployment rate v (m/s)${$("#log-time").checked ? ", log scale" : ""}`],
+      [state.plots.elevation, "Highest safe elevation h* (m) against deployment rate v (m/s)"],
+    ];
+    const width = Math.max(...blocks.map(([u]) => u.ctx.canvas.width)) + 2 * pad;
+    const legendRows = (u) => u.series.length - 1;
+    const canvas = document.createElement("canvas");
+    const ctx = canvas.getContext("2d");
+    ctx.font = `bold ${13 * ratio}px sans-serif`;
+    const captionRows = (c) => wrap(ctx, c, width - 2 * pad).length;
+    const height = blocks.reduce((h, [u, c]) => h + line * (captionRows(c) + 0.5) + u.ctx.canvas.height + legendRows(u) * line + pad, pad);
+    canvas.width = width;
+    canvas.height = height;
+    ctx.fillStyle = "#fff";
+    ctx.fillRect(0, 0, width, height);
+    let y = pad;
+    for (const [u, caption] of blocks) {
+      ctx.fillStyle = "#111";
+      ctx.font = `bold ${13 * ratio}px sans-serif`;
+      ctx.textBaseline = "top";
+      for (const row of wrap(ctx, caption, width - 2 * pad)) {
+        ctx.fillText(row, pad, y);
+        y += line;
+      }
+      y += line * 0.5;
+      ctx.drawImage(u.ctx.canvas, pad, y);
+      y += u.ctx.canvas.height;
+      ctx.font = `${12 * ratio}px sans-serif`;
+      ctx.textBaseline = "middle";
+      for (const s of u.series.slice(1)) {
+        ctx.strokeStyle = s.color || "#000";
+        ctx.lineWidth = 2 * ratio;
+        ctx.setLineDash(s.dash ? s.dash.map((d) => d * ratio) : []);
+        ctx.beginPath();
+        ctx.moveTo(pad, y + line / 2);
+        ctx.lineTo(pad + 28 * ratio, y + line / 2);
+        ctx.stroke();
+        ctx.setLineDash([]);
+        ctx.fillStyle = "#111";
+        ctx.fillText(s.label, pad + 36 * ratio, y + line / 2);
+        y += line;
+      }
+      y += pad;
+    }
+    return canvas;
+  }
+
+  $("#download-png").addEventListener("click", () => {
+    if (!state.chart) return;
+    chartPng().toBlob((blob) => download(blob, "deployment-chart.png"), "image/png");
+  });
+
+  updateHint();
+})();

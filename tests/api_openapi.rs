@@ -1,0 +1,174 @@
+//! The committed OpenAPI document is the one the code generates, and it
+//! documents every route with its error statuses and unit-named fields.
+
+use serde_json::Value;
+use tetherplan::api::openapi::openapi_json;
+
+const COMMITTED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/openapi/openapi.json");
+
+#[test]
+fn committed_openapi_is_up_to_date() {
+    let committed = std::fs::read_to_string(COMMITTED).unwrap_or_default();
+    assert!(
+        committed == openapi_json(),
+        "openapi/openapi.json is stale: run `cargo run --release --bin gen_openapi` and commit it"
+    );
+}
+
+fn doc() -> Value {
+    serde_json::from_str(&openapi_json()).unwrap()
+}
+
+#[test]
+fn every_route_is_documented_with_its_statuses() {
+    let doc = doc();
+    let expected: &[(&str, &str, &str, &[&str])] = &[
+        (
+            "post",
+            "/api/v1/stability",
+            "compute_stability",
+            &["200", "400", "413", "415", "422", "500", "503", "504"],
+        ),
+        (
+            "post",
+            "/api/v1/critical",
+            "compute_critical",
+            &["200", "400", "413", "415", "422", "500", "503", "504"],
+        ),
+        (
+            "post",
+            "/api/v1/safe-rate",
+            "compute_safe_rate",
+            &["200", "400", "413", "415", "422", "500", "503", "504"],
+        ),
+        (
+            "post",
+            "/api/v1/charts",
+            "create_chart",
+            &["200", "400", "413", "415", "422", "500", "503", "504"],
+        ),
+        (
+            "post",
+            "/api/v1/simulate",
+            "run_simulation",
+            &["200", "400", "413", "415", "422", "500", "503", "504"],
+        ),
+        (
+            "post",
+            "/api/v1/frequency-response",
+            "compute_frequency_response",
+            &["200", "400", "413", "415", "422", "500", "503", "504"],
+        ),
+        (
+            "post",
+            "/api/v1/jobs",
+            "create_job",
+            &["202", "400", "413", "415", "422", "429", "500"],
+        ),
+        ("get", "/api/v1/jobs", "list_jobs", &["200", "400", "500"]),
+        (
+            "get",
+            "/api/v1/jobs/{id}",
+            "get_job",
+            &["200", "404", "500"],
+        ),
+        (
+            "delete",
+            "/api/v1/jobs/{id}",
+            "delete_job",
+            &["200", "404", "409", "500"],
+        ),
+        ("get", "/healthz", "get_health", &["200"]),
+        ("get", "/openapi.json", "get_openapi", &["200"]),
+    ];
+    let paths = doc["paths"].as_object().unwrap();
+    let operations: usize = paths.values().map(|p| p.as_object().unwrap().len()).sum();
+    assert_eq!(
+        operations,
+        expected.len(),
+        "undocumented or unexpected operations"
+    );
+    for (method, path, id, statuses) in expected {
+        let op = &doc["paths"][path][method];
+        assert_eq!(op["operationId"], *id, "{method} {path}");
+        let mut got: Vec<&str> = op["responses"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(String::as_str)
+            .collect();
+        got.sort();
+        assert_eq!(&got, statuses, "{method} {path}");
+        for status in statuses
+            .iter()
+            .filter(|s| s.starts_with('4') || s.starts_with('5'))
+        {
+            let schema = &op["responses"][status]["content"]["application/json"]["schema"]["$ref"];
+            assert_eq!(
+                schema, "#/components/schemas/ErrorBody",
+                "{method} {path} {status}"
+            );
+        }
+        for retry in ["429", "503"] {
+            if statuses.contains(&retry) {
+                assert!(
+                    op["responses"][retry]["headers"]["Retry-After"].is_object(),
+                    "{method} {path} {retry}"
+                );
+            }
+        }
+    }
+}
+
+/// Numeric fields of the contract end in their unit (SPEC §4).
+#[test]
+fn numeric_fields_name_their_unit() {
+    const UNITS: &[&str] = &[
+        "_m", "_s", "_m_s", "_m_s2", "_n", "_kg", "_kg_m", "_kg_m3", "_m2", "_1_s", "_hz",
+        "_nondim",
+    ];
+    // Counts, ids and fractions; RateGrid's bounds are described in m/s by its parent `rates_m_s`.
+    const UNITLESS: &[&str] = &[
+        "elements", "modes", "count", "id", "attempts", "progress", "min", "max",
+    ];
+    // Dimensionless by name: ratios (E*, γ̃ as the issues name them), step
+    // and sample counts, Newton iteration counts, relative tolerances.
+    const DIMENSIONLESS_SUFFIXES: &[&str] = &[
+        "_ratio",
+        "steps",
+        "samples",
+        "steps_per_run",
+        "_failures",
+        "_tolerance",
+        "iterations",
+        "iterations_mean",
+        "iterations_max",
+        "iterations_total",
+    ];
+    let doc = doc();
+    let mut offenders = vec![];
+    for (name, schema) in doc["components"]["schemas"].as_object().unwrap() {
+        let Some(props) = schema["properties"].as_object() else {
+            continue;
+        };
+        for (field, p) in props {
+            let ty = p["type"].clone();
+            let numeric = ty == "number"
+                || ty == "integer"
+                || ty
+                    .as_array()
+                    .is_some_and(|a| a.iter().any(|t| t == "number" || t == "integer"));
+            if numeric
+                && !UNITS.iter().any(|u| field.ends_with(u))
+                && !UNITLESS.contains(&field.as_str())
+                && !DIMENSIONLESS_SUFFIXES.iter().any(|u| field.ends_with(u))
+            {
+                offenders.push(format!("{name}.{field}"));
+            }
+        }
+    }
+    assert!(
+        offenders.is_empty(),
+        "numeric fields without a unit suffix: {offenders:?}"
+    );
+}
