@@ -11,7 +11,9 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use tetherplan::config::ServeArgs;
-use tetherplan::contract::{self, Progress, RequestError, dto, run, simulate, transient};
+use tetherplan::contract::{
+    self, Progress, RequestError, dto, ge_charts, run, simulate, transient,
+};
 use tetherplan::numerics::chart::Parallelism;
 
 #[derive(Parser)]
@@ -46,11 +48,13 @@ enum Command {
     Critical(InputArg),
     /// Largest safe constant rate for a target elevation.
     SafeRate(InputArg),
-    /// Deployment chart: t* and h* against rate, one series per buoyancy.
+    /// Deployment chart: t* and h* against rate, one series per buoyancy
+    /// (`model.kind = "geometrically_exact"`: and per stiffness ratio).
     Chart(InputArg),
     /// Transient run (linear string, or `"model": {"kind": "geometrically_exact"}`).
     Simulate(InputArg),
-    /// Tip-amplitude envelope against wind forcing frequency (linear string).
+    /// Response against forcing frequency: wind on the linear string, or
+    /// `"excitation": "base"` (shaken platform, GE cable).
     FrequencyResponse(InputArg),
 }
 
@@ -175,11 +179,19 @@ fn main() -> ExitCode {
         Command::Stability(arg) => answer(arg, run::stability),
         Command::Critical(arg) => answer(arg, run::critical),
         Command::SafeRate(arg) => answer(arg, run::safe_rate),
-        Command::Chart(arg) => answer(arg, |req: &dto::ChartRequest| {
-            let bar = progress_bar(run::chart_points(req) as u64, "chart points");
-            let out = run::chart(req, Parallelism::Rayon, &bar);
-            bar.0.finish_and_clear();
-            out
+        Command::Chart(arg) => answer_with(arg, ge_charts::parse_chart, |req| match req {
+            ge_charts::AnyChartRequest::LinearString(req) => {
+                let bar = progress_bar(run::chart_points(req) as u64, "chart points");
+                let out = run::chart(req, Parallelism::Rayon, &bar);
+                bar.0.finish_and_clear();
+                out.map(ge_charts::AnyChartResponse::LinearString)
+            }
+            ge_charts::AnyChartRequest::GeometricallyExact(req) => {
+                let bar = progress_bar(ge_charts::chart_points(req) as u64, "chart points");
+                let out = ge_charts::ge_chart(req, Parallelism::Rayon, &bar);
+                bar.0.finish_and_clear();
+                out.map(ge_charts::AnyChartResponse::GeometricallyExact)
+            }
         }),
         Command::Simulate(arg) => answer_with(arg, simulate::parse_simulate, |req| {
             let bar = progress_bar(0, "steps");
@@ -188,12 +200,17 @@ fn main() -> ExitCode {
             out
         }),
         Command::FrequencyResponse(arg) => {
-            answer(arg, |req: &transient::FrequencyResponseRequest| {
-                let bar = progress_bar(
-                    transient::frequency_response_runs(req) as u64,
-                    "frequencies",
-                );
-                let out = transient::frequency_response(req, Parallelism::Rayon, &bar);
+            answer_with(arg, ge_charts::parse_frequency_response, |req| {
+                let runs = match req {
+                    ge_charts::AnyFrequencyResponseRequest::Wind(r) => {
+                        transient::frequency_response_runs(r)
+                    }
+                    ge_charts::AnyFrequencyResponseRequest::Base(r) => {
+                        r.frequencies_rad_s.count + 1
+                    }
+                };
+                let bar = progress_bar(runs as u64, "frequencies");
+                let out = ge_charts::frequency_response_any(req, Parallelism::Rayon, &bar);
                 bar.0.finish_and_clear();
                 out
             })

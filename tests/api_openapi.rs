@@ -125,7 +125,7 @@ fn every_route_is_documented_with_its_statuses() {
 fn numeric_fields_name_their_unit() {
     const UNITS: &[&str] = &[
         "_m", "_s", "_m_s", "_m_s2", "_n", "_kg", "_kg_m", "_kg_m3", "_m2", "_1_s", "_hz",
-        "_nondim",
+        "_nondim", "_db",
     ];
     // Counts, ids and fractions; RateGrid's bounds are described in m/s by its parent `rates_m_s`.
     const UNITLESS: &[&str] = &[
@@ -144,6 +144,7 @@ fn numeric_fields_name_their_unit() {
         "iterations_mean",
         "iterations_max",
         "iterations_total",
+        "_solves",
     ];
     let doc = doc();
     let mut offenders = vec![];

@@ -16,9 +16,12 @@ use crate::api::error::{ApiError, JsonBody};
 use crate::config::Limits;
 use crate::contract;
 use crate::contract::dto::*;
+use crate::contract::ge_charts::{
+    self, AnyChartRequest, AnyChartResponse, AnyFrequencyResponseRequest,
+    AnyFrequencyResponseResponse,
+};
 use crate::contract::run::{self, NoProgress};
 use crate::contract::simulate::{self, AnySimulateRequest, AnySimulateResponse};
-use crate::contract::transient::{self, FrequencyResponseRequest, FrequencyResponseResponse};
 use crate::numerics::chart::Parallelism;
 
 impl AppState {
@@ -213,17 +216,42 @@ solve_path!(
 );
 
 solve_path!(
-    /// Deployment chart: t* and h* against rate, one series per buoyancy.
+    /// Deployment chart: t* and h* against rate, one series per buoyancy
+    /// (and, for the GE cable, per stiffness ratio, perturbation and wind
+    /// amplitude).
     ///
-    /// Synchronously at most 20 000 points and 2 000 000 points × elements;
+    /// `model.kind` picks the model: `linear_string` (default) or
+    /// `geometrically_exact` (with `stiffness_ratios`). Linear string:
+    /// synchronously at most 20 000 points and 2 000 000 points × elements;
     /// larger charts (up to 1 000 000 points) go to `POST /api/v1/jobs`
-    /// with `"kind": "chart"`.
-    create_chart, "/api/v1/charts", ChartRequest, ChartResponse,
-    |req, limits| {
-        check_sync_chart(&req, limits)?;
-        to_json(&run::chart(&req, Parallelism::Rayon, &NoProgress)?)
+    /// with `"kind": "chart"`. GE: each point is a Newmark march with
+    /// local-stability checks (about a second at 20 elements), so at most
+    /// 8 points synchronously; up to 2 000 as a job.
+    create_chart, "/api/v1/charts", AnyChartRequest, AnyChartResponse,
+    parse = |body| ge_charts::parse_chart(body),
+    |req, limits| match &req {
+        AnyChartRequest::LinearString(r) => {
+            r.system.model().map_err(contract::RequestError::from)?;
+            check_sync_chart(r, limits)?;
+            to_json(&run::chart(r, Parallelism::Rayon, &NoProgress)?)
+        }
+        AnyChartRequest::GeometricallyExact(r) => {
+            let points = ge_charts::chart_points(r);
+            if points > MAX_SYNC_GE_CHART_POINTS {
+                return Err(ApiError::too_large(
+                    "rates_m_s.count",
+                    format!(
+                        "the GE chart has {points} points; synchronous GE charts have at most {MAX_SYNC_GE_CHART_POINTS} (submit a job with \"kind\": \"chart\")"
+                    ),
+                ));
+            }
+            to_json(&ge_charts::ge_chart(r, Parallelism::Rayon, &Deadline::after(limits))?)
+        }
     }
 );
+
+/// Points a synchronous GE chart may have.
+pub const MAX_SYNC_GE_CHART_POINTS: usize = 8;
 
 solve_path!(
     /// Transient run of either cable model: tip deflection, energy and
@@ -238,24 +266,31 @@ solve_path!(
 );
 
 solve_path!(
-    /// Envelope of the tip amplitude against wind forcing frequency and time.
+    /// Response against forcing frequency: wind on the linear string, or
+    /// (`"excitation": "base"`) a shaken platform under the GE cable.
     ///
-    /// One transient run per frequency of u = U0 sin(ω t), in parallel.
-    /// Synchronously at most 16 frequencies; more go to `POST /api/v1/jobs`
-    /// with `"kind": "frequency_response"`.
-    compute_frequency_response, "/api/v1/frequency-response", FrequencyResponseRequest, FrequencyResponseResponse,
-    parse = |body| contract::parse::<FrequencyResponseRequest>(body),
+    /// Wind: one transient run per frequency of u = U0 sin(ω t), envelope
+    /// of the tip amplitude against ω and time. Base: one run per ω0 of
+    /// r = R0 sin(ω0 t), amplitude gain (thesis (8.3)) with the two-DOF
+    /// model's resonance bands (8.9). Synchronously at most 16
+    /// frequencies; more go to `POST /api/v1/jobs` with
+    /// `"kind": "frequency_response"`.
+    compute_frequency_response, "/api/v1/frequency-response", AnyFrequencyResponseRequest, AnyFrequencyResponseResponse,
+    parse = |body| ge_charts::parse_frequency_response(body),
     |req, limits| {
-        if req.frequencies_rad_s.count > MAX_SYNC_FREQUENCIES {
+        let count = match &req {
+            AnyFrequencyResponseRequest::Wind(r) => r.frequencies_rad_s.count,
+            AnyFrequencyResponseRequest::Base(r) => r.frequencies_rad_s.count,
+        };
+        if count > MAX_SYNC_FREQUENCIES {
             return Err(ApiError::too_large(
                 "frequencies_rad_s.count",
                 format!(
-                    "{} frequencies take too long to answer synchronously (at most {MAX_SYNC_FREQUENCIES})",
-                    req.frequencies_rad_s.count
+                    "{count} frequencies take too long to answer synchronously (at most {MAX_SYNC_FREQUENCIES})"
                 ),
             ));
         }
-        to_json(&transient::frequency_response(&req, Parallelism::Rayon, &Deadline::after(limits))?)
+        to_json(&ge_charts::frequency_response_any(&req, Parallelism::Rayon, &Deadline::after(limits))?)
     }
 );
 

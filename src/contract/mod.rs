@@ -5,6 +5,7 @@
 
 pub mod dto;
 pub mod ge;
+pub mod ge_charts;
 pub mod run;
 pub mod simulate;
 pub mod transient;

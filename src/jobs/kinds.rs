@@ -17,6 +17,7 @@ use utoipa::ToSchema;
 
 use crate::config::Limits;
 use crate::contract::dto::*;
+use crate::contract::ge_charts::{self, AnyChartRequest, AnyFrequencyResponseRequest};
 use crate::contract::run::{self, MAX_MODES};
 use crate::contract::simulate::{self, AnySimulateRequest};
 use crate::contract::transient::{self, FrequencyResponseRequest};
@@ -273,6 +274,48 @@ impl JobKind for FrequencyResponseRequest {
     }
 }
 
+impl JobKind for AnyChartRequest {
+    const NAME: &'static str = "chart";
+    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
+        ge_charts::parse_chart(body)
+    }
+    fn validate(&self) -> Result<(), RequestError> {
+        match self {
+            Self::LinearString(r) => r.validate(),
+            Self::GeometricallyExact(r) => {
+                ge_charts::prepare_chart(r).map(drop).map_err(Into::into)
+            }
+        }
+    }
+    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
+        match self {
+            Self::LinearString(r) => r.run(progress),
+            Self::GeometricallyExact(r) => {
+                to_json(&ge_charts::ge_chart(r, Parallelism::Rayon, progress)?)
+            }
+        }
+    }
+}
+
+impl JobKind for AnyFrequencyResponseRequest {
+    const NAME: &'static str = "frequency_response";
+    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
+        ge_charts::parse_frequency_response(body)
+    }
+    fn validate(&self) -> Result<(), RequestError> {
+        validate_by_cancelled_run(|p| {
+            ge_charts::frequency_response_any(self, Parallelism::Serial, p)
+        })
+    }
+    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
+        to_json(&ge_charts::frequency_response_any(
+            self,
+            Parallelism::Rayon,
+            progress,
+        )?)
+    }
+}
+
 fn prefixed(e: RequestError, prefix: &str) -> RequestError {
     match e {
         RequestError::Invalid(InvalidInput { field, reason }) => {
@@ -329,12 +372,12 @@ job_kinds!(
     Critical(CriticalRequest),
     /// `POST /api/v1/safe-rate`.
     SafeRate(SafeRateRequest),
-    /// `POST /api/v1/charts`, up to 1 000 000 points.
-    Chart(ChartRequest),
+    /// `POST /api/v1/charts`, up to 1 000 000 points (GE: 2 000).
+    Chart(AnyChartRequest),
     /// `POST /api/v1/simulate` (either cable model).
     Simulate(AnySimulateRequest),
     /// `POST /api/v1/frequency-response`.
-    FrequencyResponse(FrequencyResponseRequest),
+    FrequencyResponse(AnyFrequencyResponseRequest),
 );
 
 impl JobItem {

@@ -1,0 +1,900 @@
+//! The JSON contract of the GE deployment chart (`POST /api/v1/charts`
+//! with `"model": {"kind": "geometrically_exact", ...}` and
+//! `stiffness_ratios`) and of the GE base-excitation frequency response
+//! (`POST /api/v1/frequency-response` with `"excitation": "base"`): request
+//! and response bodies (SI; field names end in their unit; non-dimensional
+//! values beside them), validation naming the field, work bounds, and the
+//! runners [`ge_chart`] and [`ge_base_frequency_response`].
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use crate::contract::dto::{CableInput, ProfileInput, RateGrid};
+use crate::contract::ge::{GeAerostatInput, GeModelInput, GeModelKind, NewtonInput};
+use crate::contract::{Progress, RequestError};
+use crate::numerics::aero::{AerostatBody, ForceModel, SteadyFlow};
+use crate::numerics::chart::{Parallelism, rate_grid};
+use crate::numerics::ge::base::{self, BaseExcitationProblem};
+use crate::numerics::ge::chart::{
+    self as ge_chart_core, GeChartRequest as CoreChart, GeChartSystem, GeChartWind,
+};
+use crate::numerics::ge::critical::{CriticalConfig, GeOnset};
+use crate::numerics::ge::element::TipLoad;
+use crate::numerics::ge::solver::{LengthHistory, NewtonConfig};
+use crate::numerics::ge::{GeModel, Section, TipBody};
+use crate::numerics::ge_reduced;
+use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
+use crate::numerics::profile::Profile;
+
+/// Largest `points × (horizon / Δt) × elements` of one GE chart.
+pub const MAX_CHART_WORK: f64 = 5e9;
+/// Largest element count of a GE chart (a dense QEP of size 6n per check).
+pub const MAX_CHART_ELEMENTS: usize = 200;
+/// Largest `frequencies × steps × elements` of one base-excitation sweep.
+pub const MAX_RESPONSE_WORK: f64 = 2e9;
+
+/// The GE cable of a chart; `E*` varies per series (`stiffness_ratios`).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct GeChartModelInput {
+    pub kind: GeModelKind,
+    /// Number of 2-node elements.
+    #[serde(default = "default_elements")]
+    #[schema(example = 20, minimum = 1, maximum = 200)]
+    pub elements: usize,
+    /// Bending stiffness EI (N m²), the same for every series.
+    #[schema(example = 1000.0, exclusive_minimum = 0.0)]
+    pub bending_stiffness_n_m2: f64,
+    /// γ̃ = A_ρ L0²/I_ρ.
+    #[serde(default = "default_inertia_ratio")]
+    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    pub inertia_ratio: f64,
+}
+
+fn default_elements() -> usize {
+    20
+}
+fn default_inertia_ratio() -> f64 {
+    1.0
+}
+fn default_initial_length() -> f64 {
+    1.0
+}
+fn default_gravity() -> f64 {
+    9.81
+}
+
+/// The initial sideways push on the aerostat (thesis Fig. 7.4).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct PerturbationInput {
+    /// Peak forces F0 (N), one series each; 0 is the unperturbed cable.
+    #[schema(example = json!([0.0, 200.0, 400.0]))]
+    pub forces_n: Vec<f64>,
+    /// Linear rise time (s).
+    #[serde(default = "default_ramp")]
+    #[schema(example = 0.25, minimum = 0.0)]
+    pub ramp_s: f64,
+    /// Release time (s), at least `ramp_s`.
+    #[serde(default = "default_hold")]
+    #[schema(example = 1.0, minimum = 0.0)]
+    pub hold_s: f64,
+}
+
+fn default_ramp() -> f64 {
+    0.25
+}
+fn default_hold() -> f64 {
+    1.0
+}
+
+/// A point of a tabulated wind profile.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct WindPointInput {
+    #[schema(example = 100.0, minimum = 0.0)]
+    pub elevation_m: f64,
+    #[schema(example = 4.2)]
+    pub speed_m_s: f64,
+}
+
+/// Steady wind profile u0(z).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum WindProfileInput {
+    Uniform {
+        #[schema(example = 5.0)]
+        speed_m_s: f64,
+    },
+    /// u = a z^p.
+    PowerLaw {
+        #[schema(example = 0.1)]
+        coefficient: f64,
+        #[schema(example = 0.333, minimum = 0.0, maximum = 2.0)]
+        exponent: f64,
+    },
+    /// Linear interpolation, constant beyond the ends (e.g. a measured
+    /// atmospheric profile).
+    Tabulated { points: Vec<WindPointInput> },
+    /// 0 → 8 m/s over 600 m, then uniform: the shape of the thesis's
+    /// Fig. 7.5(a), not its data.
+    Illustrative,
+}
+
+/// How the flow loads the aerostat.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ForceModelInput {
+    /// Inviscid sphere (thesis (4.4)).
+    Thesis,
+    /// Quadratic drag plus added mass.
+    Drag {
+        #[schema(example = 0.5, minimum = 0.0)]
+        drag_coefficient: f64,
+        /// Reference area (m²); default: the sphere's frontal area.
+        #[serde(default)]
+        #[schema(exclusive_minimum = 0.0)]
+        reference_area_m2: Option<f64>,
+    },
+}
+
+/// Wind on the aerostat (thesis ch. 7.5), one series per A0 of (7.4).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct GeWindInput {
+    pub profile: WindProfileInput,
+    pub force_model: ForceModelInput,
+    /// Aerostat radius (m).
+    #[serde(default = "default_radius")]
+    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    pub radius_m: f64,
+    #[serde(default = "default_air_density")]
+    #[schema(example = 1.12, exclusive_minimum = 0.0)]
+    pub air_density_kg_m3: f64,
+    /// A0 of u0(1 + A0 sin(k z)), one series each; 0 is the steady profile.
+    #[serde(default = "default_amplitudes")]
+    #[schema(example = json!([0.0, 0.5, 1.0]))]
+    pub amplitudes_nondim: Vec<f64>,
+    /// k (1/m).
+    #[serde(default = "default_wavenumber")]
+    #[schema(example = 0.01)]
+    pub wavenumber_1_m: f64,
+}
+
+fn default_radius() -> f64 {
+    1.0
+}
+fn default_air_density() -> f64 {
+    1.12
+}
+fn default_amplitudes() -> Vec<f64> {
+    vec![0.0]
+}
+fn default_wavenumber() -> f64 {
+    0.01
+}
+
+/// Settings of each critical-time search.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct GeChartNumericsInput {
+    /// Newmark step (s).
+    #[serde(default = "default_dt")]
+    #[schema(example = 0.02, exclusive_minimum = 0.0)]
+    pub time_step_s: f64,
+    /// Local QEP every this many steps (the bracket is then retraced step by step).
+    #[serde(default = "default_check")]
+    #[schema(example = 25, minimum = 1, maximum = 100000)]
+    pub check_every_steps: usize,
+    /// Stop searching (stable) after this long (s).
+    #[serde(default = "default_horizon")]
+    #[schema(example = 2000.0, exclusive_minimum = 0.0)]
+    pub horizon_s: f64,
+    /// Floor of the growth-rate tolerance on Re λ (1/s).
+    #[serde(default = "default_growth")]
+    #[schema(example = 1e-6, minimum = 0.0)]
+    pub growth_tolerance_1_s: f64,
+}
+
+fn default_dt() -> f64 {
+    CriticalConfig::default().time_step_s
+}
+fn default_check() -> usize {
+    CriticalConfig::default().check_every
+}
+fn default_horizon() -> f64 {
+    CriticalConfig::default().horizon_s
+}
+fn default_growth() -> f64 {
+    CriticalConfig::default().growth_tolerance_1_s
+}
+
+/// `POST /api/v1/charts` for the GE cable: t* and h* against rate, one
+/// series per stiffness ratio E* × F0 × buoyancy × A0.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct GeChartRequest {
+    pub cable: CableInput,
+    pub aerostat: GeAerostatInput,
+    /// Initial length L0 (m), the length scale of E* and γ̃.
+    #[serde(default = "default_initial_length")]
+    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    pub initial_length_m: f64,
+    #[serde(default = "default_gravity")]
+    #[schema(example = 9.81, minimum = 0.0)]
+    pub gravity_m_s2: f64,
+    pub model: GeChartModelInput,
+    /// E* = EA L0²/EI (= GA L0²/EI), one series each.
+    #[schema(example = json!([1e3, 1e4, 1e5]))]
+    pub stiffness_ratios: Vec<f64>,
+    pub rates_m_s: RateGrid,
+    /// Net buoyancies (N), one series each; default: the aerostat's.
+    #[serde(default)]
+    pub net_buoyancies_n: Vec<f64>,
+    #[serde(default)]
+    pub perturbation: Option<PerturbationInput>,
+    #[serde(default)]
+    pub wind: Option<GeWindInput>,
+    #[serde(default)]
+    pub numerics: Option<GeChartNumericsInput>,
+    #[serde(default)]
+    pub newton: Option<NewtonInput>,
+}
+
+/// How a point's search ended.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum GeOnsetKind {
+    /// Unstable at t = 0.
+    Immediate,
+    /// First unstable at `critical_time_s`.
+    During,
+    /// Stable over the search horizon.
+    Never,
+    /// Newton–Raphson failed before any instability.
+    NewtonFailed,
+    /// The eigenvalue iteration failed.
+    SpectrumFailed,
+    /// Stopped by the caller.
+    Cancelled,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct GeChartPointOutput {
+    pub rate_m_s: f64,
+    /// ṽ = L̇ √(I_ρ/EI) (thesis §5.6).
+    pub rate_nondim: f64,
+    pub onset: GeOnsetKind,
+    /// t* (s): 0 if unstable at once; absent unless `immediate`/`during`.
+    pub critical_time_s: Option<f64>,
+    /// h* = L(t*) (m).
+    pub max_elevation_m: Option<f64>,
+    /// String continuum bound (F/ρA − v²)/g (m), clipped at 0.
+    pub string_closed_form_elevation_m: f64,
+    /// Time at which the search ended without an onset (s).
+    pub ended_at_s: Option<f64>,
+    pub steps: usize,
+    pub qep_solves: usize,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct GeChartSeriesOutput {
+    pub stiffness_ratio: f64,
+    pub perturbation_force_n: f64,
+    pub net_buoyancy_n: f64,
+    /// A0 of (7.4); absent in still air.
+    pub wind_amplitude_nondim: Option<f64>,
+    pub points: Vec<GeChartPointOutput>,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct GeChartResponse {
+    pub series: Vec<GeChartSeriesOutput>,
+    pub elements: usize,
+    /// GE time scale L0 √(I_ρ/EI) (s): t̄ = t / scale.
+    pub time_scale_s: f64,
+    /// √(F/ρA) of the first buoyancy (m/s).
+    pub wave_speed_m_s: f64,
+}
+
+fn newton_config(input: &Option<NewtonInput>) -> Result<NewtonConfig, InvalidInput> {
+    let Some(n) = input else {
+        return Ok(NewtonConfig::default());
+    };
+    let rtol = require_positive("newton.relative_tolerance", n.relative_tolerance)?;
+    if rtol > 0.1 {
+        return Err(InvalidInput::new(
+            "newton.relative_tolerance",
+            "must not exceed 0.1",
+        ));
+    }
+    if !(1..=200).contains(&n.max_iterations) {
+        return Err(InvalidInput::new(
+            "newton.max_iterations",
+            format!("must be between 1 and 200, got {}", n.max_iterations),
+        ));
+    }
+    Ok(NewtonConfig {
+        relative_tolerance: rtol,
+        absolute_tolerance_n: require_non_negative(
+            "newton.absolute_tolerance_n",
+            n.absolute_tolerance_n,
+        )?,
+        max_iterations: n.max_iterations,
+    })
+}
+
+fn wind(input: &GeWindInput, area_default: f64) -> Result<GeChartWind, InvalidInput> {
+    let base_flow = match &input.profile {
+        WindProfileInput::Uniform { speed_m_s } => SteadyFlow::uniform(*speed_m_s)?,
+        WindProfileInput::PowerLaw {
+            coefficient,
+            exponent,
+        } => SteadyFlow::power_law(*coefficient, *exponent)?,
+        WindProfileInput::Tabulated { points } => {
+            let pts: Vec<(f64, f64)> = points
+                .iter()
+                .map(|p| (p.elevation_m, p.speed_m_s))
+                .collect();
+            SteadyFlow::tabulated(&pts, "wind.profile.points")?
+        }
+        WindProfileInput::Illustrative => GeChartWind::illustrative(vec![]).base_flow,
+    };
+    let body = AerostatBody::new(
+        require_positive("wind.radius_m", input.radius_m)?,
+        require_positive("wind.air_density_kg_m3", input.air_density_kg_m3)?,
+        None,
+    )?;
+    let force_model = match &input.force_model {
+        ForceModelInput::Thesis => ForceModel::Thesis,
+        ForceModelInput::Drag {
+            drag_coefficient,
+            reference_area_m2,
+        } => ForceModel::Drag {
+            drag_coefficient: require_non_negative(
+                "wind.force_model.drag_coefficient",
+                *drag_coefficient,
+            )?,
+            reference_area_m2: match reference_area_m2 {
+                Some(a) => require_positive("wind.force_model.reference_area_m2", *a)?,
+                None => area_default * input.radius_m * input.radius_m,
+            },
+        },
+    };
+    if input.amplitudes_nondim.is_empty() {
+        return Err(InvalidInput::new(
+            "wind.amplitudes_nondim",
+            "must list at least one value",
+        ));
+    }
+    Ok(GeChartWind {
+        base_flow,
+        force_model,
+        body,
+        amplitudes: input.amplitudes_nondim.clone(),
+        wavenumber_1_m: input.wavenumber_1_m,
+    })
+}
+
+/// The core request, checked (every field named) and bounded.
+pub fn prepare_chart(req: &GeChartRequest) -> Result<CoreChart, InvalidInput> {
+    let rho_a = req.cable.mass_per_length()?;
+    let l0 = require_positive("initial_length_m", req.initial_length_m)?;
+    let g = require_non_negative("gravity_m_s2", req.gravity_m_s2)?;
+    let m = &req.model;
+    if !(1..=MAX_CHART_ELEMENTS).contains(&m.elements) {
+        return Err(InvalidInput::new(
+            "model.elements",
+            format!(
+                "must be between 1 and {MAX_CHART_ELEMENTS} for a GE chart, got {}",
+                m.elements
+            ),
+        ));
+    }
+    let system = GeChartSystem {
+        mass_per_length_kg_m: rho_a,
+        bending_stiffness_n_m2: require_positive(
+            "model.bending_stiffness_n_m2",
+            m.bending_stiffness_n_m2,
+        )?,
+        inertia_ratio: require_positive("model.inertia_ratio", m.inertia_ratio)?,
+        aerostat_mass_kg: require_non_negative("aerostat.mass_kg", req.aerostat.mass_kg)?,
+        link_length_m: require_non_negative("aerostat.link_length_m", req.aerostat.link_length_m)?,
+        initial_length_m: l0,
+        gravity_m_s2: g,
+        elements: m.elements,
+    };
+    let grid = &req.rates_m_s;
+    let rates = rate_grid(grid.min, grid.max, grid.count)?;
+    let buoyancies = if req.net_buoyancies_n.is_empty() {
+        vec![require_positive(
+            "aerostat.net_buoyancy_n",
+            req.aerostat.net_buoyancy_n,
+        )?]
+    } else {
+        req.net_buoyancies_n.clone()
+    };
+    let (forces, ramp, hold) = match &req.perturbation {
+        None => (vec![0.0], default_ramp(), default_hold()),
+        Some(p) => (p.forces_n.clone(), p.ramp_s, p.hold_s),
+    };
+    let defaults = GeChartNumericsInput {
+        time_step_s: default_dt(),
+        check_every_steps: default_check(),
+        horizon_s: default_horizon(),
+        growth_tolerance_1_s: default_growth(),
+    };
+    let n = req.numerics.as_ref().unwrap_or(&defaults);
+    if n.check_every_steps > 100_000 {
+        return Err(InvalidInput::new(
+            "numerics.check_every_steps",
+            "must be at most 100000",
+        ));
+    }
+    let config = CriticalConfig {
+        time_step_s: n.time_step_s,
+        check_every: n.check_every_steps,
+        growth_tolerance_1_s: n.growth_tolerance_1_s,
+        horizon_s: n.horizon_s,
+        newton: newton_config(&req.newton)?,
+    };
+    let core = CoreChart {
+        system,
+        rates_m_s: rates,
+        stiffness_ratios: req.stiffness_ratios.clone(),
+        perturbation_forces_n: forces,
+        perturbation_ramp_s: ramp,
+        perturbation_hold_s: hold,
+        net_buoyancies_n: buoyancies,
+        wind: req
+            .wind
+            .as_ref()
+            .map(|w| wind(w, std::f64::consts::PI))
+            .transpose()?,
+        config,
+    };
+    // names the field: `perturbation.*`, `stiffness_ratios[i]`, …
+    core.validate().map_err(|e| {
+        let field = match e.field.as_str() {
+            "perturbation_forces_n" => "perturbation.forces_n".to_string(),
+            f if f.starts_with("perturbation_forces_n[") => {
+                f.replacen("perturbation_forces_n", "perturbation.forces_n", 1)
+            }
+            f if f.starts_with("wind.amplitudes") => {
+                f.replacen("wind.amplitudes", "wind.amplitudes_nondim", 1)
+            }
+            f => f.to_string(),
+        };
+        InvalidInput::new(field, e.reason)
+    })?;
+    let work = core.point_count() as f64
+        * (config.horizon_s / config.time_step_s)
+        * system.elements as f64;
+    if work > MAX_CHART_WORK {
+        return Err(InvalidInput::new(
+            "numerics.horizon_s",
+            format!(
+                "{} points × {:.0} steps × {} elements exceeds the work limit {MAX_CHART_WORK:.0e}",
+                core.point_count(),
+                config.horizon_s / config.time_step_s,
+                system.elements
+            ),
+        ));
+    }
+    Ok(core)
+}
+
+/// Number of points a GE chart asks for (admission limits).
+pub fn chart_points(req: &GeChartRequest) -> usize {
+    let n = |v: usize| v.max(1);
+    req.rates_m_s
+        .count
+        .saturating_mul(n(req.stiffness_ratios.len()))
+        .saturating_mul(n(req.perturbation.as_ref().map_or(1, |p| p.forces_n.len())))
+        .saturating_mul(n(req.net_buoyancies_n.len()))
+        .saturating_mul(n(req
+            .wind
+            .as_ref()
+            .map_or(1, |w| w.amplitudes_nondim.len())))
+}
+
+/// Computes a GE chart; progress counts points, cancellation stops the
+/// running searches.
+pub fn ge_chart(
+    req: &GeChartRequest,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<GeChartResponse, RequestError> {
+    let core = prepare_chart(req)?;
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    let cancel = || progress.cancelled();
+    let report = |done: usize, total: usize| progress.report(done, total);
+    let series = ge_chart_core::deployment_chart(&core, parallelism, &report, &cancel)?;
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    let model = core.system.model(core.stiffness_ratios[0])?;
+    let scale = model.section.time_scale_s(core.system.initial_length_m);
+    let out = series
+        .into_iter()
+        .map(|s| GeChartSeriesOutput {
+            stiffness_ratio: s.stiffness_ratio,
+            perturbation_force_n: s.perturbation_force_n,
+            net_buoyancy_n: s.net_buoyancy_n,
+            wind_amplitude_nondim: s.wind_amplitude,
+            points: s
+                .points
+                .into_iter()
+                .map(|p| {
+                    let (onset, ended_at_s) = match p.onset {
+                        GeOnset::Immediate { .. } => (GeOnsetKind::Immediate, None),
+                        GeOnset::During { .. } => (GeOnsetKind::During, None),
+                        GeOnset::Never { until_s } => (GeOnsetKind::Never, Some(until_s)),
+                        GeOnset::NewtonFailed(f) => (GeOnsetKind::NewtonFailed, Some(f.time_s)),
+                        GeOnset::SpectrumFailed { time_s } => {
+                            (GeOnsetKind::SpectrumFailed, Some(time_s))
+                        }
+                        GeOnset::Cancelled { time_s } => (GeOnsetKind::Cancelled, Some(time_s)),
+                    };
+                    GeChartPointOutput {
+                        rate_m_s: p.rate_m_s,
+                        rate_nondim: p.rate_m_s * scale / core.system.initial_length_m,
+                        onset,
+                        critical_time_s: p.critical_time_s,
+                        max_elevation_m: p.max_elevation_m,
+                        string_closed_form_elevation_m: p.string_closed_form_m,
+                        ended_at_s,
+                        steps: p.steps,
+                        qep_solves: p.qep_solves,
+                    }
+                })
+                .collect(),
+        })
+        .collect();
+    Ok(GeChartResponse {
+        series: out,
+        elements: core.system.elements,
+        time_scale_s: scale,
+        wave_speed_m_s: (core.net_buoyancies_n[0] / core.system.mass_per_length_kg_m).sqrt(),
+    })
+}
+
+// ---------------------------------------------------------------- base excitation
+
+/// The excitation of a frequency response.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ExcitationKind {
+    /// The platform moves R0 sin(ω0 t) across the guide (thesis ch. 8).
+    Base,
+}
+
+/// A grid of forcing frequencies.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct FrequencyGridInput {
+    /// Lowest ω0 (rad/s).
+    #[schema(example = 11.3, exclusive_minimum = 0.0)]
+    pub min: f64,
+    /// Highest ω0 (rad/s).
+    #[schema(example = 792.6, exclusive_minimum = 0.0)]
+    pub max: f64,
+    #[schema(example = 70, minimum = 1, maximum = 2000)]
+    pub count: usize,
+}
+
+/// `POST /api/v1/frequency-response` with `"excitation": "base"`: the GE
+/// cable on a platform shaken across the guide; amplitude gain (8.3)
+/// against ω0, with the two-DOF model's resonance bands (8.9).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct GeBaseFrequencyResponseRequest {
+    pub excitation: ExcitationKind,
+    pub cable: CableInput,
+    /// The aerostat; absent: the bare cantilever of thesis ch. 8.
+    #[serde(default)]
+    pub aerostat: Option<GeAerostatInput>,
+    #[serde(default = "default_initial_length")]
+    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    pub initial_length_m: f64,
+    /// Gravity on the cable (m/s²); thesis ch. 8 has none.
+    #[serde(default)]
+    #[schema(example = 0.0, minimum = 0.0)]
+    pub gravity_m_s2: f64,
+    pub model: GeModelInput,
+    /// Deployment profile; absent: constant length.
+    #[serde(default)]
+    pub profile: Option<ProfileInput>,
+    /// Platform amplitude R0 (m).
+    #[schema(example = 0.001, exclusive_minimum = 0.0)]
+    pub amplitude_m: f64,
+    pub frequencies_rad_s: FrequencyGridInput,
+    /// The normalising run's ω (rad/s); default ω̄ = 0.01 as in (8.3).
+    #[serde(default)]
+    #[schema(exclusive_minimum = 0.0)]
+    pub reference_frequency_rad_s: Option<f64>,
+    /// Duration of each run (s).
+    #[schema(example = 0.883, exclusive_minimum = 0.0)]
+    pub duration_s: f64,
+    /// Newmark step (s).
+    #[schema(example = 0.000442, exclusive_minimum = 0.0)]
+    pub time_step_s: f64,
+    /// ε of the two-DOF model (8.8)–(8.9) for the predicted bands.
+    #[serde(default = "default_epsilon")]
+    #[schema(example = 0.2, minimum = 0.0)]
+    pub reduced_model_epsilon_nondim: f64,
+    #[serde(default)]
+    pub newton: Option<NewtonInput>,
+}
+
+fn default_epsilon() -> f64 {
+    0.2
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct BaseResponsePointOutput {
+    pub frequency_rad_s: f64,
+    /// ω̄ = ω L0 √(I_ρ/EI).
+    pub frequency_nondim: f64,
+    /// Amplitude gain (8.3) (dB).
+    pub gain_db: f64,
+    /// max |u2(1,t) + r(t)| (m).
+    pub max_tip_amplitude_m: f64,
+    /// False if Newton failed before the end of the run.
+    pub completed: bool,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct ResonanceBandOutput {
+    pub low_rad_s: f64,
+    pub high_rad_s: f64,
+    pub low_nondim: f64,
+    pub high_nondim: f64,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct GeBaseFrequencyResponseResponse {
+    pub points: Vec<BaseResponsePointOutput>,
+    pub reference: BaseResponsePointOutput,
+    /// Predicted resonance bands of the two-DOF model (constant length or
+    /// constant rate only; absent when its frequencies turn complex).
+    pub reduced_model_bands: Option<Vec<ResonanceBandOutput>>,
+    /// Local maxima of the gain (rad/s).
+    pub peaks_rad_s: Vec<f64>,
+    /// GE time scale L0 √(I_ρ/EI) (s).
+    pub time_scale_s: f64,
+    pub stiffness_ratio: f64,
+    /// ṽ of a constant-rate profile.
+    pub rate_nondim: Option<f64>,
+    pub elements: usize,
+}
+
+/// Runs a base-excitation sweep.
+pub fn ge_base_frequency_response(
+    req: &GeBaseFrequencyResponseRequest,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<GeBaseFrequencyResponseResponse, RequestError> {
+    let rho_a = req.cable.mass_per_length()?;
+    let l0 = require_positive("initial_length_m", req.initial_length_m)?;
+    let g = require_non_negative("gravity_m_s2", req.gravity_m_s2)?;
+    let m = &req.model;
+    let mut section = Section::from_ratios(
+        m.bending_stiffness_n_m2,
+        m.stiffness_ratio,
+        m.inertia_ratio,
+        rho_a,
+        l0,
+    )?;
+    if let Some(gs) = m.shear_stiffness_ratio {
+        section.shear_stiffness_n = require_positive("model.shear_stiffness_ratio", gs)?
+            * section.bending_stiffness_n_m2
+            / (l0 * l0);
+    }
+    let (tip, steady) = match &req.aerostat {
+        None => (TipBody::default(), TipLoad::default()),
+        Some(a) => (
+            TipBody {
+                mass_kg: require_non_negative("aerostat.mass_kg", a.mass_kg)?,
+                link_length_m: require_non_negative("aerostat.link_length_m", a.link_length_m)?,
+            },
+            TipLoad {
+                force_n: [
+                    require_non_negative("aerostat.net_buoyancy_n", a.net_buoyancy_n)?,
+                    0.0,
+                ],
+                moment_n_m: 0.0,
+            },
+        ),
+    };
+    let model = GeModel::new(section, m.elements, tip, g)?;
+    let scale = section.time_scale_s(l0);
+    let grid = &req.frequencies_rad_s;
+    let omegas = rate_grid(grid.min, grid.max, grid.count).map_err(|e| {
+        InvalidInput::new(
+            e.field.replacen("rates_m_s", "frequencies_rad_s", 1),
+            e.reason,
+        )
+    })?;
+    if omegas.len() > base::MAX_FREQUENCIES {
+        return Err(InvalidInput::new(
+            "frequencies_rad_s.count",
+            format!("must be at most {}", base::MAX_FREQUENCIES),
+        )
+        .into());
+    }
+    let duration = require_positive("duration_s", req.duration_s)?;
+    let dt = require_positive("time_step_s", req.time_step_s)?;
+    let steps = duration / dt;
+    if steps < 1.0 {
+        return Err(InvalidInput::new("time_step_s", "must not exceed duration_s").into());
+    }
+    let work = steps * (omegas.len() + 1) as f64 * m.elements as f64;
+    if work > MAX_RESPONSE_WORK {
+        return Err(InvalidInput::new(
+            "frequencies_rad_s.count",
+            format!(
+                "{} runs × {steps:.0} steps × {} elements exceeds the work limit {MAX_RESPONSE_WORK:.0e}",
+                omegas.len() + 1,
+                m.elements
+            ),
+        )
+        .into());
+    }
+    let (length, rate) = match &req.profile {
+        None => (LengthHistory::Constant(l0), Some(0.0)),
+        Some(p) => {
+            let profile = p.profile(l0)?;
+            let rate = match profile {
+                Profile::ConstantRate { rate_m_s, .. } => Some(rate_m_s),
+                _ => None,
+            };
+            (LengthHistory::Profile(profile), rate)
+        }
+    };
+    let reference = match req.reference_frequency_rad_s {
+        None => 0.01 / scale,
+        Some(w) => require_positive("reference_frequency_rad_s", w)?,
+    };
+    let epsilon = require_non_negative(
+        "reduced_model_epsilon_nondim",
+        req.reduced_model_epsilon_nondim,
+    )?;
+    let problem = BaseExcitationProblem {
+        model,
+        length,
+        steady_tip_load: steady,
+        amplitude_m: req.amplitude_m,
+        frequencies_rad_s: omegas,
+        reference_frequency_rad_s: reference,
+        duration_s: duration,
+        time_step_s: dt,
+        newton: newton_config(&req.newton)?,
+    };
+    problem.validate().map_err(|e| {
+        let field = match e.field.as_str() {
+            "base.amplitude_m" => "amplitude_m".to_string(),
+            "base.reference_frequency_rad_s" => "reference_frequency_rad_s".to_string(),
+            "numerics.time_step_s" => "time_step_s".to_string(),
+            f => f.to_string(),
+        };
+        InvalidInput::new(field, e.reason)
+    })?;
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    let cancel = || progress.cancelled();
+    let report = |done: usize, total: usize| progress.report(done, total);
+    let r = base::frequency_response(&problem, parallelism, &report, &cancel)?;
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    let rate_nondim = rate.map(|v| v * scale / l0);
+    let bands = rate_nondim.and_then(|v| {
+        ge_reduced::resonance_bands(m.stiffness_ratio, epsilon, v, duration / scale).map(|b| {
+            b.iter()
+                .map(|b| ResonanceBandOutput {
+                    low_rad_s: b.low / scale,
+                    high_rad_s: b.high / scale,
+                    low_nondim: b.low,
+                    high_nondim: b.high,
+                })
+                .collect()
+        })
+    });
+    let out = |p: &base::ResponsePoint| BaseResponsePointOutput {
+        frequency_rad_s: p.frequency_rad_s,
+        frequency_nondim: p.frequency_rad_s * scale,
+        gain_db: p.gain_db,
+        max_tip_amplitude_m: p.max_tip_amplitude_m,
+        completed: p.completed,
+    };
+    Ok(GeBaseFrequencyResponseResponse {
+        points: r.points.iter().map(out).collect(),
+        reference: out(&r.reference),
+        reduced_model_bands: bands,
+        peaks_rad_s: base::resonance_peaks(&r.points)
+            .into_iter()
+            .map(|i| r.points[i].frequency_rad_s)
+            .collect(),
+        time_scale_s: scale,
+        stiffness_ratio: m.stiffness_ratio,
+        rate_nondim,
+        elements: m.elements,
+    })
+}
+
+// ---------------------------------------------------------------- dispatch
+
+/// `POST /api/v1/charts` for either model: `model.kind` picks the linear
+/// string (`linear_string`, the default) or the GE cable
+/// (`geometrically_exact`, with `stiffness_ratios`).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(untagged)]
+pub enum AnyChartRequest {
+    /// `model.kind = "geometrically_exact"`.
+    GeometricallyExact(GeChartRequest),
+    /// `model.kind = "linear_string"` (or absent).
+    LinearString(crate::contract::dto::ChartRequest),
+}
+
+/// The answer of [`AnyChartRequest`].
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(untagged)]
+pub enum AnyChartResponse {
+    GeometricallyExact(GeChartResponse),
+    LinearString(crate::contract::dto::ChartResponse),
+}
+
+/// Parses a chart body, choosing the model by `model.kind`.
+pub fn parse_chart(body: &[u8]) -> Result<AnyChartRequest, RequestError> {
+    let value: serde_json::Value =
+        serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
+    if value.pointer("/model/kind").and_then(|k| k.as_str()) == Some("geometrically_exact") {
+        crate::contract::parse_plain(body).map(AnyChartRequest::GeometricallyExact)
+    } else {
+        crate::contract::parse(body).map(AnyChartRequest::LinearString)
+    }
+}
+
+/// `POST /api/v1/frequency-response`: `"excitation": "base"` shakes the
+/// platform under the GE cable (thesis ch. 8); otherwise (absent) the
+/// linear string under a sinusoidal wind.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(untagged)]
+pub enum AnyFrequencyResponseRequest {
+    /// `excitation = "base"`.
+    Base(GeBaseFrequencyResponseRequest),
+    /// Wind forcing on the linear string.
+    Wind(crate::contract::transient::FrequencyResponseRequest),
+}
+
+/// The answer of [`AnyFrequencyResponseRequest`].
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(untagged)]
+pub enum AnyFrequencyResponseResponse {
+    Base(GeBaseFrequencyResponseResponse),
+    Wind(crate::contract::transient::FrequencyResponseResponse),
+}
+
+/// Parses a frequency-response body, choosing by `excitation`.
+pub fn parse_frequency_response(body: &[u8]) -> Result<AnyFrequencyResponseRequest, RequestError> {
+    let value: serde_json::Value =
+        serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
+    match value.get("excitation") {
+        None => crate::contract::parse(body).map(AnyFrequencyResponseRequest::Wind),
+        Some(_) => crate::contract::parse_plain(body).map(AnyFrequencyResponseRequest::Base),
+    }
+}
+
+/// Runs either frequency response.
+pub fn frequency_response_any(
+    req: &AnyFrequencyResponseRequest,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<AnyFrequencyResponseResponse, RequestError> {
+    match req {
+        AnyFrequencyResponseRequest::Base(r) => {
+            ge_base_frequency_response(r, parallelism, progress)
+                .map(AnyFrequencyResponseResponse::Base)
+        }
+        AnyFrequencyResponseRequest::Wind(r) => {
+            crate::contract::transient::frequency_response(r, parallelism, progress)
+                .map(AnyFrequencyResponseResponse::Wind)
+        }
+    }
+}
