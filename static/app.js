@@ -20,7 +20,7 @@
   const statusEl = $("#status");
 
   // Shared with the browser test and the console: the last request, answer and plots.
-  const state = { request: null, chart: null, via: null, jobProgress: [], plots: { time: null, elevation: null }, job: null };
+  const state = { request: null, chart: null, via: null, jobProgress: [], plots: { time: null, elevation: null, geTime: null, geElevation: null }, job: null, ge: null };
   window.tetherplan = state;
 
   // ---------- reading the form ----------
@@ -235,7 +235,7 @@
 
   // Runs a chart as a background job, showing its progress; resolves to the chart
   // answer, or to {error} when the job fails, is cancelled, or cannot be submitted.
-  async function runChartJob(req) {
+  async function runChartJob(req, points = chartPoints(req)) {
     const submitted = await api("POST", "/api/v1/jobs", { kind: "chart", request: req });
     if (!submitted.ok) return { status: submitted.status, error: unwrapJobError(submitted.body) };
     const id = submitted.body.id;
@@ -253,7 +253,7 @@
         jobProgress.value = progress;
         state.jobProgress.push([job.status, progress]);
         jobText.textContent = `${job.status} · ${(progress * 100).toFixed(0)} %`;
-        setStatus("busy", `Job ${id}: ${job.status}, ${(progress * 100).toFixed(0)} % of ${chartPoints(req)} points`);
+        setStatus("busy", `Job ${id}: ${job.status}, ${(progress * 100).toFixed(0)} % of ${points} points`);
         if (job.status === "done") return { chart: job.result, via: `job ${id}` };
         if (job.status === "failed" || job.status === "cancelled") {
           const body = job.error?.error ? job.error : { error: { code: job.status, field: null, message: `the job was ${job.status}` } };
@@ -364,11 +364,86 @@
   window.addEventListener("resize", () => {
     clearTimeout(resizeTimer);
     resizeTimer = setTimeout(() => {
-      for (const [key, el] of [["time", "#plot-time"], ["elevation", "#plot-elevation"]]) {
+      for (const [key, el] of [["time", "#plot-time"], ["elevation", "#plot-elevation"], ["geTime", "#plot-ge-time"], ["geElevation", "#plot-ge-elevation"]]) {
         state.plots[key]?.setSize(plotSize($(el)));
       }
     }, 100);
   });
+
+  // ---------- GE chart beside the string's ----------
+
+  // The GE request (GeChartRequest in the API): the form's cable, aerostat and
+  // rate range, the aerostat's net buoyancy, one series per stiffness ratio.
+  function readGeRequest(errors) {
+    const sys = readSystem(errors);
+    const ratios = [];
+    for (const [i, p] of $("#ge-ratios").value.split(/[,;\s]+/).filter((t) => t !== "").entries()) {
+      const v = Number(p);
+      if (!Number.isFinite(v)) errors.push({ field: `ge.stiffness_ratios[${i}]`, message: `“${p}” is not a number` });
+      ratios.push(v);
+    }
+    if (ratios.length === 0) errors.push({ field: "ge.stiffness_ratios", message: "list at least one stiffness ratio" });
+    return {
+      cable: sys.cable,
+      aerostat: sys.aerostat,
+      initial_length_m: sys.initial_length_m,
+      gravity_m_s2: sys.gravity_m_s2,
+      model: {
+        kind: "geometrically_exact",
+        elements: readNumber("ge.model.elements", errors, { integer: true }),
+        bending_stiffness_n_m2: readNumber("ge.model.bending_stiffness_n_m2", errors),
+        inertia_ratio: readNumber("ge.model.inertia_ratio", errors),
+      },
+      stiffness_ratios: ratios,
+      rates_m_s: {
+        min: readNumber("rates_m_s.min", errors),
+        max: readNumber("rates_m_s.max", errors),
+        count: readNumber("ge.rates_m_s.count", errors, { integer: true }),
+      },
+    };
+  }
+
+  // API fields of a GE request land on the GE inputs (`ge.` prefix), the
+  // shared ones (cable, aerostat, rate range) on the chart form's.
+  function geErrorBody(body) {
+    const err = body?.error;
+    if (!err || typeof err.field !== "string") return body;
+    const prefixed = `ge.${err.field}`;
+    return inputFor(prefixed) && inputFor(prefixed).dataset.field.startsWith("ge.") ? { error: { ...err, field: prefixed } } : body;
+  }
+
+  // One x axis for curves on different rate grids: the union of the rates,
+  // gaps where a curve has no point (drawn across).
+  function mergedSpec(stringChart, geChart, quantity) {
+    const pick = (p) => (quantity === "time" ? p.critical_time_s : p.max_elevation_m);
+    const curves = [];
+    const F = geChart.series[0]?.net_buoyancy_n;
+    const str = stringChart?.series.find((s) => s.net_buoyancy_n === F);
+    if (str) curves.push({ label: `string, ${F} N`, points: str.points.map((p) => [p.rate_m_s, pick(p)]), dash: [6, 4] });
+    for (const s of geChart.series) {
+      curves.push({ label: `GE, E* = ${s.stiffness_ratio.toExponential(0)}`, points: s.points.map((p) => [p.rate_m_s, pick(p)]) });
+    }
+    const x = [...new Set(curves.flatMap((c) => c.points.map(([v]) => v)))].sort((a, b) => a - b);
+    const data = [x];
+    const unit = quantity === "time" ? "s" : "m";
+    const series = [{ label: "v (m/s)", value: (u, v) => fmt(v, 2) }];
+    curves.forEach((c, i) => {
+      const map = new Map(c.points);
+      data.push(x.map((v) => (map.has(v) && map.get(v) != null ? map.get(v) : null)));
+      const color = COLORS[i % COLORS.length];
+      series.push({ label: `${c.label} (${unit})`, color, stroke: color, width: 2, dash: c.dash, spanGaps: true, value: (u, v) => fmt(v, 1) });
+    });
+    return { data, series, log: false };
+  }
+
+  function renderGe(geChart, stringChart) {
+    state.ge = geChart;
+    for (const id of ["#ge-time-figure", "#ge-elevation-figure"]) $(id).hidden = false;
+    state.plots.geTime?.destroy();
+    state.plots.geElevation?.destroy();
+    state.plots.geTime = makePlot($("#plot-ge-time"), mergedSpec(stringChart, geChart, "time"), "t* (s)");
+    state.plots.geElevation = makePlot($("#plot-ge-elevation"), mergedSpec(stringChart, geChart, "elevation"), "h* (m)");
+  }
 
   // ---------- chart form ----------
 
@@ -420,6 +495,23 @@
       if (outcome.chart) render(outcome.chart, req, outcome.via);
       else if (outcome.error?.error?.code === "cancelled") setStatus("idle", "Job cancelled.");
       else setStatus("error", renderApiError(outcome.status, outcome.error, $("#form-error")));
+      if (outcome.chart && $("#ge-enabled").checked) {
+        const geErrors = [];
+        const geReq = readGeRequest(geErrors);
+        if (geErrors.length) {
+          for (const e of geErrors) showFieldError(e.field, e.message);
+          setStatus("error", "Fix the highlighted GE fields.");
+        } else {
+          const points = geReq.rates_m_s.count * geReq.stiffness_ratios.length;
+          setStatus("busy", `Submitting a GE job for ${points} points…`);
+          const ge = await runChartJob(geReq, points);
+          if (ge.chart) {
+            renderGe(ge.chart, outcome.chart);
+            setStatus("ready", `String: ${outcome.chart.series.length} curves; GE: ${ge.chart.series.length} curves, ${points} points (${ge.via}).`);
+          } else if (ge.error?.error?.code === "cancelled") setStatus("idle", "GE job cancelled.");
+          else setStatus("error", renderApiError(ge.status, geErrorBody(ge.error), $("#form-error")));
+        }
+      }
     } finally {
       busy = false;
       $("#plot-button").disabled = false;

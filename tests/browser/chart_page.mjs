@@ -200,6 +200,36 @@ try {
     await jobs.close();
   }
 
+  // ---------- GE cable beside the string ----------
+  {
+    phase = "ge";
+    const geContext = await browser.newContext({ viewport: { width: 1100, height: 1400 } });
+    const gp = await geContext.newPage();
+    watch(gp);
+    await gp.goto(url, { waitUntil: "load" });
+    await gp.fill("#rate-min", "40");
+    await gp.fill("#rate-count", "10");
+    await gp.fill("#buoyancies", "1000");
+    await gp.check("#ge-enabled");
+    await gp.fill("#ge-count", "3");
+    await gp.fill("#ge-ratios", "1e3, 1e5");
+    await gp.click("#plot-button");
+    await gp.waitForSelector("#ge-time-figure:not([hidden])", { timeout: 120_000 }).catch(() => {});
+    await gp.waitForSelector('#status[data-state="ready"], #status[data-state="error"]', { timeout: 120_000 });
+    const g = await gp.evaluate(() => ({
+      series: window.tetherplan.ge?.series.map((s) => [s.stiffness_ratio, s.points.map((p) => p.max_elevation_m)]),
+      curves: window.tetherplan.plots.geElevation?.series.length,
+      string: window.tetherplan.chart?.series[0].points.at(-1).max_elevation_m,
+    }));
+    check(g.series?.length === 2 && g.series.every(([, h]) => h.length === 3), `GE chart: one series per E* (${JSON.stringify(g.series?.map(([e]) => e))})`);
+    check(g.curves === 4, `GE plot: the string curve and two GE curves (${g.curves ? g.curves - 1 : 0})`);
+    const hGe = g.series?.[1][1][2];
+    // near the wave speed the short stiff cable holds on longer (bending): above the string, within 50 %
+    check(hGe > g.string && hGe < g.string * 1.5, `GE h*(100 m/s, E* = 1e5) = ${hGe?.toFixed(1)} m, above the string h* ${g.string?.toFixed(1)} m`);
+    await gp.screenshot({ path: path.join(artifacts, "chart_page_ge.png"), fullPage: true });
+    await geContext.close();
+  }
+
   // ---------- phone width ----------
   phase = "phone";
   const phone = await browser.newContext({ viewport: { width: 375, height: 800 }, deviceScaleFactor: 2, isMobile: true, hasTouch: true });
