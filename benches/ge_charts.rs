@@ -44,11 +44,7 @@ fn chart_once() {
     let series = deployment_chart(&request, Parallelism::Rayon, &|_, _| {}, &|| false).unwrap();
     let elapsed = start.elapsed();
     let points: usize = series.iter().map(|s| s.points.len()).sum();
-    let steps: usize = series
-        .iter()
-        .flat_map(|s| &s.points)
-        .map(|p| p.steps)
-        .sum();
+    let steps: usize = series.iter().flat_map(|s| &s.points).map(|p| p.steps).sum();
     println!(
         "ge_chart/table_7_1_20_rates_x_3_stiffness_ratios: {points} points, {steps} steps, {:.2} s on {} rayon threads (one timed run)",
         elapsed.as_secs_f64(),

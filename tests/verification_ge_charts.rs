@@ -209,6 +209,7 @@ fn critical_time_is_converged_in_step_and_check_interval() {
 ///   less (0–0.3 %, within the step scatter); larger F0 never raises t*.
 /// * 10 m/s, Δt = 10 ms: F0 ≤ 400 N moves t* by less than 0.5 % (the
 ///   oscillation has decayed long before t* ≈ 135 s).
+///
 /// Departure (reported): at 50 and 90 m/s the perturbed t* still moves by
 /// 1–4 % between Δt = 2.5 and 1.25 ms, either side of the unperturbed
 /// value, so no "lowers" claim is made there.

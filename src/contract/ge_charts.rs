@@ -827,7 +827,7 @@ pub fn ge_base_frequency_response(
 #[serde(untagged)]
 pub enum AnyChartRequest {
     /// `model.kind = "geometrically_exact"`.
-    GeometricallyExact(GeChartRequest),
+    GeometricallyExact(Box<GeChartRequest>),
     /// `model.kind = "linear_string"` (or absent).
     LinearString(crate::contract::dto::ChartRequest),
 }
@@ -858,9 +858,9 @@ pub fn parse_chart(body: &[u8]) -> Result<AnyChartRequest, RequestError> {
 #[serde(untagged)]
 pub enum AnyFrequencyResponseRequest {
     /// `excitation = "base"`.
-    Base(GeBaseFrequencyResponseRequest),
+    Base(Box<GeBaseFrequencyResponseRequest>),
     /// Wind forcing on the linear string.
-    Wind(crate::contract::transient::FrequencyResponseRequest),
+    Wind(Box<crate::contract::transient::FrequencyResponseRequest>),
 }
 
 /// The answer of [`AnyFrequencyResponseRequest`].
@@ -876,7 +876,9 @@ pub fn parse_frequency_response(body: &[u8]) -> Result<AnyFrequencyResponseReque
     let value: serde_json::Value =
         serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
     match value.get("excitation") {
-        None => crate::contract::parse(body).map(AnyFrequencyResponseRequest::Wind),
+        None => {
+            crate::contract::parse(body).map(|r| AnyFrequencyResponseRequest::Wind(Box::new(r)))
+        }
         Some(_) => crate::contract::parse_plain(body).map(AnyFrequencyResponseRequest::Base),
     }
 }

@@ -267,6 +267,7 @@ impl GeChartRequest {
 }
 
 /// One point: constant-rate lengthening from `L0`, no target.
+#[allow(clippy::too_many_arguments)]
 pub fn chart_point(
     model: &GeModel,
     system: &GeChartSystem,
