@@ -95,6 +95,39 @@ pub fn complex_onset_epsilon(stiffness_ratio: f64, epsilon_max: f64) -> Option<f
     None
 }
 
+/// One instant of a constant-rate deployment from `l = 1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrequencySample {
+    /// `t̄`.
+    pub time: f64,
+    /// `l = 1 + ṽ t̄`.
+    pub length: f64,
+    pub frequencies: ReducedFrequencies,
+}
+
+/// The frozen-length frequencies of (8.9) along a constant-rate deployment
+/// from `l = 1` over `t̄ ∈ [0, duration]` (thesis Figs 8.6(a), 8.7(a)),
+/// `samples + 1` instants; stops early if the cable would vanish.
+pub fn frequency_evolution(
+    stiffness_ratio: f64,
+    epsilon: f64,
+    rate: f64,
+    duration: f64,
+    samples: usize,
+) -> Vec<FrequencySample> {
+    let samples = samples.max(1);
+    (0..=samples)
+        .map(|i| duration * i as f64 / samples as f64)
+        .map(|time| (time, 1.0 + rate * time))
+        .take_while(|&(_, l)| l > 0.0)
+        .map(|(time, length)| FrequencySample {
+            time,
+            length,
+            frequencies: natural_frequencies(stiffness_ratio, epsilon, length, rate),
+        })
+        .collect()
+}
+
 /// A frequency band `[low, high]` (rad per unit t̄).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Band {
