@@ -391,6 +391,30 @@
     return out;
   }
 
+  // An upper envelope of |y|: straight lines through its dominant peaks (the
+  // samples that are the largest within `half` samples either side), never
+  // below |y| itself.
+  function peakEnvelope(abs, half) {
+    const n = abs.length;
+    if (n < 3) return abs.slice();
+    const local = slidingMax(abs, half);
+    const peaks = [0];
+    for (let i = 1; i < n - 1; i++) if (abs[i] > 0 && abs[i] === local[i] && i - peaks[peaks.length - 1] > half) peaks.push(i);
+    const out = new Array(n);
+    for (let k = 1; k < peaks.length; k++) {
+      const a = peaks[k - 1];
+      const b = peaks[k];
+      for (let i = a; i <= b; i++) {
+        const line = abs[a] + ((abs[b] - abs[a]) * (i - a)) / (b - a || 1);
+        out[i] = Math.max(line, abs[i]);
+      }
+    }
+    // After the last peak: hold it (the run ends mid-swing).
+    const last = peaks[peaks.length - 1];
+    for (let i = last; i < n; i++) out[i] = Math.max(abs[last], abs[i]);
+    return out;
+  }
+
   // The first time ω₁(t) crosses ω, interpolated in the eigenvalue track.
   function resonance(track, omega) {
     const pts = track
@@ -415,9 +439,9 @@
 
   const axis = { stroke: "#333", grid: { stroke: "#e5e5e5" }, ticks: { stroke: "#ccc" } };
 
-  function plotSize(el, aspect = 0.5) {
+  function plotSize(el, aspect = 0.6) {
     const width = Math.max(260, Math.floor(el.clientWidth));
-    return { width, height: Math.round(Math.min(340, Math.max(200, width * aspect))) };
+    return { width, height: Math.round(Math.min(340, Math.max(240, width * aspect))) };
   }
 
   // A vertical dashed line at state.resonance.time_s, labelled.
@@ -477,23 +501,21 @@
     state.request = req;
     state.via = via;
     const t = res.time_s;
-    // Envelope: the API's max |y| per sample, widened to a sliding window of one
-    // period of the forcing (or of the slowest first mode) so it traces the peaks.
+    // Envelope: straight lines through the peaks of the API's max |y| per sample.
+    // Peaks of |y| come every half period π/ω of the fastest oscillation that
+    // matters (forcing, or the first mode at its highest): ripples closer than
+    // half of that are not peaks.
     const dtSample = t.length > 1 ? (t[t.length - 1] - t[0]) / (t.length - 1) : 1;
     const omegaWind = req.aero?.flow?.kind === "sinusoidal" ? req.aero.flow.angular_frequency_rad_s : null;
     const w1 = res.eigenvalues.map((e) => e.eigenvalues[0]?.im_1_s).filter((w) => w > 0);
-    const periods = [];
-    if (omegaWind > 0) periods.push((2 * Math.PI) / omegaWind);
-    if (w1.length) periods.push((2 * Math.PI) / Math.min(...w1));
-    const duration = t[t.length - 1] - t[0] || 1;
-    const windowS = Math.min(duration / 8, Math.max(2 * dtSample, ...(periods.length ? [Math.max(...periods)] : [duration / 50])));
-    const half = Math.max(1, Math.round(windowS / 2 / dtSample));
-    const env = slidingMax(res.tip_envelope_m, half);
-    state.envelope = { window_s: windowS, values: env };
+    const omegaMax = Math.max(omegaWind > 0 ? omegaWind : 0, ...w1, 0);
+    const spacingS = omegaMax > 0 ? Math.PI / omegaMax / 2 : 2 * dtSample;
+    const env = peakEnvelope(res.tip_envelope_m, Math.max(1, Math.round(spacingS / dtSample)));
+    state.envelope = { peak_spacing_s: spacingS, values: env };
     state.resonance = omegaWind > 0 ? resonance(res.eigenvalues, omegaWind) : null;
 
     for (const p of Object.values(state.plots)) p?.destroy();
-    const envLabel = `envelope ±max|y| over ${fmt(windowS, 2)} s (m)`;
+    const envLabel = "envelope ±|y|max (m)";
     state.plots.tip = makePlot(
       $("#tr-plot-tip"),
       [
@@ -587,7 +609,24 @@
     return out;
   }
 
-  const heat = { layout: null };
+  const heat = { layout: null, cache: null };
+
+  // The envelope drawn: the API's (max |y| over each output interval), or by
+  // default straight lines through its peaks, at most two per forcing period.
+  function heatValues(res) {
+    const smooth = $("#fr-smooth").checked;
+    if (!smooth) return res.envelope_m;
+    if (heat.cache?.res === res) return heat.cache.values;
+    const t = res.time_s;
+    const dt = t.length > 1 ? (t[t.length - 1] - t[0]) / (t.length - 1) : 1;
+    const values = res.envelope_m.map((row, i) => {
+      const w = res.frequencies_rad_s[i];
+      const spacing = w > 0 ? Math.PI / w / 2 : 2 * dt;
+      return peakEnvelope(row.map((v) => (Number.isFinite(v) ? v : 0)), Math.max(1, Math.round(spacing / dt)));
+    });
+    heat.cache = { res, values };
+    return values;
+  }
 
   function drawHeatmap() {
     const canvas = $("#fr-heatmap");
@@ -610,7 +649,7 @@
     const ph = cssH - m.top - m.bottom;
     const w = res.frequencies_rad_s;
     const t = res.time_s;
-    const E = res.envelope_m;
+    const E = heatValues(res);
     let max = 0;
     for (const row of E) for (const v of row) if (Number.isFinite(v)) max = Math.max(max, v);
     if (!(max > 0)) max = 1;
@@ -685,7 +724,7 @@
     ctx.strokeRect(bx + 0.5, m.top + 0.5, bw - 1, ph - 1);
     ctx.fillStyle = "#333";
     ctx.textAlign = "left";
-    for (const v of ticks(0, max, 4)) {
+    for (const v of ticks(0, max, 5)) {
       const y = m.top + ph - (v / max) * ph;
       ctx.fillRect(bx + bw, y, 3, 1);
       ctx.fillText(fmt(v, 2), bx + bw + 5, Math.min(m.top + ph - 5, Math.max(m.top + 5, y)));
@@ -710,6 +749,7 @@
     const i = Math.min(L.w.length - 1, Math.floor(((L.ph - y) / L.ph) * L.w.length));
     out.textContent = `t = ${fmt(L.t[j])} s, ω = ${fmt(L.w[i])} rad/s: envelope ${fmt(L.E[i][j])} m`;
   }
+  $("#fr-smooth").addEventListener("change", drawHeatmap);
   $("#fr-heatmap").addEventListener("mousemove", heatReadout);
   $("#fr-heatmap").addEventListener("mouseleave", () => ($("#fr-heat-readout").innerHTML = "&nbsp;"));
 
