@@ -31,6 +31,7 @@
     via: null,
     envelope: null,
     resonance: null,
+    firstUnstable: null,
     jobProgress: [],
     plots: { tip: null, energy: null, freq: null },
     fr: { request: null, result: null, via: null, peak: null, jobProgress: [], plot: null },
@@ -439,6 +440,17 @@
 
   const axis = { stroke: "#333", grid: { stroke: "#e5e5e5" }, ticks: { stroke: "#ccc" } };
 
+  // Log scale: uPlot's log axes find no ticks across the 60 decades of a
+  // diverged run, so the data are plotted as log₁₀ on a linear axis whose
+  // labels and legend values are shown as powers of ten.
+  const log10 = (a) => a.map((v) => (v > 0 ? Math.log10(v) : null));
+  const pow10 = (u, v) => (v == null ? "–" : fmt(10 ** v));
+  const logAxis = {
+    ...axis,
+    values: (u, splits) =>
+      splits.map((v) => (Number.isInteger(v) ? (v >= -2 && v <= 4 ? String(Number((10 ** v).toPrecision(3))) : `1e${v}`) : fmt(10 ** v, 2))),
+  };
+
   function plotSize(el, aspect = 0.6) {
     const width = Math.max(260, Math.floor(el.clientWidth));
     return { width, height: Math.round(Math.min(340, Math.max(240, width * aspect))) };
@@ -482,10 +494,10 @@
       {
         ...plotSize(el),
         series,
-        scales: { x: { time: false }, ...(extra.scales || {}) },
+        scales: { x: { time: false } },
         axes: [
           { ...axis, label: xLabel },
-          { ...axis, label: yLabel, size: 62 },
+          extra.log ? { ...logAxis, label: yLabel, size: 62 } : { ...axis, label: yLabel, size: 62 },
         ],
         legend: { live: true, markers: { dash: (u, i) => (u.series[i].dash ? "dashed" : "solid"), fill: () => "transparent" } },
         cursor: { drag: { x: true, y: false } },
@@ -496,7 +508,7 @@
     );
   }
 
-  function renderRun(res, req, via) {
+  function renderRun(res, req, via, keepScale = false) {
     state.result = res;
     state.request = req;
     state.via = via;
@@ -514,32 +526,42 @@
     state.envelope = { peak_spacing_s: spacingS, values: env };
     state.resonance = omegaWind > 0 ? resonance(res.eigenvalues, omegaWind) : null;
 
+    // A run that diverged spans hundreds of decades: switch to the log scale.
+    if (!keepScale) $("#tr-log").checked = res.outcome === "diverged";
+    const log = $("#tr-log").checked;
     for (const p of Object.values(state.plots)) p?.destroy();
     const envLabel = "envelope ±|y|max (m)";
+    // Log scale: |y| itself cannot go on it; plot the API's max |y| per output
+    // interval instead (zeros left out).
     state.plots.tip = makePlot(
       $("#tr-plot-tip"),
-      [
-        { label: "t (s)", value: (u, v) => fmt(v, 4) },
-        { label: "tip deflection y (m)", stroke: COLORS.tip, width: 1, value: (u, v) => fmt(v) },
-        { label: envLabel, stroke: COLORS.envelope, width: 1.5, dash: [5, 3], value: (u, v) => fmt(v) },
-        { label: "−envelope (m)", stroke: COLORS.envelope, width: 1.5, dash: [5, 3], value: (u, v) => fmt(v) },
-      ],
-      [t, res.tip_deflection_m, env, env.map((v) => -v)],
+      log
+        ? [
+            { label: "t (s)", value: (u, v) => fmt(v, 4) },
+            { label: "max |y| per output interval (m)", stroke: COLORS.tip, width: 1.5, value: pow10 },
+          ]
+        : [
+            { label: "t (s)", value: (u, v) => fmt(v, 4) },
+            { label: "tip deflection y (m)", stroke: COLORS.tip, width: 1, value: (u, v) => fmt(v) },
+            { label: envLabel, stroke: COLORS.envelope, width: 1.5, dash: [5, 3], value: (u, v) => fmt(v) },
+            { label: "−envelope (m)", stroke: COLORS.envelope, width: 1.5, dash: [5, 3], value: (u, v) => fmt(v) },
+          ],
+      log ? [t, log10(res.tip_envelope_m)] : [t, res.tip_deflection_m, env, env.map((v) => -v)],
       "Time t (s)",
-      "Tip deflection y (m)",
-      { plugins: [resonanceMarker] },
+      log ? "max |y| (m), log scale" : "Tip deflection y (m)",
+      { plugins: [resonanceMarker], log },
     );
     state.plots.energy = makePlot(
       $("#tr-plot-energy"),
       [
         { label: "t (s)", value: (u, v) => fmt(v, 4) },
-        { label: "total energy E (J)", stroke: COLORS.energy, width: 2, value: (u, v) => fmt(v) },
-        { label: "without axial kinetic energy (J)", stroke: COLORS.vibration, width: 1.5, dash: [6, 4], value: (u, v) => fmt(v) },
+        { label: "total energy E (J)", stroke: COLORS.energy, width: 2, value: log ? pow10 : (u, v) => fmt(v) },
+        { label: "without axial kinetic energy (J)", stroke: COLORS.vibration, width: 1.5, dash: [6, 4], value: log ? pow10 : (u, v) => fmt(v) },
       ],
-      [t, res.energy_j, res.vibration_energy_j],
+      log ? [t, log10(res.energy_j), log10(res.vibration_energy_j)] : [t, res.energy_j, res.vibration_energy_j],
       "Time t (s)",
-      "Energy E (J)",
-      { plugins: [resonanceMarker] },
+      log ? "Energy E (J), log scale" : "Energy E (J)",
+      { plugins: [resonanceMarker], log },
     );
     const tEig = res.eigenvalues.map((e) => e.time_s);
     const freqSeries = [
@@ -577,6 +599,11 @@
       );
     } else {
       parts.push(` Peak |y| ${fmt(peakAt(-Infinity, Infinity))} m.`);
+    }
+    const unstable = res.eigenvalues.find((e) => !e.stable);
+    state.firstUnstable = unstable ? { time_s: unstable.time_s, length_m: unstable.length_m } : null;
+    if (unstable) {
+      parts.push(` The linearisation is first unstable at t ≈ ${fmt(unstable.time_s)} s (L ≈ ${fmt(unstable.length_m)} m, max Re λ = ${fmt(unstable.max_real_1_s)} 1/s).`);
     }
     out.replaceChildren(...parts);
     out.hidden = false;
@@ -750,6 +777,9 @@
     out.textContent = `t = ${fmt(L.t[j])} s, ω = ${fmt(L.w[i])} rad/s: envelope ${fmt(L.E[i][j])} m`;
   }
   $("#fr-smooth").addEventListener("change", drawHeatmap);
+  $("#tr-log").addEventListener("change", () => {
+    if (state.result) renderRun(state.result, state.request, state.via, true);
+  });
   $("#fr-heatmap").addEventListener("mousemove", heatReadout);
   $("#fr-heatmap").addEventListener("mouseleave", () => ($("#fr-heat-readout").innerHTML = "&nbsp;"));
 
