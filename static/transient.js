@@ -444,45 +444,53 @@
   // diverged run, so the data are plotted as log₁₀ on a linear axis whose
   // labels and legend values are shown as powers of ten.
   const log10 = (a) => a.map((v) => (v > 0 ? Math.log10(v) : null));
-  const pow10 = (u, v) => (v == null ? "–" : fmt(10 ** v));
-  const logAxis = {
-    ...axis,
-    values: (u, splits) =>
-      splits.map((v) => (Number.isInteger(v) ? (v >= -2 && v <= 4 ? String(Number((10 ** v).toPrecision(3))) : `1e${v}`) : fmt(10 ** v, 2))),
-  };
+  // 10^k as a short label: 0.01 … 10000 plainly, else 1e60 or 3.2e59.
+  function powLabel(k, digits = 2) {
+    if (k >= -2 && k <= 4) return String(Number((10 ** k).toPrecision(digits)));
+    const e = Math.floor(k + 1e-9);
+    const m = Number((10 ** (k - e)).toPrecision(digits));
+    return m === 1 ? `1e${e}` : m >= 10 ? `1e${e + 1}` : `${m}e${e}`;
+  }
+  const pow10 = (u, v) => (v == null ? "–" : powLabel(v, 3));
+  const logAxis = { ...axis, values: (u, splits) => splits.map((v) => powLabel(v)) };
 
   function plotSize(el, aspect = 0.6) {
     const width = Math.max(260, Math.floor(el.clientWidth));
     return { width, height: Math.round(Math.min(340, Math.max(240, width * aspect))) };
   }
 
-  // A vertical dashed line at state.resonance.time_s, labelled.
+  // Vertical dashed lines, labelled: where ω₁ passes the wind frequency, and
+  // where the eigenvalue track first shows an unstable mode.
   const resonanceMarker = {
     hooks: {
       draw: [
         (u) => {
-          const r = state.resonance;
-          if (!r) return;
-          const x = Math.round(u.valToPos(r.time_s, "x", true));
-          const { top, height } = u.bbox;
+          const marks = [];
+          if (state.resonance) marks.push([state.resonance.time_s, "ω₁ = ω", "#777"]);
+          if (state.firstUnstable) marks.push([state.firstUnstable.time_s, "Re λ > 0", "#b00020"]);
+          const dpr = devicePixelRatio;
+          const { top, height, left: bl, width: bw } = u.bbox;
           const ctx = u.ctx;
-          ctx.save();
-          ctx.strokeStyle = "#777";
-          ctx.setLineDash([4, 4]);
-          ctx.lineWidth = devicePixelRatio;
-          ctx.beginPath();
-          ctx.moveTo(x, top);
-          ctx.lineTo(x, top + height);
-          ctx.stroke();
-          ctx.setLineDash([]);
-          ctx.fillStyle = "#555";
-          ctx.font = `${11 * devicePixelRatio}px sans-serif`;
-          ctx.textBaseline = "top";
-          const label = "ω₁ = ω";
-          const w = ctx.measureText(label).width;
-          const left = x + 4 * devicePixelRatio + w > u.bbox.left + u.bbox.width ? x - 4 * devicePixelRatio - w : x + 4 * devicePixelRatio;
-          ctx.fillText(label, left, top + 4 * devicePixelRatio);
-          ctx.restore();
+          for (const [time, label, colour] of marks) {
+            const x = Math.round(u.valToPos(time, "x", true));
+            if (x < bl || x > bl + bw) continue;
+            ctx.save();
+            ctx.strokeStyle = colour;
+            ctx.setLineDash([4, 4]);
+            ctx.lineWidth = dpr;
+            ctx.beginPath();
+            ctx.moveTo(x, top);
+            ctx.lineTo(x, top + height);
+            ctx.stroke();
+            ctx.setLineDash([]);
+            ctx.fillStyle = colour;
+            ctx.font = `${11 * dpr}px sans-serif`;
+            ctx.textBaseline = "top";
+            const w = ctx.measureText(label).width;
+            const left = x + 4 * dpr + w > bl + bw ? x - 4 * dpr - w : x + 4 * dpr;
+            ctx.fillText(label, left, top + 4 * dpr);
+            ctx.restore();
+          }
         },
       ],
     },
@@ -525,6 +533,8 @@
     const env = peakEnvelope(res.tip_envelope_m, Math.max(1, Math.round(spacingS / dtSample)));
     state.envelope = { peak_spacing_s: spacingS, values: env };
     state.resonance = omegaWind > 0 ? resonance(res.eigenvalues, omegaWind) : null;
+    const unstable = res.eigenvalues.find((e) => !e.stable);
+    state.firstUnstable = unstable ? { time_s: unstable.time_s, length_m: unstable.length_m } : null;
 
     // A run that diverged spans hundreds of decades: switch to the log scale.
     if (!keepScale) $("#tr-log").checked = res.outcome === "diverged";
@@ -600,8 +610,6 @@
     } else {
       parts.push(` Peak |y| ${fmt(peakAt(-Infinity, Infinity))} m.`);
     }
-    const unstable = res.eigenvalues.find((e) => !e.stable);
-    state.firstUnstable = unstable ? { time_s: unstable.time_s, length_m: unstable.length_m } : null;
     if (unstable) {
       parts.push(` The linearisation is first unstable at t ≈ ${fmt(unstable.time_s)} s (L ≈ ${fmt(unstable.length_m)} m, max Re λ = ${fmt(unstable.max_real_1_s)} 1/s).`);
     }
@@ -677,9 +685,22 @@
     const w = res.frequencies_rad_s;
     const t = res.time_s;
     const E = heatValues(res);
+    // Colour: linear in |y| from 0, or log₁₀|y| over the decades present
+    // (automatic when a run diverged).
+    const logColour = $("#fr-log").checked;
     let max = 0;
-    for (const row of E) for (const v of row) if (Number.isFinite(v)) max = Math.max(max, v);
+    let minPos = Infinity;
+    for (const row of E) {
+      for (const v of row) {
+        if (!Number.isFinite(v)) continue;
+        max = Math.max(max, v);
+        if (v > 0) minPos = Math.min(minPos, v);
+      }
+    }
     if (!(max > 0)) max = 1;
+    const lo = logColour ? Math.log10(Math.max(minPos, max * 1e-300)) : 0;
+    const hi = logColour ? Math.log10(max) : max;
+    const scaleOf = (v) => (logColour ? (v > 0 ? (Math.log10(v) - lo) / (hi - lo || 1) : 0) : v / max);
     // Cells: one pixel per (time, frequency) in an offscreen image, scaled up.
     const img = document.createElement("canvas");
     img.width = t.length;
@@ -690,7 +711,7 @@
       const row = w.length - 1 - i; // ω increases upwards
       for (let j = 0; j < t.length; j++) {
         const v = E[i][j];
-        const [r, g, b] = Number.isFinite(v) ? colour(v / max) : [200, 200, 200];
+        const [r, g, b] = Number.isFinite(v) ? colour(scaleOf(v)) : [200, 200, 200];
         const k = 4 * (row * t.length + j);
         data.data[k] = r;
         data.data[k + 1] = g;
@@ -751,10 +772,12 @@
     ctx.strokeRect(bx + 0.5, m.top + 0.5, bw - 1, ph - 1);
     ctx.fillStyle = "#333";
     ctx.textAlign = "left";
-    for (const v of ticks(0, max, 5)) {
-      const y = m.top + ph - (v / max) * ph;
+    for (const v of ticks(lo, hi, 5)) {
+      if (logColour && !Number.isInteger(v)) continue;
+      const y = m.top + ph - ((v - lo) / (hi - lo || 1)) * ph;
       ctx.fillRect(bx + bw, y, 3, 1);
-      ctx.fillText(fmt(v, 2), bx + bw + 5, Math.min(m.top + ph - 5, Math.max(m.top + 5, y)));
+      const text = logColour ? (v >= -2 && v <= 3 ? fmt(10 ** v, 2) : `1e${v}`) : fmt(v, 2);
+      ctx.fillText(text, bx + bw + 5, Math.min(m.top + ph - 5, Math.max(m.top + 5, y)));
     }
     ctx.textAlign = "center";
     ctx.textBaseline = "top";
@@ -777,6 +800,7 @@
     out.textContent = `t = ${fmt(L.t[j])} s, ω = ${fmt(L.w[i])} rad/s: envelope ${fmt(L.E[i][j])} m`;
   }
   $("#fr-smooth").addEventListener("change", drawHeatmap);
+  $("#fr-log").addEventListener("change", drawHeatmap);
   $("#tr-log").addEventListener("change", () => {
     if (state.result) renderRun(state.result, state.request, state.via, true);
   });
@@ -789,16 +813,20 @@
     state.fr.via = via;
     const peak = res.envelope_m.map((row) => row.reduce((a, v) => (Number.isFinite(v) ? Math.max(a, v) : a), 0));
     state.fr.peak = { frequencies_rad_s: res.frequencies_rad_s.slice(), peak_m: peak };
+    $("#fr-log").checked = res.outcomes.includes("diverged");
     state.fr.plot?.destroy();
+    // Diverged runs peak at up to 1e100 m: then the peaks go on a log scale.
+    const log = res.outcomes.includes("diverged");
     state.fr.plot = makePlot(
       $("#fr-plot-peak"),
       [
         { label: "ω (rad/s)", value: (u, v) => fmt(v, 4) },
-        { label: "peak tip amplitude (m)", stroke: COLORS.tip, width: 2, points: { show: true, size: 7, fill: COLORS.tip }, value: (u, v) => fmt(v) },
+        { label: "peak tip amplitude (m)", stroke: COLORS.tip, width: 2, points: { show: true, size: 7, fill: COLORS.tip }, value: log ? pow10 : (u, v) => fmt(v) },
       ],
-      [res.frequencies_rad_s, peak],
+      [res.frequencies_rad_s, log ? log10(peak) : peak],
       "Wind frequency ω (rad/s)",
-      "Peak amplitude (m)",
+      log ? "Peak amplitude (m), log scale" : "Peak amplitude (m)",
+      { log },
     );
     drawHeatmap();
     $("#fr-csv").disabled = false;
