@@ -8,9 +8,10 @@
 // plotted tip deflection, that the envelope after the resonance (first natural
 // frequency = wind frequency) is larger than before it, the energy plot, the outcome
 // and the CSV; runs a 4-frequency response directly and a 24-frequency one as a job
-// (progress), cancels a large job, puts one invalid input in each panel and checks the
-// API's error beside the field, repeats at phone width (375 px), and fails on any
-// console error. Screenshots: tests/artifacts/transient_page*.png.
+// (progress), cancels a large job, puts invalid inputs in each panel (and the chart
+// form's cable) and checks the API's error beside the field, runs a long transient as
+// a job and an unstable deployment (diverged, log scale), repeats at phone width
+// (375 px), and fails on any console error. Screenshots: tests/artifacts/transient_page*.png.
 // Exit status 0 on success, 1 on a failed check, 2 on bad usage.
 
 import { chromium } from "playwright-core";
@@ -248,6 +249,50 @@ try {
   check(/not a number/.test(await durError.textContent()), `page-side error next to the duration: “${await durError.textContent()}”`);
   await page.fill("#tr-duration", "60");
 
+  // A system field (cable, in the chart form above) refused by the transient route.
+  await page.fill("#mass-per-length", "0");
+  await page.click("#tr-run");
+  const cableError = page.locator('.field:has(#mass-per-length) .field-error[data-source="transient"]');
+  await cableError.waitFor({ timeout: 30_000 });
+  check((await cableError.getAttribute("data-error-for")) === "cable.mass_per_length_kg_m", `transient error on the chart form's ρA: “${await cableError.textContent()}”`);
+  check(/chart form above/.test(await page.textContent("#tr-status")), `status points at the chart form: “${await page.textContent("#tr-status")}”`);
+  await page.fill("#mass-per-length", "0.078");
+  check((await cableError.count()) === 0, "ρA error clears when edited");
+
+  // ---------- a long transient run goes through a job ----------
+  phase = "transient-job";
+  await page.fill("#tr-duration", "700");
+  check(/background job/.test(await page.textContent("#tr-hint")), `hint announces a job: “${await page.textContent("#tr-hint")}”`);
+  if (await runDefaultTransient(page)) {
+    const j = await page.evaluate(() => ({ via: window.tetherplanTransient.via, progress: window.tetherplanTransient.jobProgress.slice(), n: window.tetherplanTransient.result.time_s.length }));
+    const last = j.progress.at(-1);
+    check(/^job /.test(j.via ?? "") && j.n === 1000, `700 s run came from a ${j.via} (${j.n} samples)`);
+    check(last && last[0] === "done" && last[1] === 1, `transient job progress reported (${j.progress.map(([s, p]) => `${s} ${p.toFixed(2)}`).join(", ")})`);
+    check(await page.isHidden("#tr-job"), "transient progress bar hidden once done");
+  }
+  await page.fill("#tr-duration", "60");
+
+  // ---------- an unstable deployment: diverged, shown on a log scale ----------
+  phase = "diverged";
+  await page.selectOption("#tr-profile", "trapezoidal");
+  await page.fill("#tr-cruise", "10");
+  await page.fill("#tr-target", "2000");
+  await page.selectOption("#tr-wind", "power_law");
+  await page.fill("#tr-duration", "250");
+  if (await runDefaultTransient(page)) {
+    const d = await page.evaluate(() => {
+      const s = window.tetherplanTransient;
+      return { outcome: s.result.outcome, unstable: s.firstUnstable, log: document.querySelector("#tr-log").checked, ys: Array.from(s.plots.tip.data[1]).filter((v) => v != null) };
+    });
+    check(d.outcome === "diverged" && (await page.getAttribute("#tr-outcome", "data-outcome")) === "diverged", "10 m/s to 2 km under 0.1 z^(1/3) diverges");
+    check(d.unstable && d.unstable.length_m > 1100 && d.unstable.length_m < 1500, `first unstable at L ≈ ${d.unstable?.length_m?.toFixed(0)} m (critical length for 10 m/s ≈ 1.3 km)`);
+    check(d.log && Math.max(...d.ys) > 10, `log scale switched on (log₁₀ max |y| = ${Math.max(...d.ys).toFixed(1)})`);
+    await page.locator("#transient-run").screenshot({ path: path.join(artifacts, "transient_page_diverged.png") });
+  }
+  await page.fill("#tr-duration", "60");
+  await page.fill("#tr-cruise", "1");
+  await page.fill("#tr-target", "40");
+
   // The other panel options produce valid requests.
   phase = "options";
   await page.selectOption("#tr-profile", "trapezoidal");
@@ -288,5 +333,5 @@ try {
 }
 
 console.log(failures.length ? `${failures.length} check(s) failed` : "all browser checks passed");
-console.log(`screenshots: ${path.join(artifacts, "transient_page.png")}, transient_page_panels.png, transient_page_error.png, transient_page_375.png`);
+console.log(`screenshots: ${path.join(artifacts, "transient_page.png")}, transient_page_panels.png, transient_page_error.png, transient_page_diverged.png, transient_page_375.png`);
 process.exit(failures.length ? 1 : 0);
