@@ -159,11 +159,14 @@
     return null;
   }
 
-  // Eigenvalue solves along the run: enough to place the resonance, few enough
-  // to stay cheap on fine meshes.
+  // Eigenvalue solves along the run (dense QEP of size 2n): enough to place the
+  // resonance, few enough to stay cheap; none above 400 elements, where each
+  // solve takes seconds.
+  const EIGEN_MAX_ELEMENTS = 400;
   function eigenTracking(req) {
-    const solves = (req.model.elements || 50) > 200 ? 40 : 150;
-    return { interval_s: req.duration_s / solves, count: 1 };
+    const n = req.model.elements || 50;
+    if (n > EIGEN_MAX_ELEMENTS) return undefined;
+    return { interval_s: req.duration_s / (n > 200 ? 40 : 150), count: 1 };
   }
 
   function readSimulateRequest(errors) {
@@ -175,7 +178,10 @@
     const flow = readFlow(errors);
     const body = readBody(errors);
     if (flow) req.aero = { flow, ...body };
-    if (req.duration_s > 0) req.eigenvalues = eigenTracking(req);
+    if (req.duration_s > 0) {
+      const track = eigenTracking(req);
+      if (track) req.eigenvalues = track;
+    }
     return req;
   }
 
@@ -486,6 +492,7 @@
             ctx.fillStyle = colour;
             ctx.font = `${11 * dpr}px sans-serif`;
             ctx.textBaseline = "top";
+            ctx.textAlign = "left";
             const w = ctx.measureText(label).width;
             const left = x + 4 * dpr + w > bl + bw ? x - 4 * dpr - w : x + 4 * dpr;
             ctx.fillText(label, left, top + 4 * dpr);
@@ -616,7 +623,8 @@
     out.replaceChildren(...parts);
     out.hidden = false;
     $("#tr-csv").disabled = false;
-    setRunStatus("ready", `${t.length} samples, ${res.steps} steps of ${fmt(res.time_step_s)} s, ${res.elements} elements${via && via !== "direct" ? ` (${via})` : ""}.`);
+    const noTrack = req.eigenvalues ? "" : ` (natural frequencies not tracked above ${EIGEN_MAX_ELEMENTS} elements)`;
+    setRunStatus("ready", `${t.length} samples, ${res.steps} steps of ${fmt(res.time_step_s)} s, ${res.elements} elements${noTrack}${via && via !== "direct" ? ` (${via})` : ""}.`);
   }
 
   // ---------- heat map ----------
