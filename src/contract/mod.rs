@@ -17,14 +17,7 @@ use crate::numerics::params::InvalidInput;
 /// Parses a request body (system part and parameters); errors name the
 /// offending field path.
 pub fn parse<T: dto::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
-    let value: serde_json::Value =
-        serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
-    if !value.is_object() {
-        return Err(RequestError::Invalid(InvalidInput::new(
-            "body",
-            "must be a JSON object",
-        )));
-    }
+    let value = json_object(body)?;
     let system = parse_value::<dto::SystemInput>(&value)?;
     let params = parse_value::<T::Params>(&value)?;
     Ok(T::from_parts(system, params))
@@ -32,6 +25,11 @@ pub fn parse<T: dto::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
 
 /// Parses a body that has no flattened parts (one pass, field paths kept).
 pub fn parse_plain<T: serde::de::DeserializeOwned>(body: &[u8]) -> Result<T, RequestError> {
+    parse_value(&json_object(body)?)
+}
+
+/// The body as a JSON object (400 when it is not JSON, 422 when it is not an object).
+fn json_object(body: &[u8]) -> Result<serde_json::Value, RequestError> {
     let value: serde_json::Value =
         serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
     if !value.is_object() {
@@ -40,7 +38,7 @@ pub fn parse_plain<T: serde::de::DeserializeOwned>(body: &[u8]) -> Result<T, Req
             "must be a JSON object",
         )));
     }
-    parse_value(&value)
+    Ok(value)
 }
 
 /// Deserialises `T` from a JSON value with the error's field path.

@@ -139,17 +139,7 @@ impl ReducedModel {
     }
 
     pub fn coefficients(&self, s: NondimState) -> MatrixCoefficients {
-        let ft = self.system.buoyancy_ratio();
-        let mt = self.system.mass_ratio();
-        MatrixCoefficients {
-            mass_scale: s.length,
-            tip_mass: mt,
-            damping_scale: 2.0 * s.rate,
-            conv_stiffness: s.acceleration,
-            quad_stiffness: s.rate * s.rate / s.length,
-            tension_top: (1.0 - mt * s.acceleration) / s.length,
-            tension_slope: -(1.0 / ft + s.acceleration),
-        }
+        crate::numerics::string::state_coefficients(&self.system, s)
     }
 
     /// `(m, c, k)` of the projected equation at a state.

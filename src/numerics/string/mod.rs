@@ -27,6 +27,23 @@ pub fn validate_elements(field: &str, elements: usize) -> Result<usize, InvalidI
     Ok(elements)
 }
 
+/// Coefficients of `M, C, K` of the cable–aerostat system at the
+/// non-dimensional state (app. A, with the `l̇` factor of `C` restored):
+/// `T(ζ) = 1/l − m̃ l̈/l − (1/F̃ + l̈)(1−ζ)`.
+pub fn state_coefficients(system: &AerostatSystem, s: NondimState) -> MatrixCoefficients {
+    let ft = system.buoyancy_ratio();
+    let mt = system.mass_ratio();
+    MatrixCoefficients {
+        mass_scale: s.length,
+        tip_mass: mt,
+        damping_scale: 2.0 * s.rate,
+        conv_stiffness: s.acceleration,
+        quad_stiffness: s.rate * s.rate / s.length,
+        tension_top: (1.0 - mt * s.acceleration) / s.length,
+        tension_slope: -(1.0 / ft + s.acceleration),
+    }
+}
+
 /// A discretised cable–aerostat system.
 #[derive(Clone, Debug)]
 pub struct StringModel {
@@ -52,21 +69,10 @@ impl StringModel {
         self.operators.dim()
     }
 
-    /// Coefficients of `M, C, K` at the non-dimensional state (app. A,
-    /// with the `l̇` factor of `C` restored):
-    /// `T(ζ) = 1/l − m̃ l̈/l − (1/F̃ + l̈)(1−ζ)`.
+    /// Coefficients of `M, C, K` at the non-dimensional state: see
+    /// [`state_coefficients`].
     pub fn coefficients(&self, s: NondimState) -> MatrixCoefficients {
-        let ft = self.system.buoyancy_ratio();
-        let mt = self.system.mass_ratio();
-        MatrixCoefficients {
-            mass_scale: s.length,
-            tip_mass: mt,
-            damping_scale: 2.0 * s.rate,
-            conv_stiffness: s.acceleration,
-            quad_stiffness: s.rate * s.rate / s.length,
-            tension_top: (1.0 - mt * s.acceleration) / s.length,
-            tension_slope: -(1.0 / ft + s.acceleration),
-        }
+        state_coefficients(&self.system, s)
     }
 
     pub fn matrices(&self, s: NondimState) -> SecondOrderSystem {
