@@ -139,3 +139,36 @@ fn simulate_dispatches_on_the_model_kind() {
     assert_eq!(code, 2);
     assert_eq!(json["error"]["field"], "model.elements");
 }
+
+#[test]
+fn ge_chart_and_base_excitation_from_stdin() {
+    // Table 7.1, 10 elements, two fast rates: t* a few seconds each.
+    let chart = r#"{"cable": {"mass_per_length_kg_m": 0.078},
+     "aerostat": {"net_buoyancy_n": 1000, "mass_kg": 10},
+     "model": {"kind": "geometrically_exact", "elements": 10, "bending_stiffness_n_m2": 1000},
+     "stiffness_ratios": [1e5],
+     "rates_m_s": {"min": 100, "max": 150, "count": 2}}"#;
+    let (code, json) = run(&["chart"], chart);
+    assert_eq!(code, 0, "{json}");
+    let points = &json["series"][0]["points"];
+    assert_eq!(points[0]["onset"], "during");
+    assert_eq!(
+        points[1]["onset"], "immediate",
+        "150 m/s is above the wave speed"
+    );
+    assert_eq!(points[1]["critical_time_s"], 0.0);
+    let bad = chart.replace("[1e5]", "[0]");
+    let (code, json) = run(&["chart"], &bad);
+    assert_eq!(code, 2);
+    assert_eq!(json["error"]["field"], "stiffness_ratios[0]");
+
+    let base = r#"{"excitation": "base", "cable": {"mass_per_length_kg_m": 0.078},
+     "model": {"kind": "geometrically_exact", "elements": 10, "bending_stiffness_n_m2": 1000,
+               "stiffness_ratio": 5, "inertia_ratio": 1},
+     "amplitude_m": 0.001, "frequencies_rad_s": {"min": 100, "max": 400, "count": 2},
+     "duration_s": 0.1, "time_step_s": 0.0005}"#;
+    let (code, json) = run(&["frequency-response"], base);
+    assert_eq!(code, 0, "{json}");
+    assert_eq!(json["points"].as_array().unwrap().len(), 2);
+    assert_eq!(json["reduced_model_bands"].as_array().unwrap().len(), 2);
+}
