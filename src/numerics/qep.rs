@@ -49,6 +49,20 @@ pub enum QepError {
 }
 
 impl Spectrum {
+    /// The spectrum of these eigenvalues, with its largest real part and radius.
+    pub fn from_eigenvalues(eigenvalues: Vec<Eigenvalue>) -> Self {
+        let max_real = eigenvalues
+            .iter()
+            .map(|e| e.re)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let spectral_radius = eigenvalues.iter().map(Eigenvalue::abs).fold(0.0, f64::max);
+        Self {
+            eigenvalues,
+            max_real,
+            spectral_radius,
+        }
+    }
+
     pub fn tolerance(&self) -> f64 {
         STABILITY_RTOL * self.spectral_radius.max(1.0)
     }
@@ -107,21 +121,12 @@ pub fn solve(system: &SecondOrderSystem) -> Result<Spectrum, QepError> {
         }
     });
     let (re, im) = eigenvalues_real(&companion)?;
-    let eigenvalues: Vec<Eigenvalue> = re
-        .into_iter()
-        .zip(im)
-        .map(|(re, im)| Eigenvalue { re, im })
-        .collect();
-    let max_real = eigenvalues
-        .iter()
-        .map(|e| e.re)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let spectral_radius = eigenvalues.iter().map(Eigenvalue::abs).fold(0.0, f64::max);
-    Ok(Spectrum {
-        eigenvalues,
-        max_real,
-        spectral_radius,
-    })
+    Ok(Spectrum::from_eigenvalues(
+        re.into_iter()
+            .zip(im)
+            .map(|(re, im)| Eigenvalue { re, im })
+            .collect(),
+    ))
 }
 
 /// Eigenvalues of a real square matrix, sequential faer.

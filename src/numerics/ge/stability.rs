@@ -70,22 +70,13 @@ fn spectrum_of(model: &GeModel, sys: SystemMatrices) -> Result<Spectrum, QepErro
         }
     });
     let (re, im) = qep::eigenvalues_real(&companion)?;
-    let eigenvalues: Vec<Eigenvalue> = re
-        .into_iter()
-        .zip(im)
-        .map(|(re, im)| Eigenvalue {
-            re: sigma * re,
-            im: sigma * im,
-        })
-        .collect();
-    let max_real = eigenvalues
-        .iter()
-        .map(|e| e.re)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let spectral_radius = eigenvalues.iter().map(Eigenvalue::abs).fold(0.0, f64::max);
-    Ok(Spectrum {
-        eigenvalues,
-        max_real,
-        spectral_radius,
-    })
+    Ok(Spectrum::from_eigenvalues(
+        re.into_iter()
+            .zip(im)
+            .map(|(re, im)| Eigenvalue {
+                re: sigma * re,
+                im: sigma * im,
+            })
+            .collect(),
+    ))
 }
