@@ -11,11 +11,11 @@ pub struct CableInput {
     /// Mass per unit length ρA (kg/m).
     #[schema(example = 0.078, exclusive_minimum = 0.0)]
     pub mass_per_length_kg_m: Option<f64>,
-    /// Material density ρ (kg/m³), with `area_m2`.
-    #[schema(example = 7800.0, exclusive_minimum = 0.0)]
+    /// Material density ρ (kg/m³), with `area_m2` (e.g. 7800 for steel).
+    #[schema(exclusive_minimum = 0.0)]
     pub density_kg_m3: Option<f64>,
-    /// Cross-section area A (m²), with `density_kg_m3`.
-    #[schema(example = 1e-5, exclusive_minimum = 0.0)]
+    /// Cross-section area A (m²), with `density_kg_m3` (e.g. 1e-5).
+    #[schema(exclusive_minimum = 0.0)]
     pub area_m2: Option<f64>,
 }
 
