@@ -1,9 +1,16 @@
-//! Browser test of the chart page: starts `tetherplan serve` on a free
+//! Browser tests of the page. Each starts `tetherplan serve` on a free
 //! loopback port with a fresh database and the repository's `static/`, then
-//! runs `node tests/browser/chart_page.mjs <url>` (playwright-core driving
-//! Debian's Chromium), which submits the default form, checks the plotted
-//! curves, an error rendered next to its field and the console, and saves
-//! screenshots under `tests/artifacts/`.
+//! runs a script under `tests/browser/` (playwright-core driving Debian's
+//! Chromium) against it; screenshots go to `tests/artifacts/`.
+//!
+//! * `chart_page.mjs` submits the default chart form, checks the plotted
+//!   curves, an error rendered next to its field and the console.
+//! * `transient_page.mjs` runs the default transient (thesis Fig 4.5) and
+//!   checks the resonance in the plotted envelope, runs a small frequency
+//!   response directly and a larger one as a job, checks API errors next to
+//!   their fields, the phone layout and the console.
+//!
+//! The two run one after the other (a lock), not side by side on 2 cores.
 //!
 //! Needs `/usr/bin/chromium` (or `$CHROMIUM`), `node`, and
 //! `npm ci --prefix tests/browser`. When one is missing the test fails if
@@ -83,13 +90,15 @@ fn healthy(port: u16) -> bool {
     response.starts_with("HTTP/1.1 200")
 }
 
-fn start_server() -> (Server, String) {
+fn start_server(label: &str) -> (Server, String) {
     let stamp = SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .map(|d| d.as_nanos())
         .unwrap_or(0);
-    let dir =
-        std::env::temp_dir().join(format!("tetherplan-browser-{}-{stamp}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!(
+        "tetherplan-browser-{label}-{}-{stamp}",
+        std::process::id()
+    ));
     std::fs::create_dir_all(&dir).expect("temporary directory");
     let log = std::fs::File::create(dir.join("server.log")).expect("server log file");
     let port = free_port();
@@ -127,25 +136,32 @@ fn server_log(server: &Server) -> String {
     std::fs::read_to_string(server.dir.join("server.log")).unwrap_or_default()
 }
 
-#[test]
-fn chart_page_in_headless_chromium() {
+/// Serialises the browser tests.
+static ONE_BROWSER_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Runs `tests/browser/<script>` against a fresh server; skips (or, with
+/// `CI` set, fails) when a prerequisite is missing.
+fn run_page_script(script: &str) {
+    let _turn = ONE_BROWSER_AT_A_TIME
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
     let chromium = std::env::var_os("CHROMIUM")
         .map(PathBuf::from)
         .unwrap_or_else(|| "/usr/bin/chromium".into());
     if let Some(what) = missing_prerequisite(&chromium) {
         if std::env::var_os("CI").is_some() {
-            panic!("browser test cannot run in CI: {what}");
+            panic!("browser test {script} cannot run in CI: {what}");
         }
         // Straight to stderr: libtest would swallow println! of a passing test.
         let _ = writeln!(
             std::io::stderr(),
-            "skipped: browser test: {what} (set CI to make this a failure)"
+            "skipped: browser test {script}: {what} (set CI to make this a failure)"
         );
         return;
     }
-    let (server, url) = start_server();
+    let (server, url) = start_server(script.trim_end_matches(".mjs"));
     let status = Command::new("node")
-        .arg(repo().join("tests/browser/chart_page.mjs"))
+        .arg(repo().join("tests/browser").join(script))
         .arg(&url)
         .env("CHROMIUM", &chromium)
         .stdin(Stdio::null())
@@ -153,7 +169,17 @@ fn chart_page_in_headless_chromium() {
         .expect("run node");
     assert!(
         status.success(),
-        "browser checks failed ({status}); screenshots in tests/artifacts/; server log:\n{}",
+        "browser checks of {script} failed ({status}); screenshots in tests/artifacts/; server log:\n{}",
         server_log(&server)
     );
+}
+
+#[test]
+fn chart_page_in_headless_chromium() {
+    run_page_script("chart_page.mjs");
+}
+
+#[test]
+fn transient_page_in_headless_chromium() {
+    run_page_script("transient_page.mjs");
 }
