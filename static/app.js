@@ -5,6 +5,7 @@
 "use strict";
 
 (function () {
+  const { clearFieldError, fieldMessage, showFormError, unwrapJobError, api } = window.tetherplanCommon;
   // Charts with more work than this (points × elements; 5000 points at 50 elements)
   // run as a background job with progress; so does any chart the direct route
   // refuses as too large (422 `too_large`) or while the server is busy (503).
@@ -134,21 +135,8 @@
     }
   }
 
-  function clearFieldError(input) {
-    const box = input.closest(".field");
-    box?.querySelector(".field-error")?.remove();
-    input.removeAttribute("aria-invalid");
-    input.removeAttribute("aria-describedby");
-  }
-
   // The API's message starts with the field path, which the label already says:
   // keep the reason, and say which entry of a list is meant.
-  function fieldMessage(field, message) {
-    let text = message.startsWith(`${field}: `) ? message.slice(field.length + 2) : message;
-    const index = /\[(\d+)\]$/.exec(field);
-    if (index) text = `entry ${Number(index[1]) + 1}: ${text}`;
-    return text;
-  }
 
   // Shows `message` under the input that `field` names; returns false when no input matches.
   function showFieldError(field, message) {
@@ -164,11 +152,6 @@
     input.setAttribute("aria-invalid", "true");
     input.setAttribute("aria-describedby", p.id);
     return true;
-  }
-
-  function showFormError(el, message) {
-    el.textContent = message;
-    el.hidden = !message;
   }
 
   // Renders an API error body ({error: {code, field, message}}): next to its field
@@ -187,27 +170,6 @@
 
   // ---------- HTTP ----------
 
-  async function api(method, path, body) {
-    let res;
-    try {
-      res = await fetch(path, {
-        method,
-        headers: body === undefined ? {} : { "content-type": "application/json" },
-        body: body === undefined ? undefined : JSON.stringify(body),
-      });
-    } catch (e) {
-      return { ok: false, status: 0, body: { error: { code: "network", field: null, message: `cannot reach the server (${e.message})` } } };
-    }
-    let data = null;
-    const text = await res.text();
-    try {
-      data = text ? JSON.parse(text) : null;
-    } catch {
-      data = { error: { code: "bad_response", field: null, message: `HTTP ${res.status}: ${text.slice(0, 200)}` } };
-    }
-    return { ok: res.ok, status: res.status, body: data, headers: res.headers };
-  }
-
   function setStatus(kind, text) {
     // Plots of an earlier request are dimmed until a new answer replaces them.
     if (kind === "ready") delete $("#results").dataset.stale;
@@ -225,13 +187,6 @@
 
   // A submission names fields inside its `request` (`request.rates_m_s.count`):
   // drop that prefix so the error lands on the form's input.
-  function unwrapJobError(body) {
-    const err = body?.error;
-    if (!err || typeof err.field !== "string" || !err.field.startsWith("request.")) return body;
-    const field = err.field.slice("request.".length);
-    const message = err.message.startsWith(`${err.field}: `) ? `${field}: ${err.message.slice(err.field.length + 2)}` : err.message;
-    return { error: { ...err, field, message } };
-  }
 
   // Runs a chart as a background job, showing its progress; resolves to the chart
   // answer, or to {error} when the job fails, is cancelled, or cannot be submitted.

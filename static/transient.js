@@ -9,6 +9,7 @@
 "use strict";
 
 (function () {
+  const { clearFieldError, fieldMessage, showFormError, unwrapJobError, api } = window.tetherplanCommon;
   // The server answers at most this many frequencies directly (api/solve.rs,
   // MAX_SYNC_FREQUENCIES); more run as a job.
   const SYNC_FREQUENCIES = 16;
@@ -219,20 +220,6 @@
     for (const el of document.querySelectorAll('#transient [aria-invalid]')) el.removeAttribute("aria-invalid");
   }
 
-  function clearFieldError(input) {
-    const box = input.closest(".field");
-    box?.querySelector(".field-error")?.remove();
-    input.removeAttribute("aria-invalid");
-    input.removeAttribute("aria-describedby");
-  }
-
-  function fieldMessage(field, message) {
-    let text = message.startsWith(`${field}: `) ? message.slice(field.length + 2) : message;
-    const index = /\[(\d+)\]$/.exec(field);
-    if (index) text = `entry ${Number(index[1]) + 1}: ${text}`;
-    return text;
-  }
-
   function showFieldError(field, message) {
     const input = inputFor(field);
     if (!input) return null;
@@ -249,19 +236,7 @@
     return input;
   }
 
-  function showFormError(el, message) {
-    el.textContent = message;
-    el.hidden = !message;
-  }
-
   // A job submission names fields inside its `request`: drop the prefix.
-  function unwrapJobError(body) {
-    const err = body?.error;
-    if (!err || typeof err.field !== "string" || !err.field.startsWith("request.")) return body;
-    const field = err.field.slice("request.".length);
-    const message = err.message.startsWith(`${err.field}: `) ? `${field}: ${err.message.slice(err.field.length + 2)}` : err.message;
-    return { error: { ...err, field, message } };
-  }
 
   // Renders an API error body next to its field (or in `fallback`); returns a summary.
   function renderApiError(status, body, fallback) {
@@ -284,27 +259,6 @@
   }
 
   // ---------- HTTP and jobs ----------
-
-  async function api(method, path, body) {
-    let res;
-    try {
-      res = await fetch(path, {
-        method,
-        headers: body === undefined ? {} : { "content-type": "application/json" },
-        body: body === undefined ? undefined : JSON.stringify(body),
-      });
-    } catch (e) {
-      return { ok: false, status: 0, body: { error: { code: "network", field: null, message: `cannot reach the server (${e.message})` } } };
-    }
-    const text = await res.text();
-    let data = null;
-    try {
-      data = text ? JSON.parse(text) : null;
-    } catch {
-      data = { error: { code: "bad_response", field: null, message: `HTTP ${res.status}: ${text.slice(0, 200)}` } };
-    }
-    return { ok: res.ok, status: res.status, body: data };
-  }
 
   const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
   // The direct route cannot answer this one: run it as a job instead.
