@@ -317,24 +317,37 @@ struct Prepared {
     time_scale_s: f64,
 }
 
+impl GeModelInput {
+    /// The section from the model's ratios (E*, γ̃, optional shear ratio),
+    /// the cable's mass per length (kg/m) and the length scale L0 (m).
+    pub fn section(
+        &self,
+        mass_per_length_kg_m: f64,
+        initial_length_m: f64,
+    ) -> Result<Section, InvalidInput> {
+        let mut section = Section::from_ratios(
+            self.bending_stiffness_n_m2,
+            self.stiffness_ratio,
+            self.inertia_ratio,
+            mass_per_length_kg_m,
+            initial_length_m,
+        )?;
+        if let Some(gs) = self.shear_stiffness_ratio {
+            section.shear_stiffness_n = require_positive("model.shear_stiffness_ratio", gs)?
+                * section.bending_stiffness_n_m2
+                / (initial_length_m * initial_length_m);
+        }
+        Ok(section)
+    }
+}
+
 fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
     let rho_a = req.cable.mass_per_length()?;
     let l0 = require_positive("initial_length_m", req.initial_length_m)?;
     let g = require_non_negative("gravity_m_s2", req.gravity_m_s2)?;
     let buoyancy = require_non_negative("aerostat.net_buoyancy_n", req.aerostat.net_buoyancy_n)?;
     let m = &req.model;
-    let mut section = Section::from_ratios(
-        m.bending_stiffness_n_m2,
-        m.stiffness_ratio,
-        m.inertia_ratio,
-        rho_a,
-        l0,
-    )?;
-    if let Some(gs) = m.shear_stiffness_ratio {
-        section.shear_stiffness_n = require_positive("model.shear_stiffness_ratio", gs)?
-            * section.bending_stiffness_n_m2
-            / (l0 * l0);
-    }
+    let section = m.section(rho_a, l0)?;
     let tip = TipBody {
         mass_kg: require_non_negative("aerostat.mass_kg", req.aerostat.mass_kg)?,
         link_length_m: require_non_negative("aerostat.link_length_m", req.aerostat.link_length_m)?,

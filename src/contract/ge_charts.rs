@@ -21,7 +21,7 @@ use crate::numerics::ge::chart::{
 use crate::numerics::ge::critical::{CriticalConfig, GeOnset};
 use crate::numerics::ge::element::TipLoad;
 use crate::numerics::ge::solver::{LengthHistory, NewtonConfig};
-use crate::numerics::ge::{GeModel, Section, TipBody};
+use crate::numerics::ge::{GeModel, TipBody};
 use crate::numerics::ge_reduced;
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 use crate::numerics::profile::Profile;
@@ -673,18 +673,7 @@ pub fn ge_base_frequency_response(
     let l0 = require_positive("initial_length_m", req.initial_length_m)?;
     let g = require_non_negative("gravity_m_s2", req.gravity_m_s2)?;
     let m = &req.model;
-    let mut section = Section::from_ratios(
-        m.bending_stiffness_n_m2,
-        m.stiffness_ratio,
-        m.inertia_ratio,
-        rho_a,
-        l0,
-    )?;
-    if let Some(gs) = m.shear_stiffness_ratio {
-        section.shear_stiffness_n = require_positive("model.shear_stiffness_ratio", gs)?
-            * section.bending_stiffness_n_m2
-            / (l0 * l0);
-    }
+    let section = m.section(rho_a, l0)?;
     let (tip, steady) = match &req.aerostat {
         None => (TipBody::default(), TipLoad::default()),
         Some(a) => (
