@@ -489,18 +489,11 @@ pub fn static_solve(
                 });
             }
             let s = system_matrices(&scaled_model, kin, l, 0.0, &q, &zero, &zero).stiffness;
-            let Some(lu) = s.factor() else {
-                return Err(NewtonFailure {
-                    time_s: 0.0,
-                    iterations,
-                    residual_norm: rn,
-                });
-            };
-            let mut dq: Vec<f64> = r.total.iter().map(|x| -x).collect();
-            lu.solve_in_place(&mut dq);
-            for i in 0..n {
-                q[i] += dq[i];
-            }
+            let dq = newton_correction(s, &r.total, &mut q).ok_or(NewtonFailure {
+                time_s: 0.0,
+                iterations,
+                residual_norm: rn,
+            })?;
             iterations += 1;
             if at_roundoff(&dq, &q, kin.length_m) {
                 break;
@@ -512,6 +505,18 @@ pub fn static_solve(
 
 /// The Newton correction is at the roundoff level of the unknowns: the
 /// residual cannot be reduced further (stiff cables: `EA·ε` per element).
+/// One Newton update: solves `tangent · Δq = −residual`, adds `Δq` to `q`
+/// and returns it; `None` when the tangent is singular.
+fn newton_correction(tangent: Band, residual: &[f64], q: &mut [f64]) -> Option<Vec<f64>> {
+    let lu = tangent.factor()?;
+    let mut dq: Vec<f64> = residual.iter().map(|x| -x).collect();
+    lu.solve_in_place(&mut dq);
+    for (qi, di) in q.iter_mut().zip(&dq) {
+        *qi += di;
+    }
+    Some(dq)
+}
+
 fn at_roundoff(dq: &[f64], q: &[f64], length: f64) -> bool {
     let big = q.iter().fold(length, |m, x| m.max(x.abs()));
     dq.iter().all(|d| d.abs() <= 1e-13 * big)
@@ -623,18 +628,11 @@ impl<'a> Integrator<'a> {
                 y,
                 alpha_v * aero.damping_n_s_m + alpha_a * aero.added_mass_kg,
             );
-            let Some(lu) = tangent.clone().factor() else {
-                return Err(NewtonFailure {
-                    time_s: t1,
-                    iterations,
-                    residual_norm: rn,
-                });
-            };
-            let mut dq: Vec<f64> = r.total.iter().map(|x| -x).collect();
-            lu.solve_in_place(&mut dq);
-            for i in 0..n {
-                q[i] += dq[i];
-            }
+            let dq = newton_correction(tangent.clone(), &r.total, &mut q).ok_or(NewtonFailure {
+                time_s: t1,
+                iterations,
+                residual_norm: rn,
+            })?;
             iterations += 1;
             if at_roundoff(&dq, &q, kin.length_m) {
                 for i in 0..n {
