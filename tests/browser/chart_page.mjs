@@ -11,59 +11,26 @@
 // go to tests/artifacts/ (chart_page.png, chart_page_375.png).
 // Exit status 0 on success, 1 on a failed check, 2 on bad usage.
 
-import { chromium } from "playwright-core";
-import { mkdirSync, readFileSync } from "node:fs";
+import { readFileSync } from "node:fs";
 import path from "node:path";
-import { fileURLToPath } from "node:url";
+import { checker, launch, target, watchConsole } from "./harness.mjs";
 
-const url = process.argv[2];
-if (!url) {
-  console.error("usage: node chart_page.mjs <base url of a running tetherplan serve>");
-  process.exit(2);
-}
-const here = path.dirname(fileURLToPath(import.meta.url));
-const artifacts = path.resolve(here, "..", "artifacts");
-mkdirSync(artifacts, { recursive: true });
-const executablePath = process.env.CHROMIUM || "/usr/bin/chromium";
+const { url, artifacts } = target("chart_page.mjs");
 
 // The value the thesis chart gives for F = 1000 N, ρA = 0.078 kg/m, m = 10 kg,
 // L0 = 1 m, v = 10 m/s, 50 elements.
 const EXPECTED_H_M = 1310;
 const TOLERANCE = 0.01;
 
-const failures = [];
-function check(ok, what) {
-  console.log(`${ok ? "ok  " : "FAIL"} ${what}`);
-  if (!ok) failures.push(what);
-}
+const { failures, check } = checker();
 
-// Flags from NOTES.md; playwright gives Chromium its own fresh, temporary profile
-// (the equivalent of --user-data-dir=$(mktemp -d)).
-const browser = await chromium.launch({
-  executablePath,
-  headless: true,
-  args: [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-  ],
-});
+const browser = await launch();
 
 // Console errors and page errors, with the phase they happened in. The invalid-input
 // phase expects the browser's own "Failed to load resource: … status of 422" line.
 const consoleErrors = [];
 let phase = "load";
-function watch(page) {
-  page.on("console", (msg) => {
-    if (msg.type() === "error") consoleErrors.push({ phase, text: msg.text() });
-  });
-  page.on("pageerror", (err) => consoleErrors.push({ phase, text: `uncaught: ${err.message}` }));
-  page.on("requestfailed", (req) => consoleErrors.push({ phase, text: `request failed: ${req.url()} ${req.failure()?.errorText}` }));
-}
+const watch = (page) => watchConsole(page, consoleErrors, () => phase);
 
 // Reads the plotted data back from the uPlot instances the page exposes.
 async function plotted(page) {

@@ -14,53 +14,21 @@
 // (375 px), and fails on any console error. Screenshots: tests/artifacts/transient_page*.png.
 // Exit status 0 on success, 1 on a failed check, 2 on bad usage.
 
-import { chromium } from "playwright-core";
-import { mkdirSync, readFileSync } from "node:fs";
+import { readFileSync } from "node:fs";
 import path from "node:path";
-import { fileURLToPath } from "node:url";
+import { checker, launch, target, watchConsole } from "./harness.mjs";
 
-const url = process.argv[2];
-if (!url) {
-  console.error("usage: node transient_page.mjs <base url of a running tetherplan serve>");
-  process.exit(2);
-}
-const here = path.dirname(fileURLToPath(import.meta.url));
-const artifacts = path.resolve(here, "..", "artifacts");
-mkdirSync(artifacts, { recursive: true });
-const executablePath = process.env.CHROMIUM || "/usr/bin/chromium";
+const { url, artifacts } = target("transient_page.mjs");
 
-const failures = [];
-function check(ok, what) {
-  console.log(`${ok ? "ok  " : "FAIL"} ${what}`);
-  if (!ok) failures.push(what);
-}
+const { failures, check } = checker();
 
-const browser = await chromium.launch({
-  executablePath,
-  headless: true,
-  args: [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-  ],
-});
+const browser = await launch();
 
 // Console errors with the phase they happened in; the invalid-input phase expects
 // the browser's own "Failed to load resource: … status of 422" line.
 const consoleErrors = [];
 let phase = "load";
-function watch(page) {
-  page.on("console", (msg) => {
-    if (msg.type() === "error") consoleErrors.push({ phase, text: msg.text() });
-  });
-  page.on("pageerror", (err) => consoleErrors.push({ phase, text: `uncaught: ${err.message}` }));
-  page.on("requestfailed", (req) => consoleErrors.push({ phase, text: `request failed: ${req.url()} ${req.failure()?.errorText}` }));
-}
-
+const watch = (page) => watchConsole(page, consoleErrors, () => phase);
 
 async function runDefaultTransient(page) {
   await page.click("#tr-run");
