@@ -14,7 +14,9 @@ use std::time::Instant;
 use criterion::Criterion;
 use tetherplan::numerics::chart::Parallelism;
 use tetherplan::numerics::ge::chart::{GeChartRequest, GeChartSystem, deployment_chart};
-use tetherplan::numerics::ge::critical::{CriticalConfig, CriticalProblem, critical_time};
+use tetherplan::numerics::ge::critical::{
+    CriticalConfig, CriticalProblem, StartState, critical_time,
+};
 use tetherplan::numerics::profile::Profile;
 
 fn critical_12(c: &mut Criterion) {
@@ -24,6 +26,7 @@ fn critical_12(c: &mut Criterion) {
         net_buoyancy_n: 1000.0,
         perturbation: None,
         aero: None,
+        start: StartState::AtRest,
     };
     let config = CriticalConfig::default();
     let mut group = c.benchmark_group("ge_critical");

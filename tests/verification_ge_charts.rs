@@ -19,9 +19,10 @@ use tetherplan::numerics::ge::chart::{
     GeChartRequest, GeChartSeries, GeChartSystem, deployment_chart,
 };
 use tetherplan::numerics::ge::critical::{
-    CriticalConfig, CriticalProblem, GeOnset, TipPerturbation, critical_time,
+    CriticalConfig, CriticalProblem, GeOnset, StartState, TipPerturbation, critical_time,
 };
 use tetherplan::numerics::ge::element::TipLoad;
+use tetherplan::numerics::ge::extensible::ExtensibleString;
 use tetherplan::numerics::ge::solver::{LengthHistory, NewtonConfig};
 use tetherplan::numerics::ge::{GeModel, Section, TipBody};
 use tetherplan::numerics::ge_reduced::{self, ReducedFrequencies};
@@ -44,6 +45,7 @@ fn t_star(rate: f64, stiffness_ratio: f64, f0: f64, config: &CriticalConfig) -> 
         net_buoyancy_n: 1000.0,
         perturbation: (f0 > 0.0).then(|| TipPerturbation::held(f0)),
         aero: None,
+        start: StartState::AtRest,
     };
     critical_time(&table_7_1(stiffness_ratio), &problem, config, &never)
         .unwrap()
@@ -141,39 +143,91 @@ fn stiff_ge_chart_matches_the_string_chart() {
     }
 }
 
-/// Thesis ch. 7.4 claims smaller E* (more extensible, at fixed EI) goes
-/// unstable earlier, and that t* no longer changes for E* ≥ 1e5. What this
-/// model gives (reported, not the thesis's monotone law): for E* ≥ 100
-/// t* does not depend on E* (within 1 %, the size of the Δt = 0.02 s
-/// step noise at 80 m/s); the most extensible cable, E* = 1 (EA = GA = F), goes unstable
-/// at once at 80 m/s (t* < 0.5 s against 9 s) — earlier, as the thesis
-/// says — but at 12 and 40 m/s E* = 1 and 10 hold *longer* than E* = 1e5.
+/// Thesis ch. 7.4: t* "does not change for E* ≥ 1e5". Here it does not
+/// change for E* ≥ 100 either: the chart's E* = 100, 1e3 series are within
+/// 1 % of E* = 1e5 at 12, 40 and 80 m/s (EA ≥ 1e5 N stretches the cable by
+/// less than 1 %).
 #[test]
-fn stiffness_ratio_effect_on_the_chart() {
+fn stiff_cables_share_one_chart() {
     let series = chart(&GeChartRequest::table_7_1(
         vec![12.0, 40.0, 80.0],
-        vec![1.0, 10.0, 100.0, 1e3, 1e5],
+        vec![100.0, 1e3, 1e5],
     ));
     let t = |s: usize, r: usize| series[s].points[r].critical_time_s.unwrap();
-    for s in &series {
-        println!(
-            "E* = {:>8}: t* = {:?} s",
-            s.stiffness_ratio,
-            s.points
-                .iter()
-                .map(|p| format!("{:.3}", p.critical_time_s.unwrap()))
-                .collect::<Vec<_>>()
-        );
-    }
-    let stiff = 4;
-    for s in 2..4 {
+    for s in 0..2 {
         for r in 0..3 {
-            assert!((t(s, r) / t(stiff, r) - 1.0).abs() < 0.01);
+            println!(
+                "E* = {}: t* = {:.3} s against {:.3} s at E* = 1e5",
+                series[s].stiffness_ratio,
+                t(s, r),
+                t(2, r)
+            );
+            assert!((t(s, r) / t(2, r) - 1.0).abs() < 0.01);
         }
     }
-    assert!(t(0, 2) < 0.5 && t(stiff, 2) > 8.0);
-    // the departure from the thesis, pinned so it is noticed if it changes
-    assert!(t(0, 0) > t(stiff, 0) && t(1, 1) > t(stiff, 1));
+}
+
+/// Extensible cables (E* = 1, 10 at EI = 1000 N m², i.e. EA = 1, 10 kN)
+/// against the quasi-static string limit of
+/// [`tetherplan::numerics::ge::extensible`]: the shift in h* from E* = 1e5,
+/// ΔL* = L*(β) − L*(0) with β = μv²/EA, started in steady payout (no start
+/// transient). Tolerance: within 10 % of the closed-form shift at 12 and
+/// 40 m/s (measured 0.2–7 %); past the crossover rate (≈ 65 m/s for
+/// E* = 1, where the closed form turns negative) the shift changes sign as
+/// the closed form says: E* = 1 goes unstable earlier at 70, 80 and 90 m/s.
+///
+/// Departure from the thesis (Fig. 7.3, "an extensible GE cable becomes
+/// unstable earlier"): that holds only above the crossover. Below it the
+/// decelerating, un-stretching cable weighs less on the guide and a more
+/// extensible cable pays out a *longer* length first — the closed form and
+/// the GE model agree on this.
+#[test]
+fn extensible_cable_follows_the_quasi_static_limit() {
+    let run = |rate: f64, stiffness_ratio: f64| {
+        let problem = CriticalProblem {
+            profile: Profile::constant_rate(1.0, rate, None).unwrap(),
+            net_buoyancy_n: 1000.0,
+            perturbation: None,
+            aero: None,
+            start: StartState::SteadyPayout,
+        };
+        let model = table_7_1(stiffness_ratio);
+        let r = critical_time(&model, &problem, &CriticalConfig::default(), &never).unwrap();
+        during(r.onset).1
+    };
+    let closed = |rate: f64, stiffness_ratio: f64| {
+        ExtensibleString {
+            net_buoyancy_n: 1000.0,
+            aerostat_mass_kg: 10.0,
+            mass_per_length_kg_m: 0.078,
+            axial_stiffness_n: stiffness_ratio * 1000.0,
+            gravity_m_s2: 9.81,
+        }
+        .critical_length_m(rate)
+        .unwrap()
+    };
+    for rate in [12.0, 40.0] {
+        let stiff = run(rate, 1e5);
+        let mut last = stiff;
+        for es in [10.0, 1.0] {
+            let shift = run(rate, es) - stiff;
+            let expected = closed(rate, es) - closed(rate, 1e5);
+            println!(
+                "{rate} m/s, E* = {es}: h* shift {shift:+.2} m, closed form {expected:+.2} m ({:+.1} %)",
+                100.0 * (shift / expected - 1.0)
+            );
+            assert!(expected > 0.0);
+            assert!((shift / expected - 1.0).abs() < 0.10);
+            // monotone: the more extensible, the longer (below the crossover)
+            assert!(stiff + shift > last);
+            last = stiff + shift;
+        }
+    }
+    for rate in [70.0, 80.0, 90.0] {
+        let (soft, stiff) = (run(rate, 1.0), run(rate, 1e5));
+        println!("{rate} m/s: h* {soft:.1} m at E* = 1 against {stiff:.1} m at E* = 1e5");
+        assert!(soft < stiff - 40.0);
+    }
 }
 
 /// The onset does not move when the step or the QEP interval is refined

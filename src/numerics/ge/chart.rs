@@ -10,7 +10,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
-use super::critical::{CriticalConfig, CriticalProblem, GeOnset, TipPerturbation, critical_time};
+use super::critical::{
+    CriticalConfig, CriticalProblem, GeOnset, StartState, TipPerturbation, critical_time,
+};
 use super::{GeModel, Section, TipBody};
 use crate::numerics::aero::{Aerodynamics, AerostatBody, AirFlow, ForceModel, SteadyFlow};
 use crate::numerics::chart::Parallelism;
@@ -284,6 +286,7 @@ pub fn chart_point(
         net_buoyancy_n,
         perturbation,
         aero,
+        start: StartState::AtRest,
     };
     let r = critical_time(model, &problem, config, cancel)?;
     let closed =

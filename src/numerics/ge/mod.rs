@@ -47,6 +47,7 @@ pub mod chart;
 pub mod critical;
 pub mod diagnostics;
 pub mod element;
+pub mod extensible;
 pub mod solver;
 pub mod stability;
 
