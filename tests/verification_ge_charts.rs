@@ -136,6 +136,13 @@ fn stiff_ge_chart_matches_the_string_chart() {
             p.string_closed_form_m
         );
         assert!((h_ge / h_str - 1.0).abs() < 0.05);
+        // EA = 1e8 N: the extensible bound is the string's within 1e-4
+        assert!(
+            (p.extensible_closed_form_m / p.string_closed_form_m - 1.0).abs() < 1e-4,
+            "{} vs {}",
+            p.extensible_closed_form_m,
+            p.string_closed_form_m
+        );
         assert!(
             excess > 0.5 * column && excess < 2.0 * column,
             "excess {excess} m"

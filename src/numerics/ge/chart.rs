@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use super::critical::{
     CriticalConfig, CriticalProblem, GeOnset, StartState, TipPerturbation, critical_time,
 };
+use super::extensible::ExtensibleString;
 use super::{GeModel, Section, TipBody};
 use crate::numerics::aero::{Aerodynamics, AerostatBody, AirFlow, ForceModel, SteadyFlow};
 use crate::numerics::chart::Parallelism;
@@ -152,6 +153,9 @@ pub struct GeChartPoint {
     pub max_elevation_m: Option<f64>,
     /// `(F/ρA − v²)/g` (m), the string's continuum bound, clipped at zero.
     pub string_closed_form_m: f64,
+    /// The same bound for this series' axial stiffness, quasi-static
+    /// ([`super::extensible`]), clipped at zero (m).
+    pub extensible_closed_form_m: f64,
     pub onset: GeOnset,
     pub steps: usize,
     pub qep_solves: usize,
@@ -289,13 +293,23 @@ pub fn chart_point(
         start: StartState::AtRest,
     };
     let r = critical_time(model, &problem, config, cancel)?;
-    let closed =
-        (net_buoyancy_n / system.mass_per_length_kg_m - rate_m_s * rate_m_s) / system.gravity_m_s2;
+    let string = |axial_stiffness_n: f64| {
+        ExtensibleString {
+            net_buoyancy_n,
+            aerostat_mass_kg: model.tip.mass_kg,
+            mass_per_length_kg_m: system.mass_per_length_kg_m,
+            axial_stiffness_n,
+            gravity_m_s2: system.gravity_m_s2,
+        }
+        .critical_length_m(rate_m_s)
+        .unwrap_or(0.0)
+    };
     Ok(GeChartPoint {
         rate_m_s,
         critical_time_s: r.time_s(),
         max_elevation_m: r.length_m(&profile),
-        string_closed_form_m: closed.max(0.0),
+        string_closed_form_m: string(f64::INFINITY),
+        extensible_closed_form_m: string(model.section.axial_stiffness_n),
         onset: r.onset,
         steps: r.steps,
         qep_solves: r.qep_solves,
