@@ -7,6 +7,7 @@ use utoipa::ToSchema;
 
 /// The cable. Give `mass_per_length_kg_m`, or `density_kg_m3` and `area_m2`.
 #[derive(Clone, Debug, Default, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct CableInput {
     /// Mass per unit length ρA (kg/m).
     #[schema(example = 0.078, exclusive_minimum = 0.0)]
@@ -21,6 +22,7 @@ pub struct CableInput {
 
 /// The aerostat at the top of the cable.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct AerostatInput {
     /// Net buoyancy F = F_b − m g (N): the upward pull on the cable.
     #[schema(example = 1000.0, exclusive_minimum = 0.0)]
@@ -33,6 +35,7 @@ pub struct AerostatInput {
 
 /// Which cable model, and its discretisation.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct ModelInput {
     /// Model kind.
     #[serde(default)]
@@ -98,8 +101,19 @@ pub enum ModelKind {
     LinearString,
 }
 
+/// The keys of [`SystemInput`]: a flattened request gives these to the
+/// system part and the rest to its parameters.
+pub const SYSTEM_KEYS: &[&str] = &[
+    "cable",
+    "aerostat",
+    "initial_length_m",
+    "gravity_m_s2",
+    "model",
+];
+
 /// The physical system and its model: common to every request.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct SystemInput {
     pub cable: CableInput,
     pub aerostat: AerostatInput,
@@ -129,6 +143,7 @@ fn default_gravity() -> f64 {
 /// A deployment profile L(t). Positive rates lengthen, negative shorten.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(deny_unknown_fields)]
 pub enum ProfileInput {
     /// L = L0 + v t.
     ConstantRate {
@@ -177,6 +192,7 @@ pub enum ProfileInput {
 
 /// One point of a rate table.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct RatePointInput {
     /// Time (s).
     #[schema(example = 0.0, minimum = 0.0)]
@@ -188,6 +204,7 @@ pub struct RatePointInput {
 
 /// Instantaneous deployment state for a stability query.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct StateInput {
     /// Cable length L (m).
     #[schema(example = 500.0, exclusive_minimum = 0.0)]
@@ -212,6 +229,7 @@ pub struct StabilityRequest {
 
 /// The fields of a stability request besides the system.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct StabilityParams {
     pub state: StateInput,
     /// How many modes (eigenvalues with Im ≥ 0, by frequency) to return.
@@ -235,6 +253,7 @@ pub struct CriticalRequest {
 
 /// The fields of a critical-time request besides the system.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct CriticalParams {
     pub profile: ProfileInput,
     /// Also solve the full QEP at the start, half-way, and 0.1 % either side
@@ -255,6 +274,7 @@ pub struct SafeRateRequest {
 
 /// The fields of a safe-rate request besides the system.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct SafeRateParams {
     /// Elevation (cable length) to reach (m).
     #[schema(example = 1200.0, exclusive_minimum = 0.0)]
@@ -263,6 +283,7 @@ pub struct SafeRateParams {
 
 /// An evenly spaced grid of rates.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct RateGrid {
     /// Smallest rate (m/s).
     #[schema(example = 1.0, exclusive_minimum = 0.0)]
@@ -286,6 +307,7 @@ pub struct ChartRequest {
 
 /// The fields of a chart request besides the system.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct ChartParams {
     /// Rates of the chart (m/s).
     pub rates_m_s: RateGrid,
@@ -495,6 +517,10 @@ impl ErrorBody {
 pub trait SystemRequest: Sized {
     type Params: serde::de::DeserializeOwned;
     fn from_parts(system: SystemInput, params: Self::Params) -> Self;
+    /// The plausible-magnitude checks of both parts (field and range named).
+    fn check_ranges(&self) -> Result<(), crate::numerics::params::InvalidInput> {
+        Ok(())
+    }
 }
 
 macro_rules! system_request {
@@ -503,6 +529,13 @@ macro_rules! system_request {
             type Params = $params;
             fn from_parts(system: SystemInput, params: $params) -> Self {
                 Self { system, params }
+            }
+            fn check_ranges(&self) -> Result<(), crate::numerics::params::InvalidInput> {
+                crate::contract::ranges::check_system(&self.system)?;
+                crate::contract::ranges::CheckRanges::check_ranges(
+                    &self.params,
+                    self.system.initial_length_m,
+                )
             }
         }
     )*};

@@ -32,6 +32,7 @@ pub const MAX_SPECTRA: usize = 2000;
 
 /// The aerostat of a GE run.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct GeAerostatInput {
     /// Net buoyancy F = F_b − m g (N), applied at the aerostat along the guide axis.
     #[schema(example = 1000.0, minimum = 0.0)]
@@ -56,6 +57,7 @@ pub enum GeModelKind {
 
 /// The GE model and its discretisation (thesis ch. 5.6 groups).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct GeModelInput {
     pub kind: GeModelKind,
     /// Number of 2-node elements (1..=2000).
@@ -84,9 +86,10 @@ fn default_elements() -> usize {
 /// Time shape of the end load.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(deny_unknown_fields)]
 pub enum LoadTimeInput {
     /// On for the whole run.
-    Constant,
+    Constant {},
     /// Rises linearly over `ramp_s`, held until `hold_s`, then released.
     Held {
         #[schema(example = 0.1, minimum = 0.0)]
@@ -105,6 +108,7 @@ pub enum LoadTimeInput {
 
 /// An extra end load on the aerostat (a perturbation), beside the buoyancy.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct EndLoadInput {
     /// Force along the guide axis (N).
     #[serde(default)]
@@ -121,6 +125,7 @@ pub struct EndLoadInput {
 
 /// Newton–Raphson settings.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct NewtonInput {
     /// Relative residual tolerance.
     #[serde(default = "default_rtol")]
@@ -146,19 +151,27 @@ fn default_iterations() -> usize {
     NewtonConfig::default().max_iterations
 }
 
-/// Initial state of the run.
-#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub enum InitialStateInput {
+/// How the GE cable starts: `initial` as in the linear string's simulate
+/// (`{"kind": ...}`), with the kinds this model has.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(deny_unknown_fields)]
+pub enum GeInitialStateInput {
     /// Static equilibrium under buoyancy and gravity at t = 0 (default).
-    #[default]
-    StaticEquilibrium,
+    StaticEquilibrium {},
     /// Straight and unstrained, at rest.
-    Rest,
+    Rest {},
+}
+
+impl Default for GeInitialStateInput {
+    fn default() -> Self {
+        Self::StaticEquilibrium {}
+    }
 }
 
 /// `simulate` with a GE model: a transient Newmark–Newton run.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct GeSimulateRequest {
     pub cable: CableInput,
     pub aerostat: GeAerostatInput,
@@ -190,8 +203,10 @@ pub struct GeSimulateRequest {
     #[serde(default)]
     #[schema(example = 0.0, minimum = 0.0)]
     pub damping_from_s: f64,
+    /// How the cable starts (the same field as the linear string's
+    /// `initial`); default: static equilibrium.
     #[serde(default)]
-    pub initial_state: InitialStateInput,
+    pub initial: GeInitialStateInput,
     #[serde(default)]
     pub newton: Option<NewtonInput>,
     /// Record every this many steps.
@@ -313,7 +328,7 @@ struct Prepared {
     drive: Drive,
     config: RunConfig,
     steady: TipLoad,
-    initial: InitialStateInput,
+    initial: GeInitialStateInput,
     time_scale_s: f64,
 }
 
@@ -448,7 +463,7 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
                 moment_n_m: require_finite("end_load.moment_n_m", e.moment_n_m)?,
             };
             let shape = match e.time {
-                LoadTimeInput::Constant => LoadShape::Constant,
+                LoadTimeInput::Constant {} => LoadShape::Constant,
                 LoadTimeInput::Held { ramp_s, hold_s } => {
                     let ramp_s = require_non_negative("end_load.time.ramp_s", ramp_s)?;
                     let hold_s = require_non_negative("end_load.time.hold_s", hold_s)?;
@@ -527,7 +542,7 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
             eigen_every: req.eigenvalues_every_steps,
         },
         steady,
-        initial: req.initial_state,
+        initial: req.initial,
         time_scale_s,
     })
 }
@@ -543,8 +558,8 @@ pub fn simulate_ge(
     let n = model.dofs();
     let kin0 = p.drive.length.kinematics(0.0);
     let q0 = match p.initial {
-        InitialStateInput::Rest => vec![0.0; n],
-        InitialStateInput::StaticEquilibrium => {
+        GeInitialStateInput::Rest {} => vec![0.0; n],
+        GeInitialStateInput::StaticEquilibrium {} => {
             let newton = NewtonConfig {
                 max_iterations: p.config.newton.max_iterations.max(50),
                 ..p.config.newton
@@ -770,7 +785,7 @@ mod tests {
     fn newton_failure_is_an_outcome() {
         let mut v = table_7_1();
         v["newton"] = serde_json::json!({"relative_tolerance": 1e-16, "absolute_tolerance_n": 0.0, "max_iterations": 1});
-        v["initial_state"] = serde_json::json!("rest");
+        v["initial"] = serde_json::json!({"kind": "rest"});
         let req: GeSimulateRequest = serde_json::from_value(v).unwrap();
         let out = simulate_ge(&req, &NoProgress).unwrap();
         match out.outcome {

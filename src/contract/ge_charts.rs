@@ -35,6 +35,7 @@ pub const MAX_RESPONSE_WORK: f64 = 2e9;
 
 /// The GE cable of a chart; `E*` varies per series (`stiffness_ratios`).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct GeChartModelInput {
     pub kind: GeModelKind,
     /// Number of 2-node elements.
@@ -65,6 +66,7 @@ fn default_gravity() -> f64 {
 
 /// The initial sideways push on the aerostat (thesis Fig. 7.4).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct PerturbationInput {
     /// Peak forces F0 (N), one series each; 0 is the unperturbed cable.
     #[schema(example = json!([0.0, 200.0, 400.0]))]
@@ -88,6 +90,7 @@ fn default_hold() -> f64 {
 
 /// A point of a tabulated wind profile.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct WindPointInput {
     #[schema(example = 100.0, minimum = 0.0)]
     pub elevation_m: f64,
@@ -98,6 +101,7 @@ pub struct WindPointInput {
 /// Steady wind profile u0(z).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(deny_unknown_fields)]
 pub enum WindProfileInput {
     Uniform {
         #[schema(example = 5.0)]
@@ -115,15 +119,16 @@ pub enum WindProfileInput {
     Tabulated { points: Vec<WindPointInput> },
     /// 0 → 8 m/s over 600 m, then uniform: the shape of the thesis's
     /// Fig. 7.5(a), not its data.
-    Illustrative,
+    Illustrative {},
 }
 
 /// How the flow loads the aerostat.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(deny_unknown_fields)]
 pub enum ForceModelInput {
     /// Inviscid sphere (thesis (4.4)).
-    Thesis,
+    Thesis {},
     /// Quadratic drag plus added mass.
     Drag {
         #[schema(example = 0.5, minimum = 0.0)]
@@ -137,6 +142,7 @@ pub enum ForceModelInput {
 
 /// Wind on the aerostat (thesis ch. 7.5), one series per A0 of (7.4).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct GeWindInput {
     pub profile: WindProfileInput,
     pub force_model: ForceModelInput,
@@ -172,6 +178,7 @@ fn default_wavenumber() -> f64 {
 
 /// Settings of each critical-time search.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct GeChartNumericsInput {
     /// Newmark step (s).
     #[serde(default = "default_dt")]
@@ -207,6 +214,7 @@ fn default_growth() -> f64 {
 /// `POST /api/v1/charts` for the GE cable: t* and h* against rate, one
 /// series per stiffness ratio E* × F0 × buoyancy × A0.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct GeChartRequest {
     pub cable: CableInput,
     pub aerostat: GeAerostatInput,
@@ -337,7 +345,7 @@ fn wind(input: &GeWindInput, area_default: f64) -> Result<GeChartWind, InvalidIn
                 .collect();
             SteadyFlow::tabulated(&pts, "wind.profile.points")?
         }
-        WindProfileInput::Illustrative => GeChartWind::illustrative(vec![]).base_flow,
+        WindProfileInput::Illustrative {} => GeChartWind::illustrative(vec![]).base_flow,
     };
     let body = AerostatBody::new(
         require_positive("wind.radius_m", input.radius_m)?,
@@ -345,7 +353,7 @@ fn wind(input: &GeWindInput, area_default: f64) -> Result<GeChartWind, InvalidIn
         None,
     )?;
     let force_model = match &input.force_model {
-        ForceModelInput::Thesis => ForceModel::Thesis,
+        ForceModelInput::Thesis {} => ForceModel::Thesis,
         ForceModelInput::Drag {
             drag_coefficient,
             reference_area_m2,
@@ -573,6 +581,7 @@ pub enum ExcitationKind {
 
 /// A grid of forcing frequencies.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct FrequencyGridInput {
     /// Lowest ω0 (rad/s).
     #[schema(example = 11.3, exclusive_minimum = 0.0)]
@@ -588,6 +597,7 @@ pub struct FrequencyGridInput {
 /// cable on a platform shaken across the guide; amplitude gain (8.3)
 /// against ω0, with the two-DOF model's resonance bands (8.9).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct GeBaseFrequencyResponseRequest {
     pub excitation: ExcitationKind,
     pub cable: CableInput,
@@ -719,6 +729,16 @@ pub fn ge_base_frequency_response(
         return Err(InvalidInput::new("time_step_s", "must not exceed duration_s").into());
     }
     let work = steps * (omegas.len() + 1) as f64 * m.elements as f64;
+    if steps * m.elements as f64 > MAX_RESPONSE_WORK {
+        return Err(InvalidInput::new(
+            "time_step_s",
+            format!(
+                "one run alone needs {steps:.0} steps × {} elements, beyond the work limit {MAX_RESPONSE_WORK:.0e}: take a longer step or a shorter duration_s",
+                m.elements
+            ),
+        )
+        .into());
+    }
     if work > MAX_RESPONSE_WORK {
         return Err(InvalidInput::new(
             "frequencies_rad_s.count",
@@ -840,7 +860,9 @@ pub fn parse_chart(body: &[u8]) -> Result<AnyChartRequest, RequestError> {
     let value: serde_json::Value =
         serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
     if value.pointer("/model/kind").and_then(|k| k.as_str()) == Some("geometrically_exact") {
-        crate::contract::parse_plain(body).map(AnyChartRequest::GeometricallyExact)
+        let req: Box<GeChartRequest> = crate::contract::parse_plain(body)?;
+        req.check_ranges()?;
+        Ok(AnyChartRequest::GeometricallyExact(req))
     } else {
         crate::contract::parse(body).map(AnyChartRequest::LinearString)
     }
@@ -874,7 +896,11 @@ pub fn parse_frequency_response(body: &[u8]) -> Result<AnyFrequencyResponseReque
         None => {
             crate::contract::parse(body).map(|r| AnyFrequencyResponseRequest::Wind(Box::new(r)))
         }
-        Some(_) => crate::contract::parse_plain(body).map(AnyFrequencyResponseRequest::Base),
+        Some(_) => {
+            let req: Box<GeBaseFrequencyResponseRequest> = crate::contract::parse_plain(body)?;
+            req.check_ranges()?;
+            Ok(AnyFrequencyResponseRequest::Base(req))
+        }
     }
 }
 

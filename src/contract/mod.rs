@@ -6,6 +6,7 @@
 pub mod dto;
 pub mod ge;
 pub mod ge_charts;
+pub mod ranges;
 pub mod run;
 pub mod simulate;
 pub mod transient;
@@ -16,11 +17,47 @@ use crate::numerics::params::InvalidInput;
 
 /// Parses a request body (system part and parameters); errors name the
 /// offending field path.
+///
+/// Both parts refuse unknown fields: the body's keys are split between
+/// them ([`dto::SYSTEM_KEYS`] go to the system), and a key neither knows
+/// is named with every key the request takes.
 pub fn parse<T: dto::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
     let value = json_object(body)?;
-    let system = parse_value::<dto::SystemInput>(&value)?;
-    let params = parse_value::<T::Params>(&value)?;
-    Ok(T::from_parts(system, params))
+    let (system_part, params_part): (serde_json::Map<_, _>, serde_json::Map<_, _>) = value
+        .as_object()
+        .expect("json_object gives an object")
+        .clone()
+        .into_iter()
+        .partition(|(k, _)| dto::SYSTEM_KEYS.contains(&k.as_str()));
+    let system = parse_value::<dto::SystemInput>(&serde_json::Value::Object(system_part))?;
+    let params = parse_value::<T::Params>(&serde_json::Value::Object(params_part))
+        .map_err(|e| match e {
+            RequestError::Invalid(InvalidInput { field, reason })
+                if !field.contains('.') && reason.starts_with("unknown field") =>
+            {
+                RequestError::Invalid(InvalidInput::new(
+                    field,
+                    with_system_keys(&reason),
+                ))
+            }
+            other => other,
+        })?;
+    let request = T::from_parts(system, params);
+    request.check_ranges()?;
+    Ok(request)
+}
+
+/// Adds the system keys to the "expected one of" list of a top-level
+/// unknown-field message.
+fn with_system_keys(reason: &str) -> String {
+    let system: Vec<String> = dto::SYSTEM_KEYS.iter().map(|k| format!("`{k}`")).collect();
+    match reason.split_once("; expected ") {
+        Some((head, tail)) => {
+            let tail = tail.trim_start_matches("one of ").replace(" or ", ", ");
+            format!("{head}; expected one of {}, {tail}", system.join(", "))
+        }
+        None => format!("{reason}; expected one of {}", system.join(", ")),
+    }
 }
 
 /// Parses a body that has no flattened parts (one pass, field paths kept).
@@ -53,15 +90,69 @@ pub fn parse_value<T: serde::de::DeserializeOwned>(
         } else {
             format!("{path}.")
         };
-        // serde names a missing field only in its message: lift it into the path.
-        let field = match message
-            .strip_prefix("missing field `")
-            .and_then(|rest| rest.split('`').next())
-        {
+        // serde names a missing or unknown field only in its message: lift it into the path.
+        let named = ["missing field `", "unknown field `"]
+            .iter()
+            .find_map(|p| message.strip_prefix(p))
+            .and_then(|rest| rest.split('`').next());
+        let field = match named {
+            // serde_path_to_error already ends the path with an unknown key
+            // of a plain struct (not inside a tagged enum).
+            Some(name) if path == name || path.ends_with(&format!(".{name}")) => path,
             Some(name) => format!("{prefix}{name}"),
             None if prefix.is_empty() => "body".to_string(),
             None => path,
         };
-        RequestError::Invalid(InvalidInput::new(field, message))
+        RequestError::Invalid(InvalidInput::new(field, plain_words(&message)))
     })
+}
+
+/// serde's messages in plain words: "must be a number, got string \"x\""
+/// rather than "invalid type: string \"x\", expected f64".
+pub fn plain_words(message: &str) -> String {
+    if message.starts_with("missing field `") {
+        return "is required".to_string();
+    }
+    if let Some(rest) = message.strip_prefix("unknown field `") {
+        let (name, tail) = rest.split_once('`').unwrap_or((rest, ""));
+        let tail = tail.trim_start_matches(", ");
+        return match tail {
+            "there are no fields" => format!("unknown field `{name}`; this object takes no fields"),
+            t if t.starts_with("expected ") => format!("unknown field `{name}`; {t}"),
+            _ => format!("unknown field `{name}`"),
+        };
+    }
+    if let Some(rest) = message.strip_prefix("unknown variant `") {
+        let (name, tail) = rest.split_once('`').unwrap_or((rest, ""));
+        let tail = tail.trim_start_matches(", ");
+        return format!("unknown kind `{name}`; {tail}");
+    }
+    let (got, expected) = match ["invalid type: ", "invalid value: ", "invalid length "]
+        .iter()
+        .find_map(|p| message.strip_prefix(p))
+        .and_then(|rest| rest.rsplit_once(", expected "))
+    {
+        Some((got, expected)) => (got.to_string(), expected.to_string()),
+        None => return message.to_string(),
+    };
+    let got = got
+        .replace("floating point `", "")
+        .replace("integer `", "")
+        .replace('`', "");
+    let need = match expected.as_str() {
+        "f64" | "f32" => "must be a number".to_string(),
+        "usize" | "u64" | "u32" | "u16" | "u8" => "must be a whole number (0 or more)".to_string(),
+        "i64" | "i32" => "must be a whole number".to_string(),
+        "a boolean" => "must be true or false".to_string(),
+        "a string" => "must be a string".to_string(),
+        "a sequence" => "must be a list".to_string(),
+        e if e.starts_with("struct ") || e == "a map" || e.starts_with("internally tagged") => {
+            "must be an object".to_string()
+        }
+        e if e.starts_with("unit variant") || e.starts_with("variant identifier") => {
+            "must be one of the listed kinds".to_string()
+        }
+        e => format!("must be {e}"),
+    };
+    format!("{need}, got {got}")
 }

@@ -32,7 +32,9 @@ pub fn parse_simulate(body: &[u8]) -> Result<AnySimulateRequest, RequestError> {
     let value: serde_json::Value =
         serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
     if value.pointer("/model/kind").and_then(|k| k.as_str()) == Some("geometrically_exact") {
-        parse_plain(body).map(AnySimulateRequest::GeometricallyExact)
+        let req: GeSimulateRequest = parse_plain(body)?;
+        req.check_ranges()?;
+        Ok(AnySimulateRequest::GeometricallyExact(req))
     } else {
         parse(body).map(AnySimulateRequest::LinearString)
     }

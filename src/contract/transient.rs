@@ -43,12 +43,12 @@ fn default_eigen_count() -> usize {
 }
 
 /// How the cable starts.
-#[derive(Clone, Debug, Default, Deserialize, Serialize, ToSchema)]
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(deny_unknown_fields)]
 pub enum InitialStateInput {
     /// Straight and at rest.
-    #[default]
-    Rest,
+    Rest {},
     /// y = a ζ⁴ (ζ = x/L), at rest; a is the tip deflection.
     Shape {
         #[schema(example = 0.01)]
@@ -71,9 +71,16 @@ pub enum InitialStateInput {
     },
 }
 
+impl Default for InitialStateInput {
+    fn default() -> Self {
+        Self::Rest {}
+    }
+}
+
 /// A steady wind profile u(z) (z = elevation of the aerostat).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(deny_unknown_fields)]
 pub enum SteadyFlowInput {
     /// u = U.
     Uniform {
@@ -93,6 +100,7 @@ pub enum SteadyFlowInput {
 
 /// One point of a tabulated wind profile.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct FlowPointInput {
     #[schema(example = 100.0, minimum = 0.0)]
     pub elevation_m: f64,
@@ -103,6 +111,7 @@ pub struct FlowPointInput {
 /// The horizontal air flow on the aerostat.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(deny_unknown_fields)]
 pub enum AirFlowInput {
     /// u = U.
     Uniform {
@@ -140,12 +149,12 @@ pub enum AirFlowInput {
 }
 
 /// Aerodynamic force model of the aerostat.
-#[derive(Clone, Debug, Default, Deserialize, Serialize, ToSchema)]
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(deny_unknown_fields)]
 pub enum ForceModelInput {
     /// Inviscid sphere (thesis (4.3)–(4.4)): m_f (u_t + u u_z) + ½ m_f (u_t − ÿ).
-    #[default]
-    Thesis,
+    Thesis {},
     /// Quadratic drag ½ ρ_air C_D A |u − ẏ|(u − ẏ) plus the added mass ½ m_f (u_t − ÿ).
     Drag {
         #[schema(example = 0.5, minimum = 0.0)]
@@ -157,8 +166,15 @@ pub enum ForceModelInput {
     },
 }
 
+impl Default for ForceModelInput {
+    fn default() -> Self {
+        Self::Thesis {}
+    }
+}
+
 /// The aerostat as an aerodynamic body (a sphere).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct AeroBodyInput {
     #[serde(default)]
     pub model: ForceModelInput,
@@ -178,14 +194,41 @@ pub struct AeroBodyInput {
 
 /// Wind on the aerostat: flow and body.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct AeroInput {
     pub flow: AirFlowInput,
-    #[serde(flatten)]
-    pub body: AeroBodyInput,
+    /// The force model (the fields below are those of [`AeroBodyInput`],
+    /// written out so that unknown fields can be refused).
+    #[serde(default)]
+    pub model: ForceModelInput,
+    /// Sphere radius r (m): volume, displaced air, default drag area.
+    #[schema(example = 0.5, minimum = 0.001, maximum = 1000.0)]
+    pub radius_m: f64,
+    /// Air density (kg/m³).
+    #[serde(default = "default_air_density")]
+    #[schema(example = 1.205, minimum = 0.0001, maximum = 100.0)]
+    pub air_density_kg_m3: f64,
+    /// Lifting-gas density (kg/m³); see [`AeroBodyInput`].
+    #[serde(default)]
+    #[schema(minimum = 0.0001, maximum = 100.0)]
+    pub gas_density_kg_m3: Option<f64>,
+}
+
+impl AeroInput {
+    /// The body part.
+    pub fn body(&self) -> AeroBodyInput {
+        AeroBodyInput {
+            model: self.model.clone(),
+            radius_m: self.radius_m,
+            air_density_kg_m3: self.air_density_kg_m3,
+            gas_density_kg_m3: self.gas_density_kg_m3,
+        }
+    }
 }
 
 /// Eigenvalues along the run.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct EigenTrackingInput {
     /// Time between QEP solves (s).
     #[schema(example = 1.0, exclusive_minimum = 0.0)]
@@ -220,6 +263,7 @@ impl std::ops::DerefMut for SimulateRequest {
 
 /// The fields of a transient run request besides the system.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct SimulateParams {
     pub profile: ProfileInput,
     /// Simulated time (s).
@@ -308,6 +352,7 @@ pub struct SimulateResponse {
 
 /// An evenly spaced grid of forcing frequencies.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct FrequencyGrid {
     #[schema(example = 0.25, minimum = 0.0)]
     pub min: f64,
@@ -342,6 +387,7 @@ impl std::ops::DerefMut for FrequencyResponseRequest {
 
 /// The fields of a frequency response request besides the system.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
 pub struct FrequencyResponseParams {
     pub profile: ProfileInput,
     #[schema(example = 60.0, exclusive_minimum = 0.0)]
@@ -386,7 +432,7 @@ pub struct FrequencyResponseResponse {
 impl InitialStateInput {
     pub fn initial_state(&self) -> InitialState {
         match *self {
-            Self::Rest => InitialState::Rest,
+            Self::Rest {} => InitialState::Rest,
             Self::Shape { tip_deflection_m } => InitialState::Shape { tip_deflection_m },
             Self::Mode {
                 mode,
@@ -496,7 +542,7 @@ impl AeroBodyInput {
         )
         .map_err(fix)?;
         let model = match self.model {
-            ForceModelInput::Thesis => ForceModel::Thesis,
+            ForceModelInput::Thesis {} => ForceModel::Thesis,
             ForceModelInput::Drag {
                 drag_coefficient_nondim,
                 reference_area_m2,
@@ -590,7 +636,7 @@ pub fn simulate(
     let profile = req.profile.profile(sys.initial_length_m)?;
     let aero = match &req.aero {
         Some(a) => Some(
-            a.body
+            a.body()
                 .aerodynamics(a.flow.flow()?, sys.aerostat_mass_kg, "aero")?,
         ),
         None => None,

@@ -401,6 +401,7 @@ impl JobItem {
         } else {
             format!("{prefix}.request")
         };
+        refuse_unknown_keys(obj, prefix)?;
         let kind = obj.get("kind").and_then(Value::as_str).ok_or_else(|| {
             InvalidInput::new(
                 kind_field.clone(),
@@ -423,6 +424,26 @@ impl JobItem {
         item.validate_kind()
             .map_err(|e| prefixed(e, &request_field))?;
         Ok(item)
+    }
+}
+
+/// A submission envelope holds `kind` and `request` only: any other key is
+/// refused, named with its path.
+fn refuse_unknown_keys(
+    obj: &serde_json::Map<String, Value>,
+    prefix: &str,
+) -> Result<(), RequestError> {
+    match obj.keys().find(|k| *k != "kind" && *k != "request") {
+        None => Ok(()),
+        Some(k) => Err(InvalidInput::new(
+            if prefix == "body" {
+                k.clone()
+            } else {
+                format!("{prefix}.{k}")
+            },
+            format!("unknown field `{k}`; expected one of `kind`, `request`"),
+        )
+        .into()),
     }
 }
 
@@ -497,6 +518,9 @@ impl JobSubmission {
             serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
         if value.get("kind").and_then(Value::as_str) != Some("batch") {
             return JobItem::parse(&value, "body").map(Self::One);
+        }
+        if let Some(obj) = value.as_object() {
+            refuse_unknown_keys(obj, "body")?;
         }
         let list = value
             .get("request")

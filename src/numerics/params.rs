@@ -70,6 +70,136 @@ pub fn require_finite(field: &str, value: f64) -> Result<f64, InvalidInput> {
     Ok(value)
 }
 
+/// A closed range of physically plausible values of one input, with its
+/// unit: the one place where the accepted magnitudes are written down (the
+/// `#[schema(minimum, maximum)]` bounds of the JSON contract equal these;
+/// `tests/contract_ranges.rs` checks it against the OpenAPI document).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Range {
+    pub min: f64,
+    pub max: f64,
+    /// Unit as written in messages (`kg/m`); empty for pure numbers.
+    pub unit: &'static str,
+}
+
+impl Range {
+    pub const fn new(min: f64, max: f64, unit: &'static str) -> Self {
+        Self { min, max, unit }
+    }
+
+    /// `value` if it is finite and within the range; otherwise an error
+    /// naming `field` and stating the range.
+    pub fn check(&self, field: &str, value: f64) -> Result<f64, InvalidInput> {
+        if value.is_finite() && value >= self.min && value <= self.max {
+            return Ok(value);
+        }
+        let unit = if self.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {}", self.unit)
+        };
+        Err(InvalidInput::new(
+            field,
+            format!(
+                "must be between {} and {}{unit}, got {}",
+                compact(self.min),
+                compact(self.max),
+                compact(value)
+            ),
+        ))
+    }
+}
+
+/// `1e-5`, `0.01`, `100`, `1e7`: short forms for messages.
+pub fn compact(v: f64) -> String {
+    if v != 0.0 && (v.abs() >= 1e5 || v.abs() < 1e-3) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// Plausible magnitudes of every physical input (SI). Chosen to contain
+/// every real tethered aerostat and winch with margin, and to keep the
+/// non-dimensional groups in the range where the solvers stay finite.
+pub mod ranges {
+    use super::Range;
+
+    /// Cable mass per length ρA: from a thin fibre line to a heavy armoured cable.
+    pub const MASS_PER_LENGTH_KG_M: Range = Range::new(1e-5, 100.0, "kg/m");
+    /// Cable material density ρ.
+    pub const DENSITY_KG_M3: Range = Range::new(100.0, 30_000.0, "kg/m³");
+    /// Cable cross-section area A.
+    pub const AREA_M2: Range = Range::new(1e-9, 0.1, "m²");
+    /// Net buoyancy F of the linear string (must pull: > 0).
+    pub const NET_BUOYANCY_N: Range = Range::new(1e-3, 1e7, "N");
+    /// Net buoyancy of the geometrically exact cable (0: a bare cantilever).
+    pub const GE_NET_BUOYANCY_N: Range = Range::new(0.0, 1e7, "N");
+    /// Aerostat mass m.
+    pub const AEROSTAT_MASS_KG: Range = Range::new(0.0, 1e6, "kg");
+    /// Initial length L0, the length scale.
+    pub const INITIAL_LENGTH_M: Range = Range::new(1e-3, 1e4, "m");
+    /// Gravity of the linear string (the static limit F/(ρA g) needs g > 0).
+    pub const GRAVITY_M_S2: Range = Range::new(0.01, 100.0, "m/s²");
+    /// Gravity of the geometrically exact cable (0 allowed, thesis ch. 8).
+    pub const GE_GRAVITY_M_S2: Range = Range::new(0.0, 100.0, "m/s²");
+    /// A cable length (state, target): up to 100 km.
+    pub const LENGTH_M: Range = Range::new(1e-3, 1e5, "m");
+    /// A winch rate, either sign.
+    pub const RATE_M_S: Range = Range::new(-1000.0, 1000.0, "m/s");
+    /// A positive winch rate (chart grids).
+    pub const POSITIVE_RATE_M_S: Range = Range::new(1e-6, 1000.0, "m/s");
+    /// A winch acceleration, either sign.
+    pub const ACCELERATION_M_S2: Range = Range::new(-1000.0, 1000.0, "m/s²");
+    /// A time in a profile or a load history.
+    pub const TIME_S: Range = Range::new(0.0, 1e7, "s");
+    /// A run duration.
+    pub const DURATION_S: Range = Range::new(1e-6, 1e7, "s");
+    /// A time step.
+    pub const TIME_STEP_S: Range = Range::new(1e-9, 1e3, "s");
+    /// A wind speed, either sign.
+    pub const WIND_SPEED_M_S: Range = Range::new(-200.0, 200.0, "m/s");
+    /// A force on the aerostat, either sign.
+    pub const FORCE_N: Range = Range::new(-1e8, 1e8, "N");
+    /// A couple on the aerostat, either sign.
+    pub const MOMENT_N_M: Range = Range::new(-1e8, 1e8, "N m");
+    /// Aerostat radius.
+    pub const RADIUS_M: Range = Range::new(1e-3, 1000.0, "m");
+    /// Air or lifting-gas density.
+    pub const GAS_DENSITY_KG_M3: Range = Range::new(1e-4, 100.0, "kg/m³");
+    /// GE bending stiffness EI.
+    pub const BENDING_STIFFNESS_N_M2: Range = Range::new(1e-6, 1e12, "N m²");
+    /// GE ratios E* = EA L0²/EI and G A_s L0²/EI.
+    pub const STIFFNESS_RATIO: Range = Range::new(1.0, 1e12, "");
+    /// GE γ̃ = A_ρ L0²/I_ρ.
+    pub const INERTIA_RATIO: Range = Range::new(1e-6, 1e12, "");
+    /// A length of the rigid aerostat link.
+    pub const LINK_LENGTH_M: Range = Range::new(0.0, 1000.0, "m");
+    /// A forcing frequency.
+    pub const FREQUENCY_RAD_S: Range = Range::new(0.0, 1e4, "rad/s");
+    /// A platform amplitude of the base excitation.
+    pub const BASE_AMPLITUDE_M: Range = Range::new(1e-9, 1000.0, "m");
+    /// An elevation of a tabulated wind profile.
+    pub const ELEVATION_M: Range = Range::new(0.0, 1e5, "m");
+    /// A wind perturbation amplitude A0 of thesis (7.4).
+    pub const AMPLITUDE_NONDIM: Range = Range::new(-10.0, 10.0, "");
+    /// A wind perturbation wavenumber k.
+    pub const WAVENUMBER_1_M: Range = Range::new(0.0, 1000.0, "1/m");
+    /// A power-law wind exponent p of u = a z^p.
+    pub const EXPONENT_NONDIM: Range = Range::new(0.0, 2.0, "");
+    /// A drag coefficient C_D.
+    pub const DRAG_COEFFICIENT_NONDIM: Range = Range::new(0.0, 100.0, "");
+    /// A drag reference area.
+    pub const REFERENCE_AREA_M2: Range = Range::new(1e-6, 1e6, "m²");
+    /// A linear damping rate per unit mass, or a growth-rate tolerance.
+    pub const RATE_1_S: Range = Range::new(0.0, 1e6, "1/s");
+    /// ε of the two-DOF model of thesis (8.8).
+    pub const EPSILON_NONDIM: Range = Range::new(0.0, 10.0, "");
+    /// Initial tip deflection of a transient run, as a multiple of L0
+    /// (either sign): beyond it the linear string is meaningless.
+    pub const TIP_DEFLECTION_LENGTHS: f64 = 1.0;
+}
+
 /// The physical system: a heavy cable of changing length with the aerostat
 /// at its top. All fields SI.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,11 +228,13 @@ impl AerostatSystem {
             mass_per_length_kg_m: require_positive(
                 "cable.mass_per_length_kg_m",
                 mass_per_length_kg_m,
-            )?,
-            net_buoyancy_n: require_positive("aerostat.net_buoyancy_n", net_buoyancy_n)?,
-            aerostat_mass_kg: require_non_negative("aerostat.mass_kg", aerostat_mass_kg)?,
-            initial_length_m: require_positive("initial_length_m", initial_length_m)?,
-            gravity_m_s2: require_positive("gravity_m_s2", gravity_m_s2)?,
+            )
+            .and_then(|v| ranges::MASS_PER_LENGTH_KG_M.check("cable.mass_per_length_kg_m", v))?,
+            net_buoyancy_n: require_positive("aerostat.net_buoyancy_n", net_buoyancy_n)
+                .and_then(|v| ranges::NET_BUOYANCY_N.check("aerostat.net_buoyancy_n", v))?,
+            aerostat_mass_kg: ranges::AEROSTAT_MASS_KG.check("aerostat.mass_kg", aerostat_mass_kg)?,
+            initial_length_m: ranges::INITIAL_LENGTH_M.check("initial_length_m", initial_length_m)?,
+            gravity_m_s2: ranges::GRAVITY_M_S2.check("gravity_m_s2", gravity_m_s2)?,
         })
     }
 
