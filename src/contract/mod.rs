@@ -6,6 +6,8 @@
 pub mod dto;
 pub mod ge;
 pub mod ge_charts;
+pub mod ge_critical;
+pub mod ge_numerics;
 pub mod run;
 pub mod simulate;
 pub mod transient;
