@@ -195,10 +195,10 @@ pub struct GeChartNumericsInput {
     /// otherwise show as a false early onset).
     #[serde(default = "ge_numerics::default_scheme")]
     pub scheme: SchemeInput,
-    /// Spectral radius ρ∞ of the scheme as ωΔt → ∞ (default 0.5;
+    /// Spectral radius ρ∞ of the scheme as ωΔt → ∞ (default: 0 for generalized-α, 0.5 for HHT-α;
     /// generalized-α: 0–1, HHT-α: 0.5–1, average acceleration: 1).
     #[serde(default)]
-    #[schema(example = 0.5, minimum = 0.0, maximum = 1.0)]
+    #[schema(example = 0.0, minimum = 0.0, maximum = 1.0)]
     pub rho_infinity_nondim: Option<f64>,
     /// When Newton fails, halve the step and retry, at most this many
     /// levels deep.

@@ -114,7 +114,7 @@ pub struct GeCriticalRequest {
     /// The cable's motion when the winch starts.
     #[serde(default)]
     pub start_state: StartStateInput,
-    /// Step, QEP interval, horizon, scheme (default: generalized-α, ρ∞ = 0.5), step cuts.
+    /// Step, QEP interval, horizon, scheme (default: generalized-α, ρ∞ = 0), step cuts.
     #[serde(default)]
     pub numerics: Option<GeChartNumericsInput>,
     #[serde(default)]

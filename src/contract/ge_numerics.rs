@@ -16,17 +16,19 @@ use crate::numerics::params::InvalidInput;
 pub enum SchemeInput {
     /// Newmark average acceleration: no numerical dissipation (ρ∞ = 1).
     AverageAcceleration,
-    /// Chung–Hulbert generalized-α with spectral radius ρ∞ (default 0.5):
+    /// Chung–Hulbert generalized-α with spectral radius ρ∞ (default 0):
     /// unresolved (axial) modes lose the fraction 1 − ρ∞ of their
     /// amplitude per step; resolved modes are kept to second order.
     #[default]
     GeneralizedAlpha,
-    /// Hilber–Hughes–Taylor α with spectral radius ρ∞ ∈ [0.5, 1].
+    /// Hilber–Hughes–Taylor α with spectral radius ρ∞ ∈ [0.5, 1] (default 0.5).
     HhtAlpha,
 }
 
-/// Default ρ∞ of the dissipative schemes.
-pub const DEFAULT_RHO_INFINITY: f64 = 0.5;
+/// Default ρ∞ of generalized-α (the critical-time search's default scheme).
+pub const DEFAULT_RHO_INFINITY: f64 = 0.0;
+/// Default ρ∞ of HHT-α (its most dissipative member).
+pub const DEFAULT_HHT_RHO_INFINITY: f64 = 0.5;
 /// Default number of step halvings after a Newton failure.
 pub const DEFAULT_MAX_STEP_CUTS: u32 = 8;
 
@@ -61,7 +63,7 @@ pub fn scheme(
             rho_infinity: rho_infinity.unwrap_or(DEFAULT_RHO_INFINITY),
         },
         SchemeInput::HhtAlpha => Scheme::HhtAlpha {
-            rho_infinity: rho_infinity.unwrap_or(DEFAULT_RHO_INFINITY),
+            rho_infinity: rho_infinity.unwrap_or(DEFAULT_HHT_RHO_INFINITY),
         },
     };
     s.validate(&field)?;
