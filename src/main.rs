@@ -12,7 +12,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use tetherplan::config::ServeArgs;
 use tetherplan::contract::{
-    self, Progress, RequestError, dto, ge_charts, run, simulate, transient,
+    self, Progress, RequestError, dto, ge_charts, ge_critical, run, simulate, transient,
 };
 use tetherplan::numerics::chart::Parallelism;
 
@@ -176,8 +176,14 @@ fn main() -> ExitCode {
     };
     match &command {
         Command::Serve(args) => serve(args.clone()),
-        Command::Stability(arg) => answer(arg, run::stability),
-        Command::Critical(arg) => answer(arg, run::critical),
+        Command::Stability(arg) => answer_with(
+            arg,
+            ge_critical::parse_stability,
+            ge_critical::stability_any,
+        ),
+        Command::Critical(arg) => answer_with(arg, ge_critical::parse_critical, |req| {
+            ge_critical::critical_any(req, &contract::run::NoProgress)
+        }),
         Command::SafeRate(arg) => answer(arg, run::safe_rate),
         Command::Chart(arg) => answer_with(arg, ge_charts::parse_chart, |req| match req {
             ge_charts::AnyChartRequest::LinearString(req) => {

@@ -42,6 +42,7 @@ use crate::jobs::store::JobStatus;
         ErrorBody, ErrorDetail, JobStatus, JobItem, JobSubmission, BatchSubmission, BatchKind,
         BatchOutcome, BatchItemOutcome, StabilityResponse, CriticalResponse, SafeRateResponse, ChartResponse,
         Health,
+        crate::contract::ge_critical::GeCriticalResponse, crate::contract::ge_critical::GeStabilityResponse,
     )),
     tags(
         (name = "solve", description = "Synchronous answers (about a second at most)"),

@@ -20,6 +20,9 @@ use crate::contract::ge_charts::{
     self, AnyChartRequest, AnyChartResponse, AnyFrequencyResponseRequest,
     AnyFrequencyResponseResponse,
 };
+use crate::contract::ge_critical::{
+    self, AnyCriticalRequest, AnyCriticalResponse, AnyStabilityRequest, AnyStabilityResponse,
+};
 use crate::contract::run::{self, NoProgress};
 use crate::contract::simulate::{self, AnySimulateRequest, AnySimulateResponse};
 use crate::numerics::chart::Parallelism;
@@ -186,28 +189,68 @@ solve_path!(
     /// Eigenvalues and stability verdict at one deployment state.
     ///
     /// Solves the quadratic eigenvalue problem λ²M + λC + K = 0 of the
-    /// discretised cable. At most 400 elements synchronously.
-    compute_stability, "/api/v1/stability", StabilityRequest, StabilityResponse,
-    |req, limits| {
-        limit_qep_elements(&req.system, limits, "a stability analysis")?;
-        to_json(&run::stability(&req)?)
+    /// discretised cable. `model.kind` picks the model: `linear_string`
+    /// (default; at most 400 elements synchronously) or
+    /// `geometrically_exact` (the straight quasi-static equilibrium at the
+    /// state's length, rate and acceleration, then the local QEP about it;
+    /// at most 100 elements synchronously).
+    compute_stability, "/api/v1/stability", AnyStabilityRequest, AnyStabilityResponse,
+    parse = |body| ge_critical::parse_stability(body),
+    |req, limits| match &req {
+        AnyStabilityRequest::LinearString(req) => {
+            req.system.model().map_err(contract::RequestError::from)?;
+            limit_qep_elements(&req.system, limits, "a stability analysis")?;
+            to_json(&run::stability(req)?)
+        }
+        AnyStabilityRequest::GeometricallyExact(r) => {
+            limit_ge_elements(r.model.elements, MAX_SYNC_GE_STABILITY_ELEMENTS, "a GE stability analysis")?;
+            to_json(&ge_critical::ge_stability(r)?)
+        }
     }
 );
 
 solve_path!(
     /// Critical time t* and maximum safe elevation h* of a deployment profile.
     ///
-    /// With the closed-form continuum bound beside it. QEP-based searches
-    /// (accelerating profiles, `confirm_with_qep`) take at most 400
-    /// elements synchronously.
-    compute_critical, "/api/v1/critical", CriticalRequest, CriticalResponse,
-    |req, limits| {
-        if req.params.confirm_with_qep || matches!(req.params.profile, ProfileInput::ConstantAcceleration { .. }) {
-            limit_qep_elements(&req.system, limits, "a QEP-based critical-time search")?;
+    /// With the closed-form continuum bound beside it. `model.kind` picks
+    /// the model: `linear_string` (default; QEP-based searches —
+    /// accelerating profiles, `confirm_with_qep` — take at most 400
+    /// elements synchronously) or `geometrically_exact` (a Newmark march
+    /// with local-stability checks, generalized-α by default, steps cut
+    /// on Newton failure; about a second at 20 elements, at most 40
+    /// elements synchronously; longer runs stop at the timeout: submit a
+    /// job with `"kind": "critical"`).
+    compute_critical, "/api/v1/critical", AnyCriticalRequest, AnyCriticalResponse,
+    parse = |body| ge_critical::parse_critical(body),
+    |req, limits| match &req {
+        AnyCriticalRequest::LinearString(req) => {
+            req.system.model().map_err(contract::RequestError::from)?;
+            if req.params.confirm_with_qep || matches!(req.params.profile, ProfileInput::ConstantAcceleration { .. }) {
+                limit_qep_elements(&req.system, limits, "a QEP-based critical-time search")?;
+            }
+            to_json(&run::critical(req)?)
         }
-        to_json(&run::critical(&req)?)
+        AnyCriticalRequest::GeometricallyExact(r) => {
+            limit_ge_elements(r.model.elements, MAX_SYNC_GE_CRITICAL_ELEMENTS, "a GE critical-time search")?;
+            to_json(&ge_critical::ge_critical(r, &Deadline::after(limits))?)
+        }
     }
 );
+
+/// Elements a synchronous GE stability answer may have.
+pub const MAX_SYNC_GE_STABILITY_ELEMENTS: usize = 100;
+/// Elements a synchronous GE critical-time search may have.
+pub const MAX_SYNC_GE_CRITICAL_ELEMENTS: usize = 40;
+
+fn limit_ge_elements(n: usize, max: usize, why: &str) -> Result<(), ApiError> {
+    if n > max {
+        return Err(ApiError::too_large(
+            "model.elements",
+            format!("{why} with {n} elements takes too long to answer synchronously (at most {max}; submit a job)"),
+        ));
+    }
+    Ok(())
+}
 
 solve_path!(
     /// Largest safe constant winch rate to reach a target elevation.

@@ -11,6 +11,7 @@ use utoipa::ToSchema;
 
 use crate::contract::dto::{CableInput, ProfileInput, RateGrid};
 use crate::contract::ge::{GeAerostatInput, GeModelInput, GeModelKind, NewtonInput};
+use crate::contract::ge_numerics::{self, IntegratorOutput, SchemeInput, StartStateInput};
 use crate::contract::{Progress, RequestError};
 use crate::numerics::aero::{AerostatBody, ForceModel, SteadyFlow};
 use crate::numerics::chart::{Parallelism, rate_grid};
@@ -196,6 +197,21 @@ pub struct GeChartNumericsInput {
     #[serde(default = "default_growth")]
     #[schema(example = 1e-6, minimum = 0.0)]
     pub growth_tolerance_1_s: f64,
+    /// Time-stepping scheme; default: generalized-α, which dissipates the
+    /// unresolved axial modes a start from rest sets ringing (they
+    /// otherwise show as a false early onset).
+    #[serde(default = "ge_numerics::default_scheme")]
+    pub scheme: SchemeInput,
+    /// Spectral radius ρ∞ of the scheme as ωΔt → ∞ (default: 0 for generalized-α, 0.5 for HHT-α;
+    /// generalized-α: 0–1, HHT-α: 0.5–1, average acceleration: 1).
+    #[serde(default)]
+    #[schema(example = 0.0, minimum = 0.0, maximum = 1.0)]
+    pub rho_infinity_nondim: Option<f64>,
+    /// When Newton fails, halve the step and retry, at most this many
+    /// levels deep.
+    #[serde(default = "ge_numerics::default_max_step_cuts")]
+    #[schema(example = 8, minimum = 0, maximum = 12)]
+    pub max_step_cuts: u32,
 }
 
 fn default_dt() -> f64 {
@@ -241,6 +257,9 @@ pub struct GeChartRequest {
     pub numerics: Option<GeChartNumericsInput>,
     #[serde(default)]
     pub newton: Option<NewtonInput>,
+    /// The cable's motion when the winch starts (every point).
+    #[serde(default)]
+    pub start_state: StartStateInput,
 }
 
 /// How a point's search ended.
@@ -282,6 +301,13 @@ pub struct GeChartPointOutput {
     pub ended_at_s: Option<f64>,
     pub steps: usize,
     pub qep_solves: usize,
+    /// Steps halved and retried after a Newton failure.
+    pub step_cuts: usize,
+    /// Whether the closed forms beside this point describe its onset
+    /// (false with wind, or when the onset is a start-up transient).
+    pub closed_form_applies: bool,
+    /// Why the closed forms do not apply, when they do not.
+    pub closed_form_note: Option<String>,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
@@ -302,9 +328,12 @@ pub struct GeChartResponse {
     pub time_scale_s: f64,
     /// √(F/ρA) of the first buoyancy (m/s).
     pub wave_speed_m_s: f64,
+    /// The time-stepping scheme and its numerical dissipation.
+    pub integrator: IntegratorOutput,
+    pub start_state: StartStateInput,
 }
 
-fn newton_config(input: &Option<NewtonInput>) -> Result<NewtonConfig, InvalidInput> {
+pub(crate) fn newton_config(input: &Option<NewtonInput>) -> Result<NewtonConfig, InvalidInput> {
     let Some(n) = input else {
         return Ok(NewtonConfig::default());
     };
@@ -430,6 +459,9 @@ pub fn prepare_chart(req: &GeChartRequest) -> Result<CoreChart, InvalidInput> {
         check_every_steps: default_check(),
         horizon_s: default_horizon(),
         growth_tolerance_1_s: default_growth(),
+        scheme: ge_numerics::default_scheme(),
+        rho_infinity_nondim: None,
+        max_step_cuts: ge_numerics::default_max_step_cuts(),
     };
     let n = req.numerics.as_ref().unwrap_or(&defaults);
     if n.check_every_steps > 100_000 {
@@ -444,6 +476,8 @@ pub fn prepare_chart(req: &GeChartRequest) -> Result<CoreChart, InvalidInput> {
         growth_tolerance_1_s: n.growth_tolerance_1_s,
         horizon_s: n.horizon_s,
         newton: newton_config(&req.newton)?,
+        scheme: ge_numerics::scheme(n.scheme, n.rho_infinity_nondim, "numerics")?,
+        max_step_cuts: ge_numerics::step_cuts(n.max_step_cuts, "numerics")?,
     };
     let core = CoreChart {
         system,
@@ -459,6 +493,7 @@ pub fn prepare_chart(req: &GeChartRequest) -> Result<CoreChart, InvalidInput> {
             .map(|w| wind(w, std::f64::consts::PI))
             .transpose()?,
         config,
+        start: req.start_state.into(),
     };
     // names the field: `perturbation.*`, `stiffness_ratios[i]`, …
     core.validate().map_err(|e| {
@@ -556,6 +591,9 @@ pub fn ge_chart(
                         ended_at_s,
                         steps: p.steps,
                         qep_solves: p.qep_solves,
+                        step_cuts: p.step_cuts,
+                        closed_form_applies: p.closed_form.applies(),
+                        closed_form_note: p.closed_form.reason(),
                     }
                 })
                 .collect(),
@@ -566,6 +604,8 @@ pub fn ge_chart(
         elements: core.system.elements,
         time_scale_s: scale,
         wave_speed_m_s: (core.net_buoyancies_n[0] / core.system.mass_per_length_kg_m).sqrt(),
+        integrator: IntegratorOutput::new(core.config.scheme, core.config.max_step_cuts),
+        start_state: req.start_state,
     })
 }
 

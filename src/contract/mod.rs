@@ -7,6 +7,8 @@ pub mod dto;
 pub mod ge;
 pub mod ge_charts;
 pub mod ranges;
+pub mod ge_critical;
+pub mod ge_numerics;
 pub mod run;
 pub mod simulate;
 pub mod transient;

@@ -18,6 +18,7 @@ use utoipa::ToSchema;
 use crate::config::Limits;
 use crate::contract::dto::*;
 use crate::contract::ge_charts::{self, AnyChartRequest, AnyFrequencyResponseRequest};
+use crate::contract::ge_critical::{self, AnyCriticalRequest, AnyStabilityRequest};
 use crate::contract::run::{self, MAX_MODES};
 use crate::contract::simulate::{self, AnySimulateRequest};
 use crate::contract::transient::{self, FrequencyResponseRequest};
@@ -319,6 +320,46 @@ impl JobKind for AnyFrequencyResponseRequest {
     }
 }
 
+impl JobKind for AnyStabilityRequest {
+    const NAME: &'static str = "stability";
+    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
+        ge_critical::parse_stability(body)
+    }
+    fn validate(&self) -> Result<(), RequestError> {
+        match self {
+            Self::LinearString(r) => r.validate(),
+            Self::GeometricallyExact(r) => ge_critical::validate_stability(r).map_err(Into::into),
+        }
+    }
+    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
+        match self {
+            Self::LinearString(r) => r.run(progress),
+            Self::GeometricallyExact(r) => to_json(&ge_critical::ge_stability(r)?),
+        }
+    }
+}
+
+impl JobKind for AnyCriticalRequest {
+    const NAME: &'static str = "critical";
+    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
+        ge_critical::parse_critical(body)
+    }
+    fn validate(&self) -> Result<(), RequestError> {
+        match self {
+            Self::LinearString(r) => r.validate(),
+            Self::GeometricallyExact(r) => ge_critical::prepare_critical(r)
+                .map(drop)
+                .map_err(Into::into),
+        }
+    }
+    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
+        match self {
+            Self::LinearString(r) => r.run(progress),
+            Self::GeometricallyExact(r) => to_json(&ge_critical::ge_critical(r, progress)?),
+        }
+    }
+}
+
 fn prefixed(e: RequestError, prefix: &str) -> RequestError {
     match e {
         RequestError::Invalid(InvalidInput { field, reason }) => {
@@ -369,10 +410,10 @@ macro_rules! job_kinds {
 }
 
 job_kinds!(
-    /// `POST /api/v1/stability`.
-    Stability(StabilityRequest),
-    /// `POST /api/v1/critical`.
-    Critical(CriticalRequest),
+    /// `POST /api/v1/stability` (either cable model).
+    Stability(AnyStabilityRequest),
+    /// `POST /api/v1/critical` (either cable model).
+    Critical(AnyCriticalRequest),
     /// `POST /api/v1/safe-rate`.
     SafeRate(SafeRateRequest),
     /// `POST /api/v1/charts`, up to 1 000 000 points (GE: 2 000).

@@ -140,6 +140,8 @@ pub struct GeChartRequest {
     /// Air flow; `None`: still air.
     pub wind: Option<GeChartWind>,
     pub config: CriticalConfig,
+    /// The cable's state when the winch starts (every point).
+    pub start: StartState,
 }
 
 /// One point of a series.
@@ -159,6 +161,108 @@ pub struct GeChartPoint {
     pub onset: GeOnset,
     pub steps: usize,
     pub qep_solves: usize,
+    /// Steps halved and retried after a Newton failure.
+    pub step_cuts: usize,
+    /// Whether the closed forms describe this onset.
+    pub closed_form: ClosedFormVerdict,
+}
+
+/// Relative departure of the onset from the quasi-static state, in the
+/// critical length, beyond which the closed forms are flagged as not
+/// applying ([`closed_form_verdict`]).
+pub const CLOSED_FORM_TOLERANCE: f64 = 0.02;
+
+/// Whether the quasi-static closed forms printed beside a GE onset
+/// describe it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ClosedFormVerdict {
+    /// The onset is the quasi-static loss of tension the closed forms
+    /// describe (or the search ended without one).
+    Applies,
+    /// Air flow loads the aerostat; the closed forms are for still air.
+    Wind,
+    /// The axial force at the guide at `t*` departs from the quasi-static
+    /// (steady-payout) tension by `departure_n`, which alone moves the
+    /// onset by `length_shift_m`: the onset is set by a start-up transient
+    /// (axial ringing, the tip perturbation), not by the steady loss of
+    /// tension.
+    Transient {
+        departure_n: f64,
+        length_shift_m: f64,
+        closed_form_m: f64,
+    },
+}
+
+impl ClosedFormVerdict {
+    pub fn applies(&self) -> bool {
+        matches!(self, Self::Applies)
+    }
+
+    /// Why the closed forms do not apply, in words.
+    pub fn reason(&self) -> Option<String> {
+        match *self {
+            Self::Applies => None,
+            Self::Wind => Some(
+                "air flow loads the aerostat; the closed forms are for still air".to_string(),
+            ),
+            Self::Transient {
+                departure_n,
+                length_shift_m,
+                closed_form_m,
+            } => Some(format!(
+                "the onset is a start-up transient: at t* the axial force at the guide departs from \
+                 the quasi-static tension by {departure_n:+.1} N, which alone moves the onset by \
+                 {length_shift_m:.1} m ({:.1} % of the quasi-static {closed_form_m:.1} m, more than \
+                 {:.0} %); the closed forms assume a steady payout",
+                100.0 * length_shift_m.abs() / closed_form_m.max(f64::MIN_POSITIVE),
+                100.0 * CLOSED_FORM_TOLERANCE
+            )),
+        }
+    }
+}
+
+/// Judges the closed forms against a constant-rate onset: with wind they
+/// never apply; otherwise the axial force `N` in the element at the guide
+/// at `t*` is compared with the steady-payout tension `N_qs` there
+/// ([`ExtensibleString::tension_n`]), and the closed forms apply when the
+/// departure moves the critical length by at most
+/// [`CLOSED_FORM_TOLERANCE`] of the quasi-static one:
+/// `|N − N_qs| (1 + β)/(μ g) ≤ tol · L*`.
+pub fn closed_form_verdict(
+    model: &GeModel,
+    rate_m_s: f64,
+    net_buoyancy_n: f64,
+    windy: bool,
+    result: &super::critical::GeCriticalTime,
+) -> ClosedFormVerdict {
+    if windy {
+        return ClosedFormVerdict::Wind;
+    }
+    let (GeOnset::During { length_m, .. }, Some(force)) =
+        (result.onset, result.onset_root_axial_force_n)
+    else {
+        return ClosedFormVerdict::Applies;
+    };
+    let string = ExtensibleString {
+        net_buoyancy_n,
+        aerostat_mass_kg: model.tip.mass_kg,
+        mass_per_length_kg_m: model.section.mass_per_length_kg_m,
+        axial_stiffness_n: model.section.axial_stiffness_n,
+        gravity_m_s2: model.gravity_m_s2,
+    };
+    let x = 0.5 * length_m / model.elements as f64;
+    let departure_n = force - string.tension_n(rate_m_s, length_m, x);
+    let length_shift_m = departure_n * string.length_per_tension_m_n(rate_m_s);
+    let closed_form_m = string.critical_length_m(rate_m_s).unwrap_or(0.0);
+    if length_shift_m.abs() <= CLOSED_FORM_TOLERANCE * closed_form_m.max(length_m) {
+        ClosedFormVerdict::Applies
+    } else {
+        ClosedFormVerdict::Transient {
+            departure_n,
+            length_shift_m,
+            closed_form_m,
+        }
+    }
 }
 
 /// One series: a stiffness ratio, perturbation, buoyancy and flow amplitude.
@@ -185,6 +289,7 @@ impl GeChartRequest {
             net_buoyancies_n: vec![1000.0],
             wind: None,
             config: CriticalConfig::default(),
+            start: StartState::AtRest,
         }
     }
 
@@ -282,15 +387,17 @@ pub fn chart_point(
     perturbation: Option<TipPerturbation>,
     aero: Option<Aerodynamics>,
     config: &CriticalConfig,
+    start: StartState,
     cancel: &(dyn Fn() -> bool + Sync),
 ) -> Result<GeChartPoint, InvalidInput> {
     let profile = Profile::constant_rate(system.initial_length_m, rate_m_s, None)?;
+    let windy = aero.is_some();
     let problem = CriticalProblem {
         profile: profile.clone(),
         net_buoyancy_n,
         perturbation,
         aero,
-        start: StartState::AtRest,
+        start,
     };
     let r = critical_time(model, &problem, config, cancel)?;
     let string = |axial_stiffness_n: f64| {
@@ -313,6 +420,8 @@ pub fn chart_point(
         onset: r.onset,
         steps: r.steps,
         qep_solves: r.qep_solves,
+        step_cuts: r.step_cuts,
+        closed_form: closed_form_verdict(model, rate_m_s, net_buoyancy_n, windy, &r),
     })
 }
 
@@ -364,6 +473,7 @@ pub fn deployment_chart(
             perturbation,
             aero,
             &request.config,
+            request.start,
             cancel,
         );
         progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);

@@ -69,6 +69,24 @@ impl ExtensibleString {
         (length > 0.0).then_some(length)
     }
 
+    /// Quasi-static axial force (N) at unstretched distance `x_m` from the
+    /// guide once `length_m` has been paid out at `rate_m_s`:
+    /// `N(x) = F − m A − μ (g + A) (L − x)`, `A = −β g/(1 + β)`.
+    pub fn tension_n(&self, rate_m_s: f64, length_m: f64, x_m: f64) -> f64 {
+        let beta = self.beta(rate_m_s);
+        let g = self.gravity_m_s2;
+        let accel = -beta * g / (1.0 + beta);
+        self.net_buoyancy_n
+            - self.aerostat_mass_kg * accel
+            - self.mass_per_length_kg_m * (g + accel) * (length_m - x_m)
+    }
+
+    /// How far the critical length moves per newton of extra tension at
+    /// the guide (m/N): `1/|dN₀/dL| = (1 + β)/(μ g)`.
+    pub fn length_per_tension_m_n(&self, rate_m_s: f64) -> f64 {
+        (1.0 + self.beta(rate_m_s)) / (self.mass_per_length_kg_m * self.gravity_m_s2)
+    }
+
     /// Rate at which extensibility stops lengthening `L*` and starts
     /// shortening it, to first order in `β` (m/s).
     pub fn crossover_rate_m_s(&self) -> f64 {

@@ -80,3 +80,75 @@ fn spectrum_of(model: &GeModel, sys: SystemMatrices) -> Result<Spectrum, QepErro
             .collect(),
     ))
 }
+
+/// How the cable moves at a queried state (see [`super::critical::StartState`]).
+pub use super::critical::StartState as StateMotion;
+
+/// Local stability of the GE cable at one deployment state `(L, L̇, L̈)`.
+#[derive(Clone, Debug)]
+pub struct GeStateStability {
+    /// The straight equilibrium (quasi-static at the state's rate and
+    /// acceleration) about which the QEP was solved.
+    pub state: State,
+    pub spectrum: Spectrum,
+    /// Axial force in the element at the guide (N).
+    pub root_axial_force_n: f64,
+    /// Load increments of the equilibrium solve.
+    pub load_steps: usize,
+}
+
+/// Why a state's stability could not be computed.
+#[derive(Debug)]
+pub enum GeStateFailure {
+    /// The quasi-static equilibrium did not converge.
+    Equilibrium(solver::NewtonFailure),
+    /// The mass matrix was singular or the eigenvalue iteration failed.
+    Spectrum(QepError),
+}
+
+/// The local QEP (7.3) at a deployment state: the straight equilibrium of
+/// the cable at length `kin.length_m` under the tip load, gravity and the
+/// sliding terms of the rate and acceleration in `kin` (static solve in
+/// the mapped frame, in `load_steps` increments), with the velocity of
+/// `motion` (`AtRest`: every point moves at `L̇` along the guide;
+/// `SteadyPayout`: the quasi-static payout of a stretched cable) and the
+/// consistent acceleration `M q̈ = −R(q, q̇, 0)`; then the spectrum about
+/// that state. This is the state the critical-time search starts from
+/// ([`super::critical::initial_state`]) placed at any length.
+pub fn state_stability(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    motion: StateMotion,
+    load_steps: usize,
+    newton: solver::NewtonConfig,
+) -> Result<GeStateStability, GeStateFailure> {
+    let q = solver::static_solve(model, kin, load, load_steps, newton)
+        .map_err(GeStateFailure::Equilibrium)?;
+    let v = match motion {
+        StateMotion::AtRest => vec![0.0; q.len()],
+        StateMotion::SteadyPayout => super::critical::steady_payout_velocity(model, kin, &q),
+    };
+    let zero = vec![0.0; q.len()];
+    let r = solver::residual(model, kin, load, 0.0, &q, &v, &zero);
+    let m = solver::system_matrices(model, kin, load, 0.0, &q, &v, &zero).mass;
+    let lu = m
+        .factor()
+        .ok_or(GeStateFailure::Spectrum(QepError::NonFinite))?;
+    let mut a: Vec<f64> = r.total.iter().map(|x| -x).collect();
+    lu.solve_in_place(&mut a);
+    let state = State {
+        time_s: 0.0,
+        q,
+        v,
+        a,
+    };
+    let spectrum =
+        local_spectrum(model, kin, load, 0.0, &state).map_err(GeStateFailure::Spectrum)?;
+    Ok(GeStateStability {
+        root_axial_force_n: super::critical::root_axial_force_n(model, kin.length_m, &state.q),
+        spectrum,
+        state,
+        load_steps,
+    })
+}
