@@ -24,10 +24,19 @@ pub enum RequestError {
     Invalid(#[from] InvalidInput),
     /// The numerics failed on valid input (HTTP 500; should not happen).
     #[error("numerical failure: {0}")]
-    Numerical(#[from] QepError),
+    Numerical(QepError),
     /// The work was cancelled through its progress handle.
     #[error("cancelled")]
     Cancelled,
+}
+
+impl From<QepError> for RequestError {
+    fn from(e: QepError) -> Self {
+        match e {
+            QepError::Cancelled => Self::Cancelled,
+            e => Self::Numerical(e),
+        }
+    }
 }
 
 /// Progress reporting and cancellation for long requests.
@@ -199,6 +208,14 @@ pub fn stability(req: &StabilityRequest) -> Result<StabilityResponse, RequestErr
 }
 
 pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError> {
+    critical_with(req, &NoProgress)
+}
+
+/// [`critical`], stopping (`RequestError::Cancelled`) when `progress` is cancelled.
+pub fn critical_with(
+    req: &CriticalRequest,
+    progress: &dyn Progress,
+) -> Result<CriticalResponse, RequestError> {
     let model = req.system.model()?;
     let sys = model.system;
     let profile = req.params.profile.profile(sys.initial_length_m)?;
@@ -211,12 +228,13 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
             .into());
         }
     }
-    let result = critical::critical_time(
+    let result = critical::critical_time_cancellable(
         &model,
         &profile,
         SearchConfig {
             confirm_with_qep: req.params.confirm_with_qep,
         },
+        &|| progress.cancelled(),
     )?;
     let closed_form = match req.params.profile {
         ProfileInput::ConstantRate { rate_m_s, .. } if rate_m_s > 0.0 => {
@@ -356,14 +374,19 @@ pub fn chart(
         req.params.net_buoyancies_n.clone()
     };
     let report = |done: usize, total: usize| progress.report(done, total);
-    let series = chart::deployment_chart(
+    let cancel = || progress.cancelled();
+    let series = chart::deployment_chart_cancellable(
         &sys,
         model.elements(),
         &rates,
         &buoyancies,
         parallelism,
         &report,
+        &cancel,
     )?;
+    let Some(series) = series else {
+        return Err(RequestError::Cancelled);
+    };
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }

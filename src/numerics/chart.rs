@@ -78,6 +78,31 @@ pub fn deployment_chart(
     parallelism: Parallelism,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<ChartSeries>, InvalidInput> {
+    let never = || false;
+    deployment_chart_cancellable(
+        base,
+        elements,
+        rates_m_s,
+        net_buoyancies_n,
+        parallelism,
+        progress,
+        &never,
+    )
+    .map(|series| series.expect("never cancelled"))
+}
+
+/// [`deployment_chart`], polled for cancellation before every point:
+/// `Ok(None)` once `cancel()` has returned `true` (the remaining points
+/// are skipped).
+pub fn deployment_chart_cancellable(
+    base: &AerostatSystem,
+    elements: usize,
+    rates_m_s: &[f64],
+    net_buoyancies_n: &[f64],
+    parallelism: Parallelism,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &(dyn Fn() -> bool + Sync),
+) -> Result<Option<Vec<ChartSeries>>, InvalidInput> {
     crate::numerics::string::validate_elements("model.elements", elements)?;
     if net_buoyancies_n.is_empty() {
         return Err(InvalidInput::new(
@@ -105,8 +130,20 @@ pub fn deployment_chart(
     }
     let operators = Arc::new(StringOperators::new(elements));
     let done = AtomicUsize::new(0);
+    let stopped = std::sync::atomic::AtomicBool::new(false);
     let point = |index: usize| -> ChartPoint {
         let (s, r) = (index / rates_m_s.len(), index % rates_m_s.len());
+        if stopped.load(Ordering::Relaxed) || cancel() {
+            stopped.store(true, Ordering::Relaxed);
+            let nan = f64::NAN;
+            return ChartPoint {
+                rate_m_s: rates_m_s[r],
+                critical_time_s: nan,
+                max_elevation_m: nan,
+                closed_form_elevation_m: nan,
+                onset: Onset::Never { until_s: nan },
+            };
+        }
         let model = StringModel::with_operators(systems[s], operators.clone());
         let p = chart_point(&model, rates_m_s[r]);
         progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
@@ -116,14 +153,19 @@ pub fn deployment_chart(
         Parallelism::Serial => (0..total).map(point).collect(),
         Parallelism::Rayon => (0..total).into_par_iter().map(point).collect(),
     };
-    Ok(systems
-        .iter()
-        .zip(flat.chunks(rates_m_s.len().max(1)))
-        .map(|(sys, pts)| ChartSeries {
-            net_buoyancy_n: sys.net_buoyancy_n,
-            points: pts.to_vec(),
-        })
-        .collect())
+    if stopped.load(Ordering::Relaxed) {
+        return Ok(None);
+    }
+    Ok(Some(
+        systems
+            .iter()
+            .zip(flat.chunks(rates_m_s.len().max(1)))
+            .map(|(sys, pts)| ChartSeries {
+                net_buoyancy_n: sys.net_buoyancy_n,
+                points: pts.to_vec(),
+            })
+            .collect(),
+    ))
 }
 
 /// One chart point: constant-rate lengthening from `L0`, no target.

@@ -378,7 +378,7 @@ pub fn critical_time(
     let mut stable_sample = first;
     let mut step = 0;
     while step < total_steps {
-        if step % 256 == 0 && cancel() {
+        if step % 16 == 0 && cancel() {
             out.onset = GeOnset::Cancelled {
                 time_s: integrator.state.time_s,
             };
@@ -410,6 +410,12 @@ pub fn critical_time(
         let mut fine = Integrator::new(model, &drive, stable_state.clone(), dt, config.newton);
         let mut before = stable_sample;
         let after = loop {
+            if cancel() {
+                out.onset = GeOnset::Cancelled {
+                    time_s: fine.state.time_s,
+                };
+                return Ok(out);
+            }
             if let Err(f) = fine.step() {
                 out.onset = GeOnset::NewtonFailed(f);
                 return Ok(out);
