@@ -7,6 +7,8 @@ use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::time::Duration;
 
+pub use crate::api::server::ConnectionLimits;
+
 /// `tetherplan serve` flags.
 #[derive(Clone, Debug, clap::Args)]
 pub struct ServeArgs {
@@ -16,9 +18,9 @@ pub struct ServeArgs {
     /// SQLite database of batch jobs (created if missing; WAL mode).
     #[arg(long, env = "TETHERPLAN_DB", default_value = "./tetherplan.db")]
     pub db: PathBuf,
-    /// Directory served at `GET /` (the chart page).
-    #[arg(long, env = "TETHERPLAN_STATIC_DIR", default_value = "./static")]
-    pub static_dir: PathBuf,
+    /// Directory served at `GET /` instead of the chart page built into the binary.
+    #[arg(long, env = "TETHERPLAN_STATIC_DIR")]
+    pub static_dir: Option<PathBuf>,
     /// Largest request body (bytes); larger bodies get 413.
     #[arg(long, env = "TETHERPLAN_MAX_BODY_BYTES", default_value_t = Limits::default().max_body_bytes)]
     pub max_body_bytes: usize,
@@ -34,6 +36,20 @@ pub struct ServeArgs {
     /// Threads of the job pool (0: one per core).
     #[arg(long, env = "TETHERPLAN_JOB_THREADS", default_value_t = 0)]
     pub job_threads: usize,
+    /// Host names requests may address besides loopback and the bind
+    /// address (comma-separated; `*`: any). Others get 421.
+    #[arg(long, env = "TETHERPLAN_ALLOWED_HOSTS")]
+    pub allowed_hosts: Option<String>,
+    /// Connections open at once (clamped below the file limit); past it the
+    /// oldest connection is closed.
+    #[arg(long, env = "TETHERPLAN_MAX_CONNECTIONS", default_value_t = ConnectionLimits::default().max_connections)]
+    pub max_connections: usize,
+    /// Seconds a client has to send a request head (also the keep-alive idle time).
+    #[arg(long, env = "TETHERPLAN_HEADER_TIMEOUT_S", default_value_t = ConnectionLimits::default().header_timeout.as_secs_f64())]
+    pub header_timeout_s: f64,
+    /// Seconds allowed between two pieces of a request body.
+    #[arg(long, env = "TETHERPLAN_BODY_TIMEOUT_S", default_value_t = ConnectionLimits::default().body_timeout.as_secs_f64())]
+    pub body_timeout_s: f64,
 }
 
 /// Limits of the HTTP service.
@@ -75,9 +91,12 @@ impl Default for Limits {
 pub struct Config {
     pub addr: SocketAddr,
     pub db: PathBuf,
-    pub static_dir: PathBuf,
+    /// `None`: the page built into the binary.
+    pub static_dir: Option<PathBuf>,
     pub job_threads: usize,
     pub limits: Limits,
+    pub connections: ConnectionLimits,
+    pub allowed_hosts: Option<String>,
 }
 
 impl From<ServeArgs> for Config {
@@ -101,6 +120,13 @@ impl From<ServeArgs> for Config {
                 max_pending_jobs: a.max_pending_jobs,
                 ..Limits::default()
             },
+            connections: ConnectionLimits {
+                header_timeout: Duration::from_secs_f64(a.header_timeout_s.clamp(0.1, 3600.0)),
+                body_timeout: Duration::from_secs_f64(a.body_timeout_s.clamp(0.1, 3600.0)),
+                max_connections: a.max_connections.max(1),
+                ..ConnectionLimits::default()
+            },
+            allowed_hosts: a.allowed_hosts,
         }
     }
 }

@@ -86,11 +86,19 @@ fn read_input(arg: &InputArg) -> Result<Vec<u8>, String> {
     }
 }
 
+/// Prints the JSON answer on stdout. A reader that has gone away (`… | head
+/// -1`) is not an error: the process exits quietly with status 0.
 fn print_json(value: &impl Serialize) {
-    println!(
-        "{}",
-        serde_json::to_string_pretty(value).expect("responses serialise")
-    );
+    use std::io::Write;
+    let text = serde_json::to_string_pretty(value).expect("responses serialise");
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = writeln!(out, "{text}").and_then(|()| out.flush()) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("tetherplan: cannot write the answer: {e}");
+        std::process::exit(1);
+    }
 }
 
 fn answer<Req: dto::SystemRequest, Resp: Serialize>(
@@ -148,6 +156,8 @@ fn serve(args: ServeArgs) -> ExitCode {
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
         )
         .with_writer(std::io::stderr)
+        // Colour only on a terminal: log files and pipes get plain text.
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .init();
     let runtime = match tokio::runtime::Builder::new_multi_thread()
         .enable_all()

@@ -9,10 +9,14 @@
 //!
 //! Every error is the one body of [`error::ApiError`].
 
+pub mod assets;
 pub mod error;
+pub mod guard;
 pub mod jobs;
 pub mod openapi;
+pub mod server;
 pub mod solve;
+pub mod spec;
 
 use std::path::Path;
 use std::sync::Arc;
@@ -93,10 +97,18 @@ async fn method_not_allowed() -> ApiError {
     )
 }
 
-/// The application: every route, the body limit, request tracing.
+/// The application: every route, the body limit, request tracing; the
+/// page from `static_dir`.
 pub fn router(state: AppState, static_dir: &Path) -> Router {
+    app(state, Some(static_dir))
+}
+
+/// The application with the page from `static_dir`, or (`None`) the copy
+/// built into the binary ([`assets`]). Every response carries the
+/// security headers ([`guard::security_headers`]).
+pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
     let body_limit = state.limits.max_body_bytes;
-    Router::new()
+    let routes = Router::new()
         .route("/healthz", get(get_health))
         .route("/api/v1/stability", post(solve::compute_stability))
         .route("/api/v1/critical", post(solve::compute_critical))
@@ -116,9 +128,14 @@ pub fn router(state: AppState, static_dir: &Path) -> Router {
         .route("/api/{*rest}", any(api_not_found))
         .method_not_allowed_fallback(method_not_allowed)
         .with_state(state)
-        .merge(SwaggerUi::new("/docs").url("/openapi.json", openapi::openapi()))
-        .fallback_service(ServeDir::new(static_dir))
+        .merge(SwaggerUi::new("/docs").url("/openapi.json", openapi::openapi()));
+    let routes = match static_dir {
+        Some(dir) => routes.fallback_service(ServeDir::new(dir)),
+        None => routes.fallback(assets::serve_embedded),
+    };
+    routes
         .layer(DefaultBodyLimit::max(body_limit))
+        .layer(axum::middleware::map_response(guard::security_headers))
         .layer(TraceLayer::new_for_http())
 }
 
@@ -134,17 +151,49 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
         config.limits.clone(),
     ));
     let worker = queue.spawn_worker();
-    let app = router(AppState::new(queue.clone()), &config.static_dir);
     let listener = tokio::net::TcpListener::bind(config.addr)
         .await
         .map_err(|e| format!("cannot listen on {}: {e}", config.addr))?;
     let addr = listener.local_addr()?;
-    tracing::info!(%addr, db = %config.db.display(), static_dir = %config.static_dir.display(), "listening");
+    let hosts = guard::HostAllowList::new(addr, config.allowed_hosts.as_deref());
+    let app = app(AppState::new(queue.clone()), config.static_dir.as_deref())
+        .layer(tower_http::timeout::RequestBodyTimeoutLayer::new(
+            config.connections.body_timeout,
+        ))
+        .layer(axum::middleware::from_fn_with_state(
+            hosts.clone(),
+            guard::HostAllowList::check,
+        ));
+    let fd_limit = server::raise_fd_limit();
+    let cap = server::connection_cap(config.connections.max_connections, fd_limit);
+    let static_dir = config
+        .static_dir
+        .as_ref()
+        .map_or("(built in)".to_string(), |d| d.display().to_string());
+    tracing::info!(%addr, db = %config.db.display(), %static_dir, "listening");
+    tracing::info!(
+        max_connections = cap,
+        fd_limit = fd_limit.unwrap_or(0),
+        header_timeout_s = config.connections.header_timeout.as_secs_f64(),
+        body_timeout_s = config.connections.body_timeout.as_secs_f64(),
+        allowed_hosts = %hosts.describe(),
+        "connection limits"
+    );
+    warn_if_exposed(addr);
     // A line for scripts and tests (port 0 picks a free port).
-    println!("tetherplan listening on http://{addr}");
-    axum::serve(listener, app)
-        .with_graceful_shutdown(shutdown_signal())
-        .await?;
+    {
+        use std::io::Write;
+        let mut out = std::io::stdout().lock();
+        let _ = writeln!(out, "tetherplan listening on http://{addr}").and_then(|()| out.flush());
+    }
+    server::run(
+        listener,
+        app,
+        config.connections.clone(),
+        cap,
+        shutdown_signal(),
+    )
+    .await;
     tracing::info!("shutting down: stopping the job worker");
     queue.shutdown();
     let joined = tokio::task::spawn_blocking(move || worker.join().is_ok());
@@ -159,6 +208,23 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
     let requeued = queue.store.requeue_running()?;
     tracing::info!(requeued, "stopped");
     Ok(())
+}
+
+/// A loud warning when the service listens beyond loopback without
+/// `TETHERPLAN_API_TOKENS` (anyone who can reach it may use it).
+fn warn_if_exposed(addr: std::net::SocketAddr) {
+    let tokens = std::env::var("TETHERPLAN_API_TOKENS")
+        .map(|t| t.split(',').any(|s| !s.trim().is_empty()))
+        .unwrap_or(false);
+    if !addr.ip().is_loopback() && !tokens {
+        let msg = format!(
+            "SECURITY WARNING: listening on {addr}, beyond loopback, WITHOUT authentication: \
+             anyone who can reach this address can run solves and read, submit and cancel every job. \
+             Set TETHERPLAN_API_TOKENS=token1,token2 or bind to 127.0.0.1."
+        );
+        tracing::warn!("{msg}");
+        eprintln!("{msg}");
+    }
 }
 
 async fn shutdown_signal() {

@@ -60,9 +60,10 @@ pub struct ApiDoc;
 #[allow(dead_code)]
 fn get_openapi() {}
 
-/// The document.
+/// The document, with the request examples, the cable's two forms and the
+/// synchronous limits ([`crate::api::spec`]).
 pub fn openapi() -> utoipa::openapi::OpenApi {
-    ApiDoc::openapi()
+    crate::api::spec::refine(ApiDoc::openapi())
 }
 
 /// The document as committed in `openapi/openapi.json` (pretty, newline-terminated).

@@ -5,6 +5,8 @@
 //! `too_large`) with a pointer to the job queue.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use axum::extract::State;
 use axum::http::{StatusCode, header};
@@ -23,16 +25,52 @@ use crate::contract::ge_charts::{
 use crate::contract::ge_critical::{
     self, AnyCriticalRequest, AnyCriticalResponse, AnyStabilityRequest, AnyStabilityResponse,
 };
-use crate::contract::run::{self, NoProgress};
+use crate::contract::run;
 use crate::contract::simulate::{self, AnySimulateRequest, AnySimulateResponse};
 use crate::numerics::chart::Parallelism;
+
+/// What a synchronous solve sees: the limits, and when its answer is no
+/// longer wanted (the solve timeout has passed, or the caller went away).
+pub(crate) struct SolveCtx {
+    limits: Limits,
+    end: std::time::Instant,
+    abandoned: Arc<AtomicBool>,
+}
+
+impl std::ops::Deref for SolveCtx {
+    type Target = Limits;
+    fn deref(&self) -> &Limits {
+        &self.limits
+    }
+}
+
+impl SolveCtx {
+    /// Has the caller had its 504 or gone away?
+    pub(crate) fn abandoned(&self) -> bool {
+        self.abandoned.load(Ordering::Relaxed) || std::time::Instant::now() >= self.end
+    }
+}
+
+/// Marks the solve abandoned when the handler's future ends: after its
+/// answer (harmless), its 504, or when hyper drops it because the client
+/// closed the connection.
+struct AbandonOnDrop(Arc<AtomicBool>);
+
+impl Drop for AbandonOnDrop {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+}
 
 impl AppState {
     /// Runs `work` on the rayon pool; the in-flight permit is held until the
     /// work ends (even if the caller has timed out), so the bound is real.
+    /// Work whose caller has gone (504 or closed connection) is not started,
+    /// and long work polls [`SolveCtx::abandoned`] through its [`Deadline`]
+    /// progress, so the permit comes back within a bounded time.
     pub(crate) async fn solve(
         &self,
-        work: impl FnOnce(&Limits) -> Result<Vec<u8>, ApiError> + Send + 'static,
+        work: impl FnOnce(&SolveCtx) -> Result<Vec<u8>, ApiError> + Send + 'static,
     ) -> Result<Response, ApiError> {
         let permit = self.solves.clone().try_acquire_owned().map_err(|_| {
             ApiError::new(
@@ -47,13 +85,30 @@ impl AppState {
             .retry_after(1)
         })?;
         let (tx, rx) = tokio::sync::oneshot::channel();
-        let limits = self.limits.clone();
+        let abandoned = Arc::new(AtomicBool::new(false));
+        let _abandon_on_drop = AbandonOnDrop(abandoned.clone());
+        let ctx = SolveCtx {
+            limits: self.limits.clone(),
+            end: std::time::Instant::now() + self.limits.solve_timeout,
+            abandoned,
+        };
         let span = tracing::Span::current();
         rayon::spawn(move || {
             let _permit = permit;
             let _enter = span.enter();
-            let out = catch_unwind(AssertUnwindSafe(|| work(&limits)))
+            if ctx.abandoned() {
+                tracing::debug!("solve abandoned before it started");
+                return;
+            }
+            let started = std::time::Instant::now();
+            let out = catch_unwind(AssertUnwindSafe(|| work(&ctx)))
                 .unwrap_or_else(|_| Err(ApiError::internal("the solver panicked")));
+            if ctx.abandoned() {
+                tracing::info!(
+                    ran_s = started.elapsed().as_secs_f64(),
+                    "abandoned solve stopped (timeout or caller gone)"
+                );
+            }
             let _ = tx.send(out);
         });
         let timeout = self.limits.solve_timeout;
@@ -124,16 +179,18 @@ pub fn check_sync_chart(req: &ChartRequest, limits: &Limits) -> Result<(), ApiEr
     Ok(())
 }
 
-/// Progress that gives up once the solve timeout has passed, so a request
-/// whose caller got a 504 stops using the CPU.
+/// Progress that gives up once the solve timeout has passed or the caller
+/// has gone away, so an abandoned request stops using the CPU.
 struct Deadline {
     end: std::time::Instant,
+    abandoned: Arc<AtomicBool>,
 }
 
 impl Deadline {
-    fn after(limits: &Limits) -> Self {
+    fn after(ctx: &SolveCtx) -> Self {
         Self {
-            end: std::time::Instant::now() + limits.solve_timeout,
+            end: ctx.end,
+            abandoned: ctx.abandoned.clone(),
         }
     }
 }
@@ -141,7 +198,7 @@ impl Deadline {
 impl contract::Progress for Deadline {
     fn report(&self, _: usize, _: usize) {}
     fn cancelled(&self) -> bool {
-        std::time::Instant::now() >= self.end
+        self.abandoned.load(Ordering::Relaxed) || std::time::Instant::now() >= self.end
     }
 }
 
@@ -175,7 +232,7 @@ macro_rules! solve_path {
             )
         )]
         pub async fn $name(State(app): State<AppState>, JsonBody(body): JsonBody) -> Result<Response, ApiError> {
-            app.solve(move |$limits: &Limits| {
+            app.solve(move |$limits: &SolveCtx| {
                 let $b: &[u8] = &body;
                 let $r: $req = $parse?;
                 $body
@@ -228,7 +285,7 @@ solve_path!(
             if req.params.confirm_with_qep || matches!(req.params.profile, ProfileInput::ConstantAcceleration { .. }) {
                 limit_qep_elements(&req.system, limits, "a QEP-based critical-time search")?;
             }
-            to_json(&run::critical(req)?)
+            to_json(&run::critical_with(req, &Deadline::after(limits))?)
         }
         AnyCriticalRequest::GeometricallyExact(r) => {
             limit_ge_elements(r.model.elements, MAX_SYNC_GE_CRITICAL_ELEMENTS, "a GE critical-time search")?;
@@ -276,7 +333,7 @@ solve_path!(
         AnyChartRequest::LinearString(r) => {
             r.system.model().map_err(contract::RequestError::from)?;
             check_sync_chart(r, limits)?;
-            to_json(&run::chart(r, Parallelism::Rayon, &NoProgress)?)
+            to_json(&run::chart(r, Parallelism::Rayon, &Deadline::after(limits))?)
         }
         AnyChartRequest::GeometricallyExact(r) => {
             let points = ge_charts::chart_points(r);

@@ -25,10 +25,19 @@ pub enum RequestError {
     Invalid(#[from] InvalidInput),
     /// The numerics failed on valid input (HTTP 500; should not happen).
     #[error("numerical failure: {0}")]
-    Numerical(#[from] QepError),
+    Numerical(QepError),
     /// The work was cancelled through its progress handle.
     #[error("cancelled")]
     Cancelled,
+}
+
+impl From<QepError> for RequestError {
+    fn from(e: QepError) -> Self {
+        match e {
+            QepError::Cancelled => Self::Cancelled,
+            e => Self::Numerical(e),
+        }
+    }
 }
 
 /// Progress reporting and cancellation for long requests.
@@ -214,6 +223,14 @@ pub fn stability(req: &StabilityRequest) -> Result<StabilityResponse, RequestErr
 }
 
 pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError> {
+    critical_with(req, &NoProgress)
+}
+
+/// [`critical`], stopping (`RequestError::Cancelled`) when `progress` is cancelled.
+pub fn critical_with(
+    req: &CriticalRequest,
+    progress: &dyn Progress,
+) -> Result<CriticalResponse, RequestError> {
     let model = req.system.model()?;
     let sys = model.system;
     let profile = req.params.profile.profile(sys.initial_length_m)?;
@@ -251,12 +268,13 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
             }
         }
         chart::Discretisation::Elements(_) => {
-            let result = critical::critical_time(
+            let result = critical::critical_time_cancellable(
                 &model,
                 &profile,
                 SearchConfig {
                     confirm_with_qep: req.params.confirm_with_qep,
                 },
+                &|| progress.cancelled(),
             )?;
             let c = converged::critical_time(
                 &sys,
@@ -487,14 +505,19 @@ pub fn chart(
     };
     let report = |done: usize, total: usize| progress.report(done, total);
     let discretisation = req.system.discretisation()?;
-    let series = chart::deployment_chart_with(
+    let cancel = || progress.cancelled();
+    let series = chart::deployment_chart_cancellable(
         &sys,
         discretisation,
         &rates,
         &buoyancies,
         parallelism,
         &report,
+        &cancel,
     )?;
+    let Some(series) = series else {
+        return Err(RequestError::Cancelled);
+    };
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }

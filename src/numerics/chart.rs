@@ -114,6 +114,31 @@ pub fn deployment_chart_with(
     parallelism: Parallelism,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<ChartSeries>, InvalidInput> {
+    let never = || false;
+    deployment_chart_cancellable(
+        base,
+        discretisation,
+        rates_m_s,
+        net_buoyancies_n,
+        parallelism,
+        progress,
+        &never,
+    )
+    .map(|series| series.expect("never cancelled"))
+}
+
+/// [`deployment_chart_with`], polled for cancellation before every point:
+/// `Ok(None)` once `cancel()` has returned `true` (the remaining points
+/// are skipped).
+pub fn deployment_chart_cancellable(
+    base: &AerostatSystem,
+    discretisation: Discretisation,
+    rates_m_s: &[f64],
+    net_buoyancies_n: &[f64],
+    parallelism: Parallelism,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &(dyn Fn() -> bool + Sync),
+) -> Result<Option<Vec<ChartSeries>>, InvalidInput> {
     let elements = match discretisation {
         Discretisation::Elements(n) => {
             crate::numerics::string::validate_elements("model.elements", n)?
@@ -149,8 +174,22 @@ pub fn deployment_chart_with(
     }
     let operators = Arc::new(StringOperators::new(elements));
     let done = AtomicUsize::new(0);
+    let stopped = std::sync::atomic::AtomicBool::new(false);
     let point = |index: usize| -> ChartPoint {
         let (s, r) = (index / rates_m_s.len(), index % rates_m_s.len());
+        if stopped.load(Ordering::Relaxed) || cancel() {
+            stopped.store(true, Ordering::Relaxed);
+            let nan = f64::NAN;
+            return ChartPoint {
+                rate_m_s: rates_m_s[r],
+                critical_time_s: nan,
+                max_elevation_m: nan,
+                closed_form_elevation_m: nan,
+                critical_time_error_s: nan,
+                max_elevation_error_m: nan,
+                onset: Onset::Never { until_s: nan },
+            };
+        }
         let p = match discretisation {
             Discretisation::Elements(_) => {
                 let model = StringModel::with_operators(systems[s], operators.clone());
@@ -167,14 +206,19 @@ pub fn deployment_chart_with(
         Parallelism::Serial => (0..total).map(point).collect(),
         Parallelism::Rayon => (0..total).into_par_iter().map(point).collect(),
     };
-    Ok(systems
-        .iter()
-        .zip(flat.chunks(rates_m_s.len().max(1)))
-        .map(|(sys, pts)| ChartSeries {
-            net_buoyancy_n: sys.net_buoyancy_n,
-            points: pts.to_vec(),
-        })
-        .collect())
+    if stopped.load(Ordering::Relaxed) {
+        return Ok(None);
+    }
+    Ok(Some(
+        systems
+            .iter()
+            .zip(flat.chunks(rates_m_s.len().max(1)))
+            .map(|(sys, pts)| ChartSeries {
+                net_buoyancy_n: sys.net_buoyancy_n,
+                points: pts.to_vec(),
+            })
+            .collect(),
+    ))
 }
 
 /// One chart point: constant-rate lengthening from `L0`, no target.

@@ -46,6 +46,9 @@ pub enum QepError {
     NoConvergence,
     #[error("the system matrices contain non-finite values")]
     NonFinite,
+    /// The caller stopped the work (its answer is no longer wanted).
+    #[error("the search was cancelled")]
+    Cancelled,
 }
 
 impl Spectrum {

@@ -166,7 +166,7 @@ impl BaseExcitationProblem {
         let steps = (self.duration_s / self.time_step_s).round() as usize;
         let mut integrator = Integrator::new(model, &drive, start, self.time_step_s, self.newton);
         for step in 1..=steps {
-            if step % 512 == 0 && cancel() {
+            if step % 64 == 0 && cancel() {
                 return point;
             }
             if integrator.step().is_err() {

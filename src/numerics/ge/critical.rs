@@ -433,7 +433,7 @@ pub fn critical_time(
     let mut stable_sample = first;
     let mut step = 0;
     while step < total_steps {
-        if step % 256 == 0 && cancel() {
+        if step % 16 == 0 && cancel() {
             out.onset = GeOnset::Cancelled {
                 time_s: integrator.state.time_s,
             };
@@ -469,6 +469,12 @@ pub fn critical_time(
             .with_scheme(config.scheme);
         let mut before = stable_sample;
         let after = loop {
+            if cancel() {
+                out.onset = GeOnset::Cancelled {
+                    time_s: fine.state.time_s,
+                };
+                return Ok(out);
+            }
             match fine.step_with_cuts(config.max_step_cuts) {
                 Ok(s) => out.step_cuts += s.cuts,
                 Err(f) => {

@@ -981,7 +981,8 @@ pub fn run(
     let mut integrator = Integrator::new(model, drive, initial, config.time_step_s, config.newton);
     let (mut total, mut max) = (0, 0);
     let mut outcome = RunOutcome::Completed;
-    let report_every = (steps_total / 200).max(1);
+    // At most 64 steps between two polls: a cancelled run stops promptly.
+    let report_every = (steps_total / 200).clamp(1, 64);
     let mut steps = 0;
     for step in 1..=steps_total {
         if step % report_every == 0 && !observer(step, steps_total) {

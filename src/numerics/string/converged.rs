@@ -484,7 +484,7 @@ fn divergence_time(
 ) -> Option<f64> {
     let unstable = |t: f64| critical::looks_unstable(model, profile.kinematics(t));
     let Some(prev) = previous_s.filter(|&t| t > 0.0) else {
-        return critical::first_crossing(horizon_s, 256, unstable);
+        return critical::first_crossing(horizon_s, 256, unstable, &|| false);
     };
     let mut width = 1e-3 * prev;
     let mut lo;
@@ -498,7 +498,7 @@ fn divergence_time(
         }
         tries += 1;
         if lo == 0.0 || tries > 20 {
-            return critical::first_crossing(horizon_s, 256, unstable);
+            return critical::first_crossing(horizon_s, 256, unstable, &|| false);
         }
         width *= 4.0;
     }
@@ -512,7 +512,7 @@ fn divergence_time(
         }
         tries += 1;
         if hi >= horizon_s || tries > 20 {
-            return critical::first_crossing(horizon_s, 256, unstable);
+            return critical::first_crossing(horizon_s, 256, unstable, &|| false);
         }
         lo = hi;
         width *= 4.0;

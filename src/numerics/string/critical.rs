@@ -35,6 +35,8 @@ use crate::numerics::tridiag::count_negative_pivots;
 pub const PROBE_OFFSET: f64 = 1e-3;
 /// Relative precision of the pencil bisection (length, rate²).
 const PENCIL_RTOL: f64 = 1e-12;
+/// Iteration cap of every bisection here (2⁻²⁰⁰ is far below any tolerance).
+const MAX_BISECTIONS: usize = 200;
 
 /// Why a deployment is unstable from its first instant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -134,6 +136,17 @@ pub fn critical_time(
     profile: &Profile,
     config: SearchConfig,
 ) -> Result<CriticalTime, QepError> {
+    critical_time_cancellable(model, profile, config, &|| false)
+}
+
+/// [`critical_time`], polling `cancel()` between the QEP solves of the
+/// general search; `Err(QepError::Cancelled)` once it returns `true`.
+pub fn critical_time_cancellable(
+    model: &StringModel,
+    profile: &Profile,
+    config: SearchConfig,
+    cancel: &dyn Fn() -> bool,
+) -> Result<CriticalTime, QepError> {
     match *profile {
         Profile::ConstantRate {
             rate_m_s,
@@ -157,7 +170,7 @@ pub fn critical_time(
             }
             Ok(result)
         }
-        _ => general_profile(model, profile),
+        _ => general_profile(model, profile, cancel),
     }
 }
 
@@ -192,7 +205,10 @@ pub(crate) fn pencil_limit(
             return Some(f64::INFINITY);
         }
     }
-    while hi - lo > PENCIL_RTOL * hi {
+    for _ in 0..MAX_BISECTIONS {
+        if hi - lo <= PENCIL_RTOL * hi {
+            break;
+        }
         let mid = 0.5 * (lo + hi);
         if definite(mid) { lo = mid } else { hi = mid }
     }
@@ -335,17 +351,29 @@ pub(crate) fn clamp_to_positive_length(model: &StringModel, profile: &Profile, h
     lo
 }
 
-/// First time the indicator turns unstable within `[0, horizon]`.
-pub(crate) fn first_crossing(horizon_s: f64, samples: usize, unstable: impl Fn(f64) -> bool) -> Option<f64> {
+/// First time the indicator turns unstable within `[0, horizon]`; `None`
+/// also when `cancel()` stops the scan (the caller checks it).
+pub(crate) fn first_crossing(
+    horizon_s: f64,
+    samples: usize,
+    unstable: impl Fn(f64) -> bool,
+    cancel: &dyn Fn() -> bool,
+) -> Option<f64> {
     if unstable(0.0) {
         return Some(0.0);
     }
     let mut prev = 0.0;
     for j in 1..=samples {
+        if cancel() {
+            return None;
+        }
         let t = horizon_s * j as f64 / samples as f64;
         if unstable(t) {
             let (mut lo, mut hi) = (prev, t);
-            while hi - lo > 1e-12 * hi.max(1e-300) {
+            for _ in 0..MAX_BISECTIONS {
+                if hi - lo <= 1e-12 * hi.max(1e-300) || cancel() {
+                    break;
+                }
                 let mid = 0.5 * (lo + hi);
                 if mid <= lo || mid >= hi {
                     break;
@@ -359,7 +387,12 @@ pub(crate) fn first_crossing(horizon_s: f64, samples: usize, unstable: impl Fn(f
     None
 }
 
-fn general_profile(model: &StringModel, profile: &Profile) -> Result<CriticalTime, QepError> {
+fn general_profile(
+    model: &StringModel,
+    profile: &Profile,
+    cancel: &dyn Fn() -> bool,
+) -> Result<CriticalTime, QepError> {
+    let check = || if cancel() { Err(QepError::Cancelled) } else { Ok(()) };
     let horizon = clamp_to_positive_length(model, profile, search_horizon_s(model, profile));
     // A profile that starts retrieving (e.g. decelerating from rest) is
     // shortening from its first instant: unstable at once.
@@ -373,9 +406,13 @@ fn general_profile(model: &StringModel, profile: &Profile) -> Result<CriticalTim
             probes,
         });
     }
-    let candidate = first_crossing(horizon, 256, |t| {
-        looks_unstable(model, profile.kinematics(t))
-    });
+    let candidate = first_crossing(
+        horizon,
+        256,
+        |t| looks_unstable(model, profile.kinematics(t)),
+        cancel,
+    );
+    check()?;
     let onset = onset_at(model, profile, candidate, horizon);
     let probes = probes_around(model, profile, &onset)?;
     let result = CriticalTime {
@@ -395,7 +432,9 @@ fn general_profile(model: &StringModel, profile: &Profile) -> Result<CriticalTim
             .map(|s| !s.is_stable())
             .unwrap_or(true)
     };
-    let candidate = first_crossing(horizon, 64, qep_unstable);
+    check()?;
+    let candidate = first_crossing(horizon, 64, qep_unstable, cancel);
+    check()?;
     let onset = onset_at(model, profile, candidate, horizon);
     let probes = probes_around(model, profile, &onset)?;
     Ok(CriticalTime {

@@ -726,10 +726,11 @@ fn run_planned(
         if step == plan.steps || !matches!(outcome, RunOutcome::Completed) {
             break;
         }
-        if step.is_multiple_of(report_every) {
-            if report_progress {
-                observer.report(step, plan.steps);
-            }
+        if step.is_multiple_of(report_every) && report_progress {
+            observer.report(step, plan.steps);
+        }
+        // Cancellation is polled often (bounded stop time), progress rarely.
+        if step.is_multiple_of(report_every.min(64)) {
             if observer.cancelled() {
                 outcome = RunOutcome::Cancelled {
                     time_s: step as f64 * dt_s,

@@ -1,0 +1,221 @@
+//! What utoipa's derive cannot say, added to the generated OpenAPI
+//! document ([`refine`]):
+//!
+//! * **One complete request example per POST route** (media-type
+//!   `example`, what `/docs` "Try it out" sends). Each succeeds as is:
+//!   `tests/api_examples.rs` posts every example of the document and
+//!   asserts a 2xx.
+//! * **The cable is one of two forms**: `mass_per_length_kg_m`, or
+//!   `density_kg_m3` with `area_m2`, never both (the server refuses a mix):
+//!   `CableInput` becomes a `oneOf` of the two, each built from the derived
+//!   property schemas (so their bounds stay the derive's).
+//! * **The synchronous limits** per route, in the operation description
+//!   (see [`SYNC_LIMITS`]); the larger requests are valid job requests.
+
+use serde_json::{Value, json};
+
+/// The Table A1 system (steel cable, F = 1000 N, m = 10 kg, L0 = 1 m).
+fn system(elements: usize) -> Value {
+    json!({
+        "cable": {"mass_per_length_kg_m": 0.078},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+        "initial_length_m": 1.0,
+        "gravity_m_s2": 9.81,
+        "model": {"kind": "linear_string", "elements": elements}
+    })
+}
+
+fn with(mut base: Value, extra: Value) -> Value {
+    if let (Some(b), Some(e)) = (base.as_object_mut(), extra.as_object()) {
+        for (k, v) in e {
+            b.insert(k.clone(), v.clone());
+        }
+    }
+    base
+}
+
+/// The request example of each POST route (path, body).
+pub fn request_examples() -> Vec<(&'static str, Value)> {
+    let critical = with(
+        system(50),
+        json!({"profile": {"kind": "constant_rate", "rate_m_s": 10.0}}),
+    );
+    vec![
+        (
+            "/api/v1/stability",
+            with(
+                system(50),
+                json!({"state": {"length_m": 500.0, "rate_m_s": 10.0, "acceleration_m_s2": 0.0}, "modes": 4}),
+            ),
+        ),
+        ("/api/v1/critical", critical.clone()),
+        (
+            "/api/v1/safe-rate",
+            with(system(50), json!({"target_elevation_m": 1200.0})),
+        ),
+        (
+            "/api/v1/charts",
+            with(
+                system(50),
+                json!({"rates_m_s": {"min": 1.0, "max": 120.0, "count": 60},
+                       "net_buoyancies_n": [1000.0, 1500.0]}),
+            ),
+        ),
+        (
+            "/api/v1/simulate",
+            with(
+                with(system(30), json!({"initial_length_m": 100.0})),
+                json!({"profile": {"kind": "constant_rate", "rate_m_s": 1.0}, "duration_s": 5.0,
+                       "samples": 20, "initial": {"kind": "shape", "tip_deflection_m": 0.1}}),
+            ),
+        ),
+        (
+            "/api/v1/frequency-response",
+            with(
+                system(20),
+                json!({"profile": {"kind": "constant_rate", "rate_m_s": 1.0}, "duration_s": 10.0,
+                       "samples": 10, "aero": {"radius_m": 0.5}, "wind_amplitude_m_s": 10.0,
+                       "frequencies_rad_s": {"min": 1.0, "max": 4.0, "count": 4}}),
+            ),
+        ),
+        (
+            "/api/v1/jobs",
+            json!({"kind": "critical", "request": critical}),
+        ),
+    ]
+}
+
+/// Synchronous limits stated on each route (the server's `too_large`
+/// answers: `config::Limits`, `solve::MAX_SYNC_*`).
+pub const SYNC_LIMITS: [(&str, &str); 4] = [
+    (
+        "/api/v1/stability",
+        "Synchronous limit: `model.elements` ≤ 400 (larger: 422 `too_large`, submit a job).",
+    ),
+    (
+        "/api/v1/charts",
+        "Synchronous limits: linear string ≤ 20 000 points (rates × buoyancies) and ≤ 2 000 000 \
+         points × elements; GE ≤ 8 points. Larger charts: 422 `too_large`, submit a `chart` job.",
+    ),
+    (
+        "/api/v1/frequency-response",
+        "Synchronous limit: `frequencies_rad_s.count` ≤ 16 (larger: 422 `too_large`, submit a \
+         `frequency_response` job).",
+    ),
+    (
+        "/api/v1/simulate",
+        "Runs that do not finish within the solve timeout (30 s by default) answer 504; submit \
+         them as `simulate` jobs.",
+    ),
+];
+
+/// Adds the examples, the cable's `oneOf` and the synchronous limits to
+/// the generated document.
+pub fn refine(doc: utoipa::openapi::OpenApi) -> utoipa::openapi::OpenApi {
+    let mut v = serde_json::to_value(&doc).expect("the document serialises");
+    refine_value(&mut v);
+    serde_json::from_value(v).expect("the refined document is an OpenAPI document")
+}
+
+fn refine_value(v: &mut Value) {
+    for (path, example) in request_examples() {
+        if let Some(media) = v
+            .pointer_mut(&format!(
+                "/paths/{}/post/requestBody/content/application~1json",
+                path.replace('~', "~0").replace('/', "~1")
+            ))
+            .and_then(Value::as_object_mut)
+        {
+            media.insert("example".into(), example);
+        }
+    }
+    for (path, note) in SYNC_LIMITS {
+        if let Some(op) = v
+            .pointer_mut(&format!("/paths/{}/post", path.replace('/', "~1")))
+            .and_then(Value::as_object_mut)
+        {
+            let d = op
+                .get("description")
+                .and_then(Value::as_str)
+                .unwrap_or("")
+                .to_string();
+            if !d.contains(note) {
+                let joined = if d.is_empty() {
+                    note.to_string()
+                } else {
+                    format!("{d}\n\n{note}")
+                };
+                op.insert("description".into(), Value::String(joined));
+            }
+        }
+    }
+    if let Some(cable) = v.pointer_mut("/components/schemas/CableInput") {
+        cable_one_of(cable);
+    }
+}
+
+/// `CableInput` as `oneOf` its two forms, from the derived properties.
+fn cable_one_of(cable: &mut Value) {
+    let Some(props) = cable.get("properties").and_then(Value::as_object).cloned() else {
+        return;
+    };
+    // The derive marks the optional fields nullable; in each form the
+    // fields it uses are required numbers.
+    let number = |name: &str| -> Value {
+        let mut p = props.get(name).cloned().unwrap_or_else(|| json!({}));
+        if let Some(o) = p.as_object_mut() {
+            o.insert("type".into(), json!("number"));
+            o.insert("format".into(), json!("double"));
+        }
+        p
+    };
+    let description = cable
+        .get("description")
+        .cloned()
+        .unwrap_or_else(|| json!("The cable."));
+    *cable = json!({
+        "description": description,
+        "oneOf": [
+            {
+                "title": "mass per length",
+                "type": "object",
+                "required": ["mass_per_length_kg_m"],
+                "properties": {"mass_per_length_kg_m": number("mass_per_length_kg_m")},
+                "additionalProperties": false
+            },
+            {
+                "title": "density and area",
+                "type": "object",
+                "required": ["density_kg_m3", "area_m2"],
+                "properties": {
+                    "density_kg_m3": number("density_kg_m3"),
+                    "area_m2": number("area_m2")
+                },
+                "additionalProperties": false
+            }
+        ]
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_post_route_gets_an_example_and_the_cable_two_forms() {
+        let doc = serde_json::to_value(crate::api::openapi::openapi()).unwrap();
+        let paths = doc["paths"].as_object().unwrap();
+        let posts: Vec<&String> = paths
+            .iter()
+            .filter(|(_, ops)| ops.get("post").is_some())
+            .map(|(p, _)| p)
+            .collect();
+        assert!(posts.len() >= 7, "{posts:?}");
+        for p in posts {
+            let ex = &paths[p]["post"]["requestBody"]["content"]["application/json"]["example"];
+            assert!(ex.is_object(), "{p} has no request example");
+        }
+        let cable = &doc["components"]["schemas"]["CableInput"];
+        assert_eq!(cable["oneOf"].as_array().unwrap().len(), 2, "{cable}");
+    }
+}
