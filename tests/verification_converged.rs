@@ -355,3 +355,136 @@ fn print_acceleration_ladder() {
         println!("  converged: {:?}", c.time_s);
     }
 }
+
+fn stability(body: Value) -> tetherplan::contract::dto::StabilityResponse {
+    let req: tetherplan::contract::dto::StabilityRequest =
+        contract::parse(body.to_string().as_bytes()).unwrap();
+    run::stability(&req).unwrap()
+}
+
+#[test]
+fn stability_verdict_is_converged_near_the_limit() {
+    // 10 m/s on the thesis data: the continuum limit is 1296.69 m, the
+    // 50-element mesh's 1309.99 m.
+    let exact = closed_form_h(1000.0, 10.0);
+    let at = |length_m: f64, extra: Value| {
+        stability(merge(
+            merge(system(1000.0, 10.0), extra),
+            json!({"state": {"length_m": length_m, "rate_m_s": 10.0}}),
+        ))
+    };
+    let r = at(1300.0, json!({}));
+    assert!(
+        r.converged && !r.stable,
+        "1300 m is beyond the continuum limit"
+    );
+    let l = r.critical_length_m.unwrap();
+    assert!(l <= exact && (exact - l) / exact <= 1e-4, "{l} vs {exact}");
+    assert!(at(1290.0, json!({})).stable);
+    // the 50-element mesh calls 1300 m stable, and says by how much it errs
+    let r = at(1300.0, json!({"model": {"elements": 50}}));
+    assert!(!r.converged && r.stable);
+    let (l, e) = (
+        r.critical_length_m.unwrap(),
+        r.critical_length_error_m.unwrap(),
+    );
+    assert!(
+        (l - exact).abs() <= e && (l - 1310.0).abs() < 0.1,
+        "{l} ± {e}"
+    );
+}
+
+#[test]
+fn critical_length_of_an_accelerating_state_is_the_root_tension_limit() {
+    // Root effective tension (1 − m̃ã − ṽ²)/l − (1/F̃ + ã) = 0 (SPEC §1).
+    let sys = AerostatSystem::new(RHO_A, 1000.0, 10.0, 1.0, G).unwrap();
+    for (v, a) in [(10.0, 0.5), (30.0, 0.05), (5.0, -0.2)] {
+        let s = sys.to_nondim(tetherplan::numerics::params::Kinematics {
+            length_m: 1.0,
+            rate_m_s: v,
+            acceleration_m_s2: a,
+        });
+        let mt = sys.mass_ratio();
+        let exact = (1.0 - mt * s.acceleration - s.rate * s.rate)
+            / (1.0 / sys.buoyancy_ratio() + s.acceleration);
+        let c = converged::critical_length_at_state(&sys, v, a, 1e-4).unwrap();
+        assert!(
+            (c.value - exact).abs() <= c.error_estimate && c.relative_error() <= 1e-4,
+            "v = {v}, a = {a}: {} ± {:e} vs {exact}",
+            c.value,
+            c.error_estimate
+        );
+        assert!((c.order - 1.0).abs() < 0.15, "order {}", c.order);
+    }
+}
+
+#[test]
+fn the_roller_element_mesh_gives_the_graded_mesh_value() {
+    // Constant rate: the pencil is diagonal in the element slopes and the
+    // roller element is critical, so [0, h₁, 1] and the graded mesh agree.
+    use tetherplan::numerics::string::critical::critical_length_constant_rate as pencil;
+    for level in [0, 3, 9] {
+        let graded = converged::graded_operators(level);
+        let roller = converged::roller_operators(level);
+        for vt in [0.0, 0.1, 0.5, 0.9] {
+            let (a, b) = (
+                pencil(&graded, 1306.9, vt).unwrap(),
+                pencil(&roller, 1306.9, vt).unwrap(),
+            );
+            assert!(
+                (a - b).abs() <= 1e-11 * a,
+                "level {level}, ṽ = {vt}: {a} vs {b}"
+            );
+        }
+    }
+}
+
+#[test]
+#[ignore = "diagnostic: timings"]
+fn print_timings() {
+    use std::time::Instant;
+    use tetherplan::numerics::string::StringModel;
+    let sys = AerostatSystem::thesis();
+    let s = sys.to_nondim(tetherplan::numerics::params::Kinematics {
+        length_m: 1100.0,
+        rate_m_s: 30.0,
+        acceleration_m_s2: 0.5,
+    });
+    for level in [0, 4, 7, 10] {
+        let model = StringModel::with_operators(sys, converged::graded_operators(level));
+        let t0 = Instant::now();
+        for _ in 0..20 {
+            model.spectrum(s).unwrap();
+        }
+        println!(
+            "QEP graded level {level} ({} el): {:?}",
+            model.elements(),
+            t0.elapsed() / 20
+        );
+    }
+    for n in [16, 24, 50] {
+        let model = StringModel::new(sys, n).unwrap();
+        let t0 = Instant::now();
+        for _ in 0..20 {
+            model.spectrum(s).unwrap();
+        }
+        println!("QEP uniform {n}: {:?}", t0.elapsed() / 20);
+    }
+    let t0 = Instant::now();
+    for _ in 0..20 {
+        converged::constant_acceleration(&sys, 0.5, None, 1e-4).unwrap();
+    }
+    println!("converged accel: {:?}", t0.elapsed() / 20);
+    let t0 = Instant::now();
+    for _ in 0..2000 {
+        converged::constant_rate(&sys, 10.0, None, 1e-4);
+    }
+    println!("converged rate: {:?}", t0.elapsed() / 2000);
+    let t0 = Instant::now();
+    for _ in 0..2000 {
+        converged::safe_rate(&sys, 1200.0, 1e-4).unwrap();
+    }
+    println!("converged safe rate: {:?}", t0.elapsed() / 2000);
+    let c = converged::constant_acceleration(&sys, 0.5, None, 1e-4).unwrap();
+    println!("{:?}", c);
+}

@@ -359,8 +359,19 @@ pub struct StateOutput {
 
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
 pub struct StabilityResponse {
-    /// Every Re λ ≤ tolerance.
+    /// Every Re λ ≤ tolerance on the spectrum's mesh and, when converged
+    /// (model.elements omitted), the length is below the safe side of the
+    /// converged `critical_length_m`.
     pub stable: bool,
+    /// Shortest length (m) at which a state with this rate and acceleration
+    /// diverges (the roller-end effective tension is lost); converged: on
+    /// the safe (low) side of its error. Null when shortening (unstable at
+    /// any length), or when no such length exists up to 4× the static limit.
+    pub critical_length_m: Option<f64>,
+    /// Estimated discretisation error of `critical_length_m` (m).
+    pub critical_length_error_m: Option<f64>,
+    /// Whether the verdict and `critical_length_m` are converged.
+    pub converged: bool,
     /// Largest Re λ (1/s).
     pub max_real_1_s: f64,
     /// Largest Re λ (1/t̄).

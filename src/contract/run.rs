@@ -203,8 +203,48 @@ pub fn stability(req: &StabilityRequest) -> Result<StabilityResponse, RequestErr
             frequency_hz: to_si(e.im) / (2.0 * std::f64::consts::PI),
         })
         .collect();
+    let discretisation = req.system.discretisation()?;
+    let (critical_length_m, critical_length_error_m, stable) = match discretisation {
+        chart::Discretisation::Converged { relative_tolerance } => {
+            match converged::critical_length_at_state(
+                &sys,
+                k.rate_m_s,
+                k.acceleration_m_s2,
+                relative_tolerance,
+            ) {
+                Some(c) => (
+                    Some(c.lower()),
+                    Some(c.error_estimate),
+                    spectrum.is_stable() && k.length_m < c.lower(),
+                ),
+                None => (None, None, spectrum.is_stable()),
+            }
+        }
+        chart::Discretisation::Elements(_) => {
+            let mesh = converged::critical_length_at_state_on(
+                &model,
+                k.rate_m_s,
+                k.acceleration_m_s2,
+                None,
+            );
+            let conv = converged::critical_length_at_state(
+                &sys,
+                k.rate_m_s,
+                k.acceleration_m_s2,
+                converged::DEFAULT_RELATIVE_TOLERANCE,
+            );
+            let error = match (mesh, conv) {
+                (Some(m), Some(c)) => Some(converged::mesh_error_estimate(m, &c)),
+                _ => None,
+            };
+            (mesh, error, spectrum.is_stable())
+        }
+    };
     Ok(StabilityResponse {
-        stable: spectrum.is_stable(),
+        stable,
+        critical_length_m,
+        critical_length_error_m,
+        converged: req.system.model.elements.is_none(),
         max_real_1_s: to_si(spectrum.max_real),
         max_real_nondim: spectrum.max_real,
         tolerance_1_s: to_si(spectrum.tolerance()),
@@ -340,7 +380,20 @@ pub fn critical_with(
         }
         Onset::During { time_s, length_m } => (
             "during",
-            format!("stable until t* = {time_s:.3} s, when the cable is {length_m:.1} m long"),
+            if result.converged {
+                format!(
+                    "stable until t* = {time_s:.3} s, when the cable is {length_m:.1} m long \
+                     (converged; the safe side of a ±{:.2e} s discretisation error)",
+                    result.time_error_s.unwrap_or(0.0)
+                )
+            } else {
+                format!(
+                    "stable until t* = {time_s:.3} s, when the cable is {length_m:.1} m long \
+                     (on {} elements; estimated discretisation error ±{:.3} s)",
+                    result.elements,
+                    result.time_error_s.unwrap_or(0.0)
+                )
+            },
             Some(length_m),
         ),
         Onset::Never { until_s } => (

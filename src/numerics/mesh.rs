@@ -128,6 +128,24 @@ impl Mesh {
         Self { nodes }
     }
 
+    /// Two elements, `[0, first]` and `[first, 1]`: for constant-rate
+    /// lengthening the first element alone sets the critical length (see
+    /// `string::converged`), so this mesh gives the graded mesh's value.
+    pub fn roller_element(first: f64) -> Self {
+        assert!(
+            first > 0.0 && first <= 1.0,
+            "the first element must be in (0, 1]"
+        );
+        if first == 1.0 {
+            return Self {
+                nodes: vec![0.0, 1.0],
+            };
+        }
+        Self {
+            nodes: vec![0.0, first, 1.0],
+        }
+    }
+
     pub fn elements(&self) -> usize {
         self.nodes.len() - 1
     }
