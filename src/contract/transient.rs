@@ -15,7 +15,8 @@ use crate::numerics::params::{
 };
 use crate::numerics::reduced::ReducedModel;
 use crate::numerics::string::transient::{
-    self, EigenTracking, InitialState, MAX_FREQUENCIES, Observer, RunOutcome, TransientConfig,
+    self, EigenTracking, InitialState, MAGNITUDE_CAP_LENGTHS, MAX_FREQUENCIES, Observer,
+    RunOutcome, TransientConfig,
     TransientError, TransientRun,
 };
 
@@ -342,6 +343,23 @@ pub struct SimulateResponse {
     /// When the run ended early (s).
     pub outcome_time_s: Option<f64>,
     pub explanation: String,
+    /// First unstable instant of the deployment within the run (s): the
+    /// critical time t* of the profile (the QEP criterion of `/critical`),
+    /// or, where that search is too costly, the first unstable
+    /// `eigenvalues` sample; null when stable over the run (or not known).
+    /// The samples after it show growth past onset.
+    pub first_unstable_time_s: Option<f64>,
+    /// Cable length at `first_unstable_time_s` (m).
+    pub first_unstable_length_m: Option<f64>,
+    /// Why the run ended: `completed`, `magnitude_cap` (a deflection passed
+    /// `magnitude_cap_m`), `step_failed` (non-finite or singular step),
+    /// `length_collapsed`.
+    pub stopped_reason: String,
+    /// The deflection at which a run stops: `magnitude_cap_lengths_nondim`
+    /// × the cable length, at the stop (or the end) of the run (m).
+    pub magnitude_cap_m: f64,
+    /// The cap as a multiple of the current cable length.
+    pub magnitude_cap_lengths_nondim: f64,
     pub time_step_s: f64,
     pub steps: usize,
     /// Displaced air mass m_f used by the aerodynamics (kg).
@@ -679,8 +697,13 @@ pub fn simulate(
             "ran {} steps of {:.4e} s to t = {} s",
             run.steps, run.time_step_s, req.duration_s
         ),
+        RunOutcome::Diverged { time_s } if run.stopped_at_cap => format!(
+            "the deflection passed {} × the cable length ({:.4e} m, far beyond the linear model) and the run stopped at t = {time_s:.3} s: the deployment is unstable",
+            MAGNITUDE_CAP_LENGTHS,
+            MAGNITUDE_CAP_LENGTHS * run.final_kinematics.length_m
+        ),
         RunOutcome::Diverged { time_s } => format!(
-            "the deflection grew without bound (beyond the linear model) and the run stopped at t = {time_s:.3} s: the deployment is unstable"
+            "a time step failed (the deflection grew without bound) and the run stopped at t = {time_s:.3} s: the deployment is unstable"
         ),
         RunOutcome::LengthCollapsed { time_s } => {
             format!(
@@ -689,6 +712,14 @@ pub fn simulate(
         }
         RunOutcome::Cancelled { .. } => unreachable!("handled above"),
     };
+    let stopped_reason = match run.outcome {
+        RunOutcome::Completed | RunOutcome::Cancelled { .. } => "completed",
+        RunOutcome::Diverged { .. } if run.stopped_at_cap => "magnitude_cap",
+        RunOutcome::Diverged { .. } => "step_failed",
+        RunOutcome::LengthCollapsed { .. } => "length_collapsed",
+    };
+    let (first_unstable_time_s, first_unstable_length_m) =
+        first_unstable(&model, &profile, &run, req.duration_s);
     let col = |f: fn(&transient::Sample) -> f64| run.samples.iter().map(f).collect::<Vec<f64>>();
     Ok(SimulateResponse {
         time_s: col(|s| s.time_s),
@@ -719,12 +750,54 @@ pub fn simulate(
         outcome: outcome.into(),
         outcome_time_s,
         explanation,
+        first_unstable_time_s,
+        first_unstable_length_m,
+        stopped_reason: stopped_reason.into(),
+        magnitude_cap_m: MAGNITUDE_CAP_LENGTHS * run.final_kinematics.length_m,
+        magnitude_cap_lengths_nondim: MAGNITUDE_CAP_LENGTHS,
         time_step_s: run.time_step_s,
         steps: run.steps,
         displaced_air_mass_kg,
         groups: groups(&sys),
         elements: model.elements(),
     })
+}
+
+/// Largest element count at which a simulate answer also runs the
+/// critical-time search of its profile (dense QEP probes of size 2n).
+pub const MAX_ONSET_SEARCH_ELEMENTS: usize = 400;
+
+/// The first unstable instant of the run and the length then: the
+/// profile's critical time when it falls within the run, else the first
+/// unstable eigenvalue sample. A failed search is "not known" (null), not
+/// an error: the run itself is the answer.
+fn first_unstable(
+    model: &crate::numerics::string::StringModel,
+    profile: &crate::numerics::profile::Profile,
+    run: &TransientRun,
+    duration_s: f64,
+) -> (Option<f64>, Option<f64>) {
+    use crate::numerics::string::critical::{self, SearchConfig};
+    if model.elements() <= MAX_ONSET_SEARCH_ELEMENTS
+        && let Ok(ct) = critical::critical_time(
+            model,
+            profile,
+            SearchConfig {
+                confirm_with_qep: false,
+            },
+        )
+    {
+        return match ct.time_s() {
+            Some(t) if t.is_finite() && t <= duration_s => {
+                (Some(t), Some(profile.kinematics(t).length_m))
+            }
+            _ => (None, None),
+        };
+    }
+    run.eigen
+        .iter()
+        .find(|e| !e.stable)
+        .map_or((None, None), |e| (Some(e.time_s), Some(e.length_m)))
 }
 
 fn reduced_output(
@@ -933,7 +1006,12 @@ mod tests {
             let body = format!(
                 r#"{{ {SYSTEM}, "profile": {{"kind": "constant_rate", "rate_m_s": 1}}, {extra} }}"#
             );
-            let req: SimulateRequest = parse(body.as_bytes()).unwrap();
+            // the range checks run at parsing, the rest at the run
+            let req: SimulateRequest = match parse(body.as_bytes()) {
+                Ok(r) => r,
+                Err(RequestError::Invalid(e)) => return e.field,
+                Err(e) => panic!("{e:?}"),
+            };
             match simulate(&req, &NoProgress) {
                 Err(RequestError::Invalid(e)) => e.field,
                 other => panic!("expected invalid input, got {other:?}"),

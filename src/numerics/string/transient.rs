@@ -59,6 +59,11 @@ pub const STEPS_PER_RAMP: f64 = 8.0;
 /// The run stops as diverged when `|η|` exceeds this (deflections of
 /// `1e100 L0` are far outside the linear model, and near overflow).
 pub const DIVERGENCE_LIMIT: f64 = 1e100;
+/// The run stops, diverged, when any deflection exceeds this multiple of
+/// the cable length at that instant: far past the linear model (whose
+/// deflections are small against the length), so the growth after onset
+/// is shown up to a stated magnitude instead of to overflow.
+pub const MAGNITUDE_CAP_LENGTHS: f64 = 10.0;
 /// The run stops when the length falls below this fraction of `L0`.
 pub const MIN_LENGTH_FRACTION: f64 = 1e-3;
 
@@ -155,7 +160,8 @@ pub struct EigenSample {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RunOutcome {
     Completed,
-    /// The deflection exceeded [`DIVERGENCE_LIMIT`] or a step failed.
+    /// A deflection exceeded [`MAGNITUDE_CAP_LENGTHS`] × the length (then
+    /// [`TransientRun::stopped_at_cap`]) or [`DIVERGENCE_LIMIT`], or a step failed.
     Diverged {
         time_s: f64,
     },
@@ -182,6 +188,10 @@ pub struct TransientRun {
     pub final_kinematics: Kinematics,
     /// Tip mass used, `m̃ + ½ m_f/(ρA L0)`.
     pub tip_mass_nondim: f64,
+    /// The run stopped because a deflection passed [`MAGNITUDE_CAP_LENGTHS`]
+    /// × the length; the cap at that instant is
+    /// `MAGNITUDE_CAP_LENGTHS × final_kinematics.length_m`.
+    pub stopped_at_cap: bool,
 }
 
 /// Errors of a run: bad input or a failed eigenvalue solve.
@@ -707,6 +717,7 @@ fn run_planned(
     };
 
     let mut step = 0usize;
+    let mut stopped_at_cap = false;
     loop {
         // Observe the state at `step`.
         let tip = state.displacement[n - 1].abs();
@@ -762,12 +773,10 @@ fn run_planned(
         // Keep the time exact on the grid (no drift from summing dt).
         state.time = (step + 1) as f64 * dt;
         step += 1;
-        if state
-            .displacement
-            .iter()
-            .any(|q| q.abs() > DIVERGENCE_LIMIT)
-        {
+        let cap = (MAGNITUDE_CAP_LENGTHS * s.length).min(DIVERGENCE_LIMIT);
+        if state.displacement.iter().any(|q| q.abs() > cap) {
             outcome = RunOutcome::Diverged { time_s: t_next };
+            stopped_at_cap = true;
         }
     }
     // A run that ended early still reports its last state.
@@ -790,6 +799,7 @@ fn run_planned(
         final_state: state,
         final_kinematics: kin,
         tip_mass_nondim: sys.mass_ratio() + added,
+        stopped_at_cap,
     })
 }
 
