@@ -164,7 +164,12 @@ async fn ge_critical_flags_a_start_up_transient_and_runs_as_a_job() {
         "{ge}"
     );
     // the same request as a job gives the same answer
-    let (status, sub) = post(&app, "/api/v1/jobs", &json!({"kind": "critical", "request": body})).await;
+    let (status, sub) = post(
+        &app,
+        "/api/v1/jobs",
+        &json!({"kind": "critical", "request": body}),
+    )
+    .await;
     assert_eq!(status, StatusCode::ACCEPTED, "{sub}");
     let id = sub["id"].as_i64().unwrap();
     let ran = try_execute_next(&queue).unwrap().unwrap();
@@ -172,21 +177,49 @@ async fn ge_critical_flags_a_start_up_transient_and_runs_as_a_job() {
     let job = get(&app, &format!("/api/v1/jobs/{id}")).await;
     assert_eq!(job["result"], ge);
 
-    // in steady payout the same cable has no start transient: the closed
-    // form (466.6 m) applies and the GE h* is within 5 % of it
+    // in steady payout at 75 m/s (β = μv²/EA = 0.44) the cable still
+    // departs from the quasi-static tension: printed, not asserted
     let steady = with(body.clone(), json!({"start_state": "steady_payout"}));
     let (status, ge) = post(&app, "/api/v1/critical", &steady).await;
+    assert_eq!(status, StatusCode::OK, "{ge}");
+    println!(
+        "E* = 1, 75 m/s, steady payout: h* = {} m, closed form {} m, applies {}: {}",
+        ge["max_elevation_m"],
+        ge["extensible_closed_form_elevation_m"],
+        ge["closed_form_applies"],
+        ge["closed_form_note"]
+    );
+    // at 12 m/s (β = 0.011) in steady payout the onset is quasi-static: the
+    // closed form applies, and the GE h* is within 5 % of it (bending adds
+    // ~20 m, the 20-element mesh ~1 %)
+    let slow = with(
+        system(1.0),
+        json!({"profile": {"kind": "constant_rate", "rate_m_s": 12.0}, "start_state": "steady_payout"}),
+    );
+    let (status, ge) = post(&app, "/api/v1/critical", &slow).await;
     assert_eq!(status, StatusCode::OK, "{ge}");
     let (h, closed) = (
         ge["max_elevation_m"].as_f64().unwrap(),
         ge["extensible_closed_form_elevation_m"].as_f64().unwrap(),
     );
-    println!("E* = 1, 75 m/s, steady payout: h* = {h:.1} m, closed form {closed:.1} m, {}", ge["closed_form_note"]);
+    println!(
+        "E* = 1, 12 m/s, steady payout: h* = {h:.1} m, closed form {closed:.1} m, {}",
+        ge["closed_form_note"]
+    );
+    assert_eq!(ge["closed_form_applies"], true, "{ge}");
     assert!((h / closed - 1.0).abs() < 0.05);
 
     // a stability job
-    let st = with(system(1e5), json!({"state": {"length_m": 500.0, "rate_m_s": 10.0}}));
-    let (status, sub) = post(&app, "/api/v1/jobs", &json!({"kind": "stability", "request": st})).await;
+    let st = with(
+        system(1e5),
+        json!({"state": {"length_m": 500.0, "rate_m_s": 10.0}}),
+    );
+    let (status, sub) = post(
+        &app,
+        "/api/v1/jobs",
+        &json!({"kind": "stability", "request": st}),
+    )
+    .await;
     assert_eq!(status, StatusCode::ACCEPTED, "{sub}");
     let ran = try_execute_next(&queue).unwrap().unwrap();
     assert_eq!(ran.status, JobStatus::Done);
@@ -202,12 +235,18 @@ async fn ge_bad_input_names_the_field() {
     let cases = [
         (
             "/api/v1/critical",
-            with(critical.clone(), json!({"numerics": {"rho_infinity_nondim": 1.5}})),
+            with(
+                critical.clone(),
+                json!({"numerics": {"rho_infinity_nondim": 1.5}}),
+            ),
             "numerics.rho_infinity_nondim",
         ),
         (
             "/api/v1/critical",
-            with(critical.clone(), json!({"numerics": {"scheme": "hht_alpha", "rho_infinity_nondim": 0.2}})),
+            with(
+                critical.clone(),
+                json!({"numerics": {"scheme": "hht_alpha", "rho_infinity_nondim": 0.2}}),
+            ),
             "numerics.rho_infinity_nondim",
         ),
         (
@@ -222,7 +261,10 @@ async fn ge_bad_input_names_the_field() {
         ),
         (
             "/api/v1/critical",
-            with(critical.clone(), json!({"profile": {"kind": "constant_rate", "rate_m_s": 0.0}})),
+            with(
+                critical.clone(),
+                json!({"profile": {"kind": "constant_rate", "rate_m_s": 0.0}}),
+            ),
             "profile.rate_m_s",
         ),
         (
@@ -232,7 +274,10 @@ async fn ge_bad_input_names_the_field() {
         ),
         (
             "/api/v1/stability",
-            with(system(1e5), json!({"state": {"length_m": 10.0}, "modes": 0})),
+            with(
+                system(1e5),
+                json!({"state": {"length_m": 10.0}, "modes": 0}),
+            ),
             "modes",
         ),
     ];

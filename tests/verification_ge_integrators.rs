@@ -16,11 +16,12 @@
 //!   to 1000, for every scheme (Newton stops at a relative residual 1e-9);
 //! * the spectral radius as ωΔt → ∞ (at ωΔt = 1e5) is the scheme's stated
 //!   `ρ∞` within 1e-3 — the dissipation reported in the responses;
-//! * displacement error after two periods falls as Δt² (observed order in
-//!   [1.9, 2.1] between ωΔt = 0.1 and 0.05);
+//! * the largest displacement error over two periods falls as Δt²
+//!   (observed order in [1.9, 2.1] between ωΔt = 0.1 and 0.05);
 //! * the loss of amplitude per step of a resolved mode, 1 − ρ(ωΔt), is of
-//!   order ≥ 3 in ωΔt for the dissipative schemes (0 for average
-//!   acceleration): resolved modes are not damped to second order.
+//!   fourth order in ωΔt for the dissipative schemes (observed 3.96–4.00
+//!   between ωΔt = 0.1 and 0.05; asserted ≥ 3.8), and nil for average
+//!   acceleration: resolved modes are not damped to second order.
 
 use faer::Mat;
 use tetherplan::numerics::ge::element::TipLoad;
@@ -94,7 +95,11 @@ fn closed_form(scheme: Scheme, big_omega: f64) -> [[f64; 3]; 3] {
     let o2 = big_omega * big_omega;
     let mut a = [[0.0; 3]; 3];
     for j in 0..3 {
-        let (x0, y0, z0) = ((j == 0) as u8 as f64, (j == 1) as u8 as f64, (j == 2) as u8 as f64);
+        let (x0, y0, z0) = (
+            (j == 0) as u8 as f64,
+            (j == 1) as u8 as f64,
+            (j == 2) as u8 as f64,
+        );
         let d = x0 + big_omega * y0 + o2 * (0.5 - b) * z0;
         let z1 = -(am * z0 + (1.0 - af) * d + af * x0) / ((1.0 - am) + (1.0 - af) * b * o2);
         let x1 = d + b * o2 * z1;
@@ -173,7 +178,10 @@ fn step_matrix_equals_the_closed_form() {
     let model = model();
     for scheme in schemes() {
         for big_omega in [0.01, 0.1, 1.0, 10.0, 1000.0] {
-            let (ge, exact) = (ge_matrix(&model, scheme, big_omega), closed_form(scheme, big_omega));
+            let (ge, exact) = (
+                ge_matrix(&model, scheme, big_omega),
+                closed_form(scheme, big_omega),
+            );
             let err = (0..3)
                 .flat_map(|i| (0..3).map(move |j| (i, j)))
                 .map(|(i, j)| (ge[i][j] - exact[i][j]).abs())
@@ -188,7 +196,10 @@ fn spectral_radius_at_high_frequency_is_rho_infinity() {
     let model = model();
     for scheme in schemes() {
         let rho = spectral_radius(&ge_matrix(&model, scheme, 1e5));
-        println!("{scheme:?}: ρ(ωΔt = 1e5) = {rho:.6}, stated ρ∞ = {}", scheme.rho_infinity());
+        println!(
+            "{scheme:?}: ρ(ωΔt = 1e5) = {rho:.6}, stated ρ∞ = {}",
+            scheme.rho_infinity()
+        );
         assert!((rho - scheme.rho_infinity()).abs() < 1e-3);
     }
 }
@@ -199,7 +210,7 @@ fn second_order_accurate_and_resolved_modes_barely_damped() {
     let w = omega(&model);
     let drive = drive();
     for scheme in schemes() {
-        // displacement error after two periods, u(0) = δ, consistent ü(0)
+        // largest displacement error over two periods, u(0) = δ, consistent ü(0)
         let error = |big_omega: f64| {
             let dt = big_omega / w;
             let periods = 2.0 * 2.0 * std::f64::consts::PI / w;
@@ -209,23 +220,32 @@ fn second_order_accurate_and_resolved_modes_barely_damped() {
             state.q[0] = delta;
             state.a[0] = -w * w * delta;
             let mut it = Integrator::new(&model, &drive, state, dt, newton()).with_scheme(scheme);
+            let mut worst: f64 = 0.0;
             for _ in 0..steps {
                 it.step().unwrap();
+                let t = it.state.time_s;
+                worst = worst.max((it.state.q[0] - delta * (w * t).cos()).abs() / delta);
             }
-            let t = it.state.time_s;
-            (it.state.q[0] - delta * (w * t).cos()).abs() / delta
+            worst
         };
         let (e1, e2) = (error(0.1), error(0.05));
         let order = (e1 / e2).log2();
         // amplitude lost per step by a resolved mode
         let loss = |o: f64| 1.0 - spectral_radius(&closed_form(scheme, o));
         let (l1, l2) = (loss(0.1), loss(0.05));
-        let dissipation_order = if l2 > 1e-13 { (l1 / l2).log2() } else { f64::INFINITY };
+        let dissipation_order = if l2 > 1e-13 {
+            (l1 / l2).log2()
+        } else {
+            f64::INFINITY
+        };
         println!(
             "{scheme:?}: error {e1:.3e} → {e2:.3e} (order {order:.3}); 1 − ρ = {l1:.3e} → {l2:.3e} (order {dissipation_order:.2})"
         );
         assert!((1.9..=2.1).contains(&order), "order {order}");
-        assert!(dissipation_order >= 2.9, "dissipation order {dissipation_order}");
+        assert!(
+            dissipation_order >= 3.8,
+            "dissipation order {dissipation_order}"
+        );
         // and the GE integrator dissipates the same: its ρ at ωΔt = 0.1
         let ge_loss = 1.0 - spectral_radius(&ge_matrix(&model, scheme, 0.1));
         assert!((ge_loss - l1).abs() < 1e-7, "{ge_loss:e} vs {l1:e}");

@@ -29,7 +29,12 @@ fn never() -> bool {
     false
 }
 
-fn search(rate: f64, stiffness_ratio: f64, start: StartState, config: &CriticalConfig) -> GeCriticalTime {
+fn search(
+    rate: f64,
+    stiffness_ratio: f64,
+    start: StartState,
+    config: &CriticalConfig,
+) -> GeCriticalTime {
     let model = GeChartSystem::table_7_1().model(stiffness_ratio).unwrap();
     let problem = CriticalProblem {
         profile: Profile::constant_rate(1.0, rate, None).unwrap(),
@@ -63,7 +68,10 @@ fn perturbed_chart_completes_at_default_settings() {
             let mut request = GeChartRequest::table_7_1(vec![12.0, 26.0, 40.0], vec![1e5]);
             request.system.aerostat_mass_kg = mass;
             request.perturbation_forces_n = vec![0.0, 200.0, 400.0];
-            (mass, deployment_chart(&request, Parallelism::Rayon, &|_, _| {}, &never).unwrap())
+            (
+                mass,
+                deployment_chart(&request, Parallelism::Rayon, &|_, _| {}, &never).unwrap(),
+            )
         })
         .collect();
     for (mass, series) in &charts {
@@ -84,7 +92,10 @@ fn perturbed_chart_completes_at_default_settings() {
                     p.closed_form.applies()
                 );
                 let t = p.critical_time_s.unwrap_or_else(|| {
-                    panic!("F0 = {} N, {} m/s: {:?}", s.perturbation_force_n, p.rate_m_s, p.onset)
+                    panic!(
+                        "F0 = {} N, {} m/s: {:?}",
+                        s.perturbation_force_n, p.rate_m_s, p.onset
+                    )
                 });
                 assert!(matches!(p.onset, GeOnset::During { .. }));
                 assert!((t / t0 - 1.0).abs() < 0.10, "t* = {t} against {t0}");
@@ -127,7 +138,10 @@ fn a_failed_newton_step_is_halved_and_retried() {
         .map(|&v| t_star(&run(v, CriticalConfig::default().scheme, 8)))
         .collect();
     for ((v, cuts), r) in cases.iter().zip(&results) {
-        println!("{v} m/s, F0 = 400 N, average acceleration, at most {cuts} cuts: {:?}, {} cuts", r.onset, r.step_cuts);
+        println!(
+            "{v} m/s, F0 = 400 N, average acceleration, at most {cuts} cuts: {:?}, {} cuts",
+            r.onset, r.step_cuts
+        );
     }
     for k in 0..2 {
         let (strict, cut) = (&results[2 * k], &results[2 * k + 1]);
@@ -144,7 +158,10 @@ fn a_failed_newton_step_is_halved_and_retried() {
 #[test]
 fn from_rest_matches_steady_payout_with_dissipation() {
     let default = CriticalConfig::default();
-    assert_eq!(default.scheme, Scheme::GeneralizedAlpha { rho_infinity: 0.0 });
+    assert_eq!(
+        default.scheme,
+        Scheme::GeneralizedAlpha { rho_infinity: 0.0 }
+    );
     let undamped = CriticalConfig {
         scheme: Scheme::AverageAcceleration,
         ..default
@@ -207,6 +224,12 @@ fn closed_form_is_flagged_on_a_start_up_transient() {
     }
     assert!(matches!(verdicts[0].0, ClosedFormVerdict::Transient { .. }));
     assert!(!verdicts[0].0.applies());
-    assert!(verdicts[0].0.reason().unwrap().contains("start-up transient"));
+    assert!(
+        verdicts[0]
+            .0
+            .reason()
+            .unwrap()
+            .contains("start-up transient")
+    );
     assert_eq!(verdicts[1].0, ClosedFormVerdict::Applies);
 }

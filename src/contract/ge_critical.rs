@@ -17,8 +17,8 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::dto::{
-    CableInput, CriticalRequest, CriticalResponse, EigenvalueOutput, ProfileInput, StabilityRequest,
-    StabilityResponse, StateInput,
+    CableInput, CriticalRequest, CriticalResponse, EigenvalueOutput, ProfileInput,
+    StabilityRequest, StabilityResponse, StateInput,
 };
 use crate::contract::ge::{GeAerostatInput, GeModelInput, NewtonInput};
 use crate::contract::ge_charts::{GeChartNumericsInput, GeOnsetKind, newton_config};
@@ -231,10 +231,16 @@ pub fn prepare_critical(
             if x.force_n.abs() > MAX_PERTURBATION_N {
                 return Err(InvalidInput::new(
                     "perturbation.force_n",
-                    format!("must be between -{MAX_PERTURBATION_N:.0e} and {MAX_PERTURBATION_N:.0e} N, got {}", x.force_n),
+                    format!(
+                        "must be between -{MAX_PERTURBATION_N:.0e} and {MAX_PERTURBATION_N:.0e} N, got {}",
+                        x.force_n
+                    ),
                 ));
             }
-            for (field, v) in [("perturbation.ramp_s", x.ramp_s), ("perturbation.hold_s", x.hold_s)] {
+            for (field, v) in [
+                ("perturbation.ramp_s", x.ramp_s),
+                ("perturbation.hold_s", x.hold_s),
+            ] {
                 if !(0.0..=1e4).contains(&v) {
                     return Err(InvalidInput::new(
                         field,
@@ -356,9 +362,9 @@ pub fn ge_critical(
         GeOnset::Immediate { max_real_1_s } => format!(
             "unstable at t = 0: the local QEP of the start state has a growth rate {max_real_1_s:.3e} 1/s"
         ),
-        GeOnset::During { time_s, length_m } => format!(
-            "stable until t* = {time_s:.3} s, when the cable is {length_m:.1} m long"
-        ),
+        GeOnset::During { time_s, length_m } => {
+            format!("stable until t* = {time_s:.3} s, when the cable is {length_m:.1} m long")
+        }
         GeOnset::Never { until_s } => format!(
             "stable for the whole search (checked up to t = {until_s:.3} s, length {:.1} m)",
             problem.profile.kinematics(until_s).length_m
@@ -368,7 +374,9 @@ pub fn ge_critical(
             f.time_s, f.iterations, f.residual_norm, config.max_step_cuts
         ),
         GeOnset::SpectrumFailed { time_s } => {
-            format!("the eigenvalue iteration failed at t = {time_s:.4} s; no onset was seen before")
+            format!(
+                "the eigenvalue iteration failed at t = {time_s:.4} s; no onset was seen before"
+            )
         }
         GeOnset::Cancelled { time_s } => format!("cancelled at t = {time_s:.3} s"),
     };
@@ -380,7 +388,8 @@ pub fn ge_critical(
         max_elevation_m: r.length_m(&problem.profile),
         ended_at_s,
         string_closed_form_elevation_m: rate.map(|v| closed(f64::INFINITY, v)),
-        extensible_closed_form_elevation_m: rate.map(|v| closed(model.section.axial_stiffness_n, v)),
+        extensible_closed_form_elevation_m: rate
+            .map(|v| closed(model.section.axial_stiffness_n, v)),
         closed_form_applies: applies,
         closed_form_note: note,
         onset_root_axial_force_n: r.onset_root_axial_force_n,
@@ -513,7 +522,14 @@ pub struct GeStabilityResponse {
 /// Every check of a GE stability query (no solve).
 fn stability_inputs(
     req: &GeStabilityRequest,
-) -> Result<(Prepared, Kinematics, crate::numerics::ge::solver::NewtonConfig), InvalidInput> {
+) -> Result<
+    (
+        Prepared,
+        Kinematics,
+        crate::numerics::ge::solver::NewtonConfig,
+    ),
+    InvalidInput,
+> {
     let p = prepare(
         &req.cable,
         &req.aerostat,
@@ -539,7 +555,11 @@ fn stability_inputs(
     if req.modes == 0 || req.modes > run::MAX_MODES {
         return Err(InvalidInput::new(
             "modes",
-            format!("must be between 1 and {}, got {}", run::MAX_MODES, req.modes),
+            format!(
+                "must be between 1 and {}, got {}",
+                run::MAX_MODES,
+                req.modes
+            ),
         ));
     }
     if !(1..=100).contains(&req.load_steps) {
@@ -587,9 +607,7 @@ pub fn ge_stability(req: &GeStabilityRequest) -> Result<GeStabilityResponse, Req
         rate_m_s: kin.rate_m_s,
         acceleration_m_s2: kin.acceleration_m_s2,
         cable_motion: req.cable_motion,
-        string_closed_form_elevation_m: string(f64::INFINITY)
-            .critical_length_m(v)
-            .unwrap_or(0.0),
+        string_closed_form_elevation_m: string(f64::INFINITY).critical_length_m(v).unwrap_or(0.0),
         extensible_closed_form_elevation_m: string(model.section.axial_stiffness_n)
             .critical_length_m(v)
             .unwrap_or(0.0),
@@ -641,8 +659,11 @@ pub fn ge_stability(req: &GeStabilityRequest) -> Result<GeStabilityResponse, Req
             out.equilibrium = Some(GeEquilibriumOutput {
                 tip_axial_displacement_m: s.state.q[GeModel::dof(model.elements, 0)],
                 root_axial_force_n: s.root_axial_force_n,
-                quasi_static_root_tension_n: string(model.section.axial_stiffness_n)
-                    .tension_n(v, kin.length_m, x),
+                quasi_static_root_tension_n: string(model.section.axial_stiffness_n).tension_n(
+                    v,
+                    kin.length_m,
+                    x,
+                ),
             });
             out.explanation = if stable {
                 format!(

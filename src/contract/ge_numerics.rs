@@ -107,9 +107,10 @@ impl IntegratorOutput {
                 SchemeInput::AverageAcceleration,
                 "Newmark average acceleration",
             ),
-            Scheme::GeneralizedAlpha { .. } => {
-                (SchemeInput::GeneralizedAlpha, "generalized-α (Chung–Hulbert)")
-            }
+            Scheme::GeneralizedAlpha { .. } => (
+                SchemeInput::GeneralizedAlpha,
+                "generalized-α (Chung–Hulbert)",
+            ),
             Scheme::HhtAlpha { .. } => (SchemeInput::HhtAlpha, "HHT-α"),
         };
         let rho = scheme.rho_infinity();

@@ -202,9 +202,9 @@ impl ClosedFormVerdict {
     pub fn reason(&self) -> Option<String> {
         match *self {
             Self::Applies => None,
-            Self::Wind => Some(
-                "air flow loads the aerostat; the closed forms are for still air".to_string(),
-            ),
+            Self::Wind => {
+                Some("air flow loads the aerostat; the closed forms are for still air".to_string())
+            }
             Self::Transient {
                 departure_n,
                 length_shift_m,

@@ -195,7 +195,10 @@ impl CriticalConfig {
         if self.max_step_cuts > MAX_STEP_CUTS {
             return Err(InvalidInput::new(
                 "numerics.max_step_cuts",
-                format!("must be at most {MAX_STEP_CUTS}, got {}", self.max_step_cuts),
+                format!(
+                    "must be at most {MAX_STEP_CUTS}, got {}",
+                    self.max_step_cuts
+                ),
             ));
         }
         if self.check_every == 0 {
@@ -427,8 +430,8 @@ pub fn critical_time(
         .map_or(config.horizon_s, |s| s.min(config.horizon_s));
     let total_steps = (horizon / config.time_step_s).ceil() as usize;
     let dt = config.time_step_s;
-    let mut integrator = Integrator::new(model, &drive, start.clone(), dt, config.newton)
-        .with_scheme(config.scheme);
+    let mut integrator =
+        Integrator::new(model, &drive, start.clone(), dt, config.newton).with_scheme(config.scheme);
     let mut stable_state = start;
     let mut stable_sample = first;
     let mut step = 0;
