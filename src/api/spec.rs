@@ -199,7 +199,6 @@ fn cable_one_of(cable: &mut Value) {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
 
     #[test]
     fn every_post_route_gets_an_example_and_the_cable_two_forms() {
