@@ -2,10 +2,20 @@
 # tetherplan: the HTTP service and chart page in a small Debian image.
 #
 #   docker build -t tetherplan .
-#   docker run --rm -p 8080:8080 -v tetherplan-data:/data tetherplan
+#   docker run --rm -p 127.0.0.1:8080:8080 -v tetherplan-data:/data tetherplan
 #
 # Then open http://localhost:8080/ (chart page), /docs (API), /healthz.
 # Jobs persist in the SQLite database on the /data volume.
+#
+# Security: inside the container the server binds 0.0.0.0:8080 (it must, to
+# be reachable through the port mapping) and logs a loud warning when no
+# tokens are set. Publish on loopback as above, or before exposing the port:
+#   -e TETHERPLAN_API_TOKENS=token1,token2    every /api route then needs
+#                                             "Authorization: Bearer token1"
+#   -e TETHERPLAN_ALLOWED_HOSTS=plan.example.org   Host names besides
+#                                             localhost (others get 421)
+# Connection limits: TETHERPLAN_HEADER_TIMEOUT_S (5), TETHERPLAN_BODY_TIMEOUT_S
+# (10), TETHERPLAN_MAX_CONNECTIONS (10000, clamped below the file limit).
 
 # ---- build: release binary ----
 FROM rust:1.95-slim-bookworm AS build
@@ -18,14 +28,12 @@ RUN --mount=type=cache,target=/usr/local/cargo/registry \
     cargo build --release --locked --bin tetherplan \
     && cp target/release/tetherplan /usr/local/bin/tetherplan
 
-# ---- runtime: binary + static files ----
+# ---- runtime: the binary (the page is built into it) ----
 FROM debian:bookworm-slim
 RUN useradd --system --uid 10001 --home-dir /data --shell /usr/sbin/nologin tetherplan \
     && mkdir -p /data && chown tetherplan /data
 COPY --from=build /usr/local/bin/tetherplan /usr/local/bin/tetherplan
-COPY static /app/static
 ENV TETHERPLAN_DB=/data/tetherplan.db \
-    TETHERPLAN_STATIC_DIR=/app/static \
     RUST_LOG=info
 VOLUME ["/data"]
 WORKDIR /data

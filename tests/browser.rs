@@ -9,6 +9,8 @@
 //!   checks the resonance in the plotted envelope, runs a small frequency
 //!   response directly and a larger one as a job, checks API errors next to
 //!   their fields, the phone layout and the console.
+//! * `docs_page.mjs` runs every POST operation's "Try it out" in `/docs`
+//!   with the document's example (each must answer 2xx) under the CSP.
 //!
 //! The two run one after the other (a lock), not side by side on 2 cores.
 //!
@@ -182,4 +184,9 @@ fn chart_page_in_headless_chromium() {
 #[test]
 fn transient_page_in_headless_chromium() {
     run_page_script("transient_page.mjs");
+}
+
+#[test]
+fn docs_try_it_out_in_headless_chromium() {
+    run_page_script("docs_page.mjs");
 }

@@ -163,7 +163,9 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
         .layer(axum::middleware::from_fn_with_state(
             hosts.clone(),
             guard::HostAllowList::check,
-        ));
+        ))
+        // (again outside the Host check, so its 421 carries them too)
+        .layer(axum::middleware::map_response(guard::security_headers));
     let fd_limit = server::raise_fd_limit();
     let cap = server::connection_cap(config.connections.max_connections, fd_limit);
     let static_dir = config

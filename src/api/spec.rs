@@ -109,6 +109,22 @@ pub const SYNC_LIMITS: [(&str, &str); 4] = [
     ),
 ];
 
+/// Synchronous limits that are bounds on one field, added to the route's
+/// request schema as `allOf: [request, overlay]` (the request types are
+/// shared with jobs, which take more).
+fn sync_overlays() -> Vec<(&'static str, Value)> {
+    vec![
+        (
+            "/api/v1/stability",
+            json!({"properties": {"model": {"properties": {"elements": {"maximum": 400}}}}}),
+        ),
+        (
+            "/api/v1/frequency-response",
+            json!({"properties": {"frequencies_rad_s": {"properties": {"count": {"maximum": 16}}}}}),
+        ),
+    ]
+}
+
 /// Adds the examples, the cable's `oneOf` and the synchronous limits to
 /// the generated document.
 pub fn refine(doc: utoipa::openapi::OpenApi) -> utoipa::openapi::OpenApi {
@@ -127,6 +143,19 @@ fn refine_value(v: &mut Value) {
             .and_then(Value::as_object_mut)
         {
             media.insert("example".into(), example);
+        }
+    }
+    for (path, overlay) in sync_overlays() {
+        if let Some(media) = v
+            .pointer_mut(&format!(
+                "/paths/{}/post/requestBody/content/application~1json",
+                path.replace('/', "~1")
+            ))
+            .and_then(Value::as_object_mut)
+        {
+            if let Some(schema) = media.remove("schema") {
+                media.insert("schema".into(), json!({"allOf": [schema, overlay]}));
+            }
         }
     }
     for (path, note) in SYNC_LIMITS {
@@ -199,7 +228,6 @@ fn cable_one_of(cable: &mut Value) {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
 
     #[test]
     fn every_post_route_gets_an_example_and_the_cable_two_forms() {

@@ -86,13 +86,15 @@ impl CableInput {
 
 impl SystemInput {
     pub fn system(&self) -> Result<AerostatSystem, InvalidInput> {
-        AerostatSystem::new(
+        let sys = AerostatSystem::new(
             self.cable.mass_per_length()?,
             self.aerostat.net_buoyancy_n,
             self.aerostat.mass_kg,
             self.initial_length_m,
             self.gravity_m_s2,
-        )
+        )?;
+        check_scales(&sys)?;
+        Ok(sys)
     }
 
     pub fn model(&self) -> Result<StringModel, InvalidInput> {
@@ -152,6 +154,37 @@ impl ProfileInput {
             }
         }
     }
+}
+
+/// Backstop against parameters so far apart that the scales of the
+/// problem overflow or vanish in f64 (ρA = 1e308 kg/m with F = 1e-216 N):
+/// every answer would carry infinities or zeros where numbers belong.
+fn check_scales(sys: &AerostatSystem) -> Result<(), InvalidInput> {
+    let scales = [
+        ("wave speed", sys.wave_speed_m_s()),
+        ("time scale", sys.time_scale_s()),
+        ("buoyancy ratio", sys.buoyancy_ratio()),
+        ("static lift limit", sys.static_lift_limit_m()),
+    ];
+    for (name, v) in scales {
+        if !(v.is_finite() && v > 1e-150 && v < 1e150) {
+            return Err(InvalidInput::new(
+                "cable.mass_per_length_kg_m",
+                format!(
+                    "with this cable, net buoyancy, length and gravity the {name} is {v:e}: \
+                     the parameters are too far apart to compute with"
+                ),
+            ));
+        }
+    }
+    let m = sys.mass_ratio();
+    if !(m.is_finite() && m < 1e150) {
+        return Err(InvalidInput::new(
+            "aerostat.mass_kg",
+            format!("the mass ratio m/(ρA L0) is {m:e}: too large to compute with"),
+        ));
+    }
+    Ok(())
 }
 
 pub fn groups(s: &AerostatSystem) -> Groups {

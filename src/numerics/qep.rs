@@ -116,20 +116,59 @@ pub fn solve(system: &SecondOrderSystem) -> Result<Spectrum, QepError> {
         }
     }
     system.mass.solve_columns_in_place(&mut rhs, cols);
+    if !rhs.iter().all(|v| v.is_finite()) {
+        return Err(QepError::NonFinite);
+    }
+    let gamma = eigenvalue_scale(&rhs, n);
+    let (k_scale, c_scale) = (1.0 / (gamma * gamma), 1.0 / gamma);
     let companion = Mat::<f64>::from_fn(cols, cols, |i, j| {
         if i < n {
             if j == i + n { 1.0 } else { 0.0 }
+        } else if j < n {
+            -rhs[(i - n) * cols + j] * k_scale
         } else {
-            -rhs[(i - n) * cols + j]
+            -rhs[(i - n) * cols + j] * c_scale
         }
     });
     let (re, im) = eigenvalues_real(&companion)?;
+    if !re.iter().chain(&im).all(|v| v.is_finite()) {
+        return Err(QepError::NonFinite);
+    }
     Ok(Spectrum::from_eigenvalues(
         re.into_iter()
             .zip(im)
-            .map(|(re, im)| Eigenvalue { re, im })
+            .map(|(re, im)| Eigenvalue {
+                re: re * gamma,
+                im: im * gamma,
+            })
             .collect(),
     ))
+}
+
+/// Scale `γ` of the eigenvalues, `λ = γ μ`, so that the companion of
+/// `μ² M + μ C/γ + K/γ² = 0` has entries of order one (Fan, Lin & Van
+/// Dooren 2004). Systems of wildly scaled parameters (ρA = 1e262 kg/m
+/// gives `|M⁻¹K| ~ 1e265`) otherwise overflow inside the Schur iteration,
+/// which then never ends. A power of two (exact scaling), and 1 unless
+/// the entries are beyond 2^±64, so ordinary systems are untouched.
+fn eigenvalue_scale(minv_kc: &[f64], n: usize) -> f64 {
+    let cols = 2 * n;
+    let (mut kmax, mut cmax) = (0.0f64, 0.0f64);
+    for row in minv_kc.chunks(cols.max(1)) {
+        for (j, v) in row.iter().enumerate() {
+            if j < n {
+                kmax = kmax.max(v.abs());
+            } else {
+                cmax = cmax.max(v.abs());
+            }
+        }
+    }
+    let size = kmax.sqrt().max(cmax);
+    if !(size > 0.0 && size.is_finite()) {
+        return 1.0;
+    }
+    let exp = size.log2().round();
+    if exp.abs() <= 64.0 { 1.0 } else { exp.exp2() }
 }
 
 /// Eigenvalues of a real square matrix, sequential faer.
@@ -160,4 +199,51 @@ pub fn eigenvalues_real(a: &Mat<f64>) -> Result<(Vec<f64>, Vec<f64>), QepError> 
     let re = s_re.column_vector().iter().copied().collect();
     let im = s_im.column_vector().iter().copied().collect();
     Ok((re, im))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::numerics::tridiag::Tridiagonal;
+
+    fn diagonal(values: &[f64]) -> Tridiagonal {
+        let mut t = Tridiagonal::zeros(values.len());
+        t.diag.copy_from_slice(values);
+        t
+    }
+
+    /// Uncoupled oscillators `λ² + c λ + k = 0`: closed-form roots, and the
+    /// same roots times `s` when `C → sC`, `K → s²K`, for `s` up to 1e130
+    /// (which used to overflow inside the Schur iteration and never end).
+    #[test]
+    fn badly_scaled_systems_keep_their_closed_form_roots() {
+        let (c, k) = ([0.3, 2.0, 0.0], [4.0, 0.5, 9.0]);
+        for s in [1.0, 1e-80, 1e40, 1e130] {
+            let system = SecondOrderSystem {
+                mass: diagonal(&[1.0, 1.0, 1.0]),
+                damping: diagonal(&c.map(|v| v * s)),
+                stiffness: diagonal(&k.map(|v| v * s * s)),
+            };
+            let start = std::time::Instant::now();
+            let spectrum = solve(&system).unwrap();
+            assert!(start.elapsed().as_secs_f64() < 1.0);
+            let mut want: Vec<(f64, f64)> = Vec::new();
+            for (c, k) in c.iter().zip(&k) {
+                let disc = c * c - 4.0 * k;
+                if disc < 0.0 {
+                    let im = 0.5 * (-disc).sqrt();
+                    want.extend([(-0.5 * c, im), (-0.5 * c, -im)]);
+                } else {
+                    let r = 0.5 * disc.sqrt();
+                    want.extend([(-0.5 * c + r, 0.0), (-0.5 * c - r, 0.0)]);
+                }
+            }
+            for (re, im) in want {
+                let found = spectrum.eigenvalues.iter().any(|e| {
+                    (e.re / s - re).abs() <= 1e-12 * 4.0 && (e.im / s - im).abs() <= 1e-12 * 4.0
+                });
+                assert!(found, "s = {s:e}: {re} + {im}i not in {:?}", spectrum.eigenvalues);
+            }
+        }
+    }
 }
