@@ -6,6 +6,16 @@
 #
 # Then open http://localhost:8080/ (chart page), /docs (API), /healthz.
 # Jobs persist in the SQLite database on the /data volume.
+#
+# The image listens on 0.0.0.0: give it API tokens, or anyone who can reach
+# the port can read, submit and cancel every job (the server logs a loud
+# warning when it has none):
+#   docker run --rm -p 8080:8080 -v tetherplan-data:/data \
+#     -e TETHERPLAN_API_TOKENS="$(openssl rand -hex 24),$(openssl rand -hex 24)" \
+#     --hostname tetherplan-1 tetherplan
+# A fixed --hostname lets a restarted container take over its interrupted job
+# at once; otherwise it is taken over when its lease (TETHERPLAN_JOB_LEASE_S,
+# 30 s) expires.
 
 # ---- build: release binary ----
 FROM rust:1.95-slim-bookworm AS build

@@ -9,6 +9,8 @@
 //!
 //! Every error is the one body of [`error::ApiError`].
 
+pub mod auth;
+pub mod auth_doc;
 pub mod error;
 pub mod jobs;
 pub mod openapi;
@@ -40,6 +42,8 @@ pub struct AppState {
     pub queue: Arc<JobQueue>,
     pub limits: Limits,
     solves: Arc<Semaphore>,
+    /// API tokens (none: open).
+    pub tokens: Arc<auth::Tokens>,
 }
 
 impl AppState {
@@ -50,7 +54,14 @@ impl AppState {
             queue,
             limits,
             solves,
+            tokens: Arc::new(auth::Tokens::default()),
         }
+    }
+
+    /// The same, requiring one of `tokens` on every `/api` route.
+    pub fn with_tokens(mut self, tokens: &[String]) -> Self {
+        self.tokens = Arc::new(auth::Tokens::new(tokens));
+        self
     }
 }
 
@@ -96,6 +107,7 @@ async fn method_not_allowed() -> ApiError {
 /// The application: every route, the body limit, request tracing.
 pub fn router(state: AppState, static_dir: &Path) -> Router {
     let body_limit = state.limits.max_body_bytes;
+    let tokens = state.tokens.clone();
     Router::new()
         .route("/healthz", get(get_health))
         .route("/api/v1/stability", post(solve::compute_stability))
@@ -115,6 +127,7 @@ pub fn router(state: AppState, static_dir: &Path) -> Router {
         .route("/api", any(api_not_found))
         .route("/api/{*rest}", any(api_not_found))
         .method_not_allowed_fallback(method_not_allowed)
+        .layer(axum::middleware::from_fn_with_state(tokens, auth::require_token))
         .with_state(state)
         .merge(SwaggerUi::new("/docs").url("/openapi.json", openapi::openapi()))
         .fallback_service(ServeDir::new(static_dir))
@@ -134,7 +147,19 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
         config.limits.clone(),
     ));
     let worker = queue.spawn_worker();
-    let app = router(AppState::new(queue.clone()), &config.static_dir);
+    let state = AppState::new(queue.clone()).with_tokens(&config.api_tokens);
+    if !state.tokens.is_enabled() && !config.addr.ip().is_loopback() {
+        tracing::warn!(
+            addr = %config.addr,
+            "SERVING ON A NON-LOOPBACK ADDRESS WITHOUT API TOKENS: anyone who can reach it can read, \
+             submit and cancel every job; set TETHERPLAN_API_TOKENS"
+        );
+        eprintln!(
+            "tetherplan: WARNING: listening on {} without TETHERPLAN_API_TOKENS: the API is open to anyone who can reach it",
+            config.addr
+        );
+    }
+    let app = router(state, &config.static_dir);
     let listener = tokio::net::TcpListener::bind(config.addr)
         .await
         .map_err(|e| format!("cannot listen on {}: {e}", config.addr))?;
@@ -156,7 +181,7 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
             "the job worker did not stop within 10 s; its job will run again at the next start"
         );
     }
-    let requeued = queue.store.requeue_running()?;
+    let requeued = queue.store.release_all()?;
     tracing::info!(requeued, "stopped");
     Ok(())
 }
