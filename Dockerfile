@@ -16,6 +16,16 @@
 #                                             localhost (others get 421)
 # Connection limits: TETHERPLAN_HEADER_TIMEOUT_S (5), TETHERPLAN_BODY_TIMEOUT_S
 # (10), TETHERPLAN_MAX_CONNECTIONS (10000, clamped below the file limit).
+#
+# The image listens on 0.0.0.0: give it API tokens, or anyone who can reach
+# the port can read, submit and cancel every job (the server logs a loud
+# warning when it has none):
+#   docker run --rm -p 8080:8080 -v tetherplan-data:/data \
+#     -e TETHERPLAN_API_TOKENS="$(openssl rand -hex 24),$(openssl rand -hex 24)" \
+#     --hostname tetherplan-1 tetherplan
+# A fixed --hostname lets a restarted container take over its interrupted job
+# at once; otherwise it is taken over when its lease (TETHERPLAN_JOB_LEASE_S,
+# 30 s) expires.
 
 # ---- build: release binary ----
 FROM rust:1.95-slim-bookworm AS build

@@ -50,6 +50,33 @@ pub struct ServeArgs {
     /// Seconds allowed between two pieces of a request body.
     #[arg(long, env = "TETHERPLAN_BODY_TIMEOUT_S", default_value_t = ConnectionLimits::default().body_timeout.as_secs_f64())]
     pub body_timeout_s: f64,
+    #[command(flatten)]
+    pub jobs: JobArgs,
+}
+
+/// Job limits, leases and API tokens (`tetherplan serve`).
+#[derive(Clone, Debug, clap::Args)]
+pub struct JobArgs {
+    /// Comma-separated bearer tokens; when set, every `/api` route needs
+    /// `Authorization: Bearer <token>` and a job is visible to its own token only.
+    #[arg(long, env = "TETHERPLAN_API_TOKENS", hide_env_values = true)]
+    pub api_tokens: Option<String>,
+    /// Jobs queued or running at once per token; beyond: 429.
+    #[arg(long, env = "TETHERPLAN_TOKEN_MAX_PENDING_JOBS", default_value_t = Limits::default().max_pending_jobs_per_token)]
+    pub token_max_pending_jobs: usize,
+    /// Seconds a job claim lasts without a heartbeat; a dead process's job is
+    /// taken over by another after this.
+    #[arg(long, env = "TETHERPLAN_JOB_LEASE_S", default_value_t = Limits::default().job_lease.as_secs_f64())]
+    pub job_lease_s: f64,
+    /// Starts of one job (process died each time) before it is failed.
+    #[arg(long, env = "TETHERPLAN_JOB_MAX_ATTEMPTS", default_value_t = Limits::default().max_job_attempts)]
+    pub job_max_attempts: u32,
+    /// Longest run of one job, seconds; beyond it the job fails.
+    #[arg(long, env = "TETHERPLAN_JOB_MAX_RUN_S", default_value_t = Limits::default().max_job_run_time.as_secs_f64())]
+    pub job_max_run_s: f64,
+    /// Largest estimated answer of one job (bytes of JSON); larger: 422.
+    #[arg(long, env = "TETHERPLAN_JOB_MAX_RESULT_BYTES", default_value_t = Limits::default().max_job_result_bytes)]
+    pub job_max_result_bytes: u64,
 }
 
 /// Limits of the HTTP service.
@@ -69,6 +96,16 @@ pub struct Limits {
     pub max_sync_qep_elements: usize,
     /// Largest number of requests in one batch job.
     pub max_batch_items: usize,
+    /// Jobs queued or running at once for one API token.
+    pub max_pending_jobs_per_token: usize,
+    /// How long a job claim lasts unless renewed (heartbeat every third of it).
+    pub job_lease: Duration,
+    /// Claims of one job whose process died before it is failed.
+    pub max_job_attempts: u32,
+    /// Longest run of one job.
+    pub max_job_run_time: Duration,
+    /// Largest estimated answer of one job, bytes of JSON.
+    pub max_job_result_bytes: u64,
 }
 
 impl Default for Limits {
@@ -82,6 +119,11 @@ impl Default for Limits {
             max_sync_chart_work: 2_000_000,
             max_sync_qep_elements: 400,
             max_batch_items: 1000,
+            max_pending_jobs_per_token: 100,
+            job_lease: Duration::from_secs(30),
+            max_job_attempts: 3,
+            max_job_run_time: Duration::from_secs(3600),
+            max_job_result_bytes: 64 << 20,
         }
     }
 }
@@ -97,6 +139,8 @@ pub struct Config {
     pub limits: Limits,
     pub connections: ConnectionLimits,
     pub allowed_hosts: Option<String>,
+    /// API tokens (empty: no authentication).
+    pub api_tokens: Vec<String>,
 }
 
 impl From<ServeArgs> for Config {
@@ -113,11 +157,17 @@ impl From<ServeArgs> for Config {
             db: a.db,
             static_dir: a.static_dir,
             job_threads,
+            api_tokens: crate::api::auth::parse_tokens(a.jobs.api_tokens.as_deref()),
             limits: Limits {
                 max_body_bytes: a.max_body_bytes,
                 max_in_flight: a.max_in_flight,
                 solve_timeout: Duration::from_secs_f64(a.solve_timeout_s.clamp(0.001, 86_400.0)),
                 max_pending_jobs: a.max_pending_jobs,
+                max_pending_jobs_per_token: a.jobs.token_max_pending_jobs,
+                job_lease: Duration::from_secs_f64(a.jobs.job_lease_s.clamp(0.1, 86_400.0)),
+                max_job_attempts: a.jobs.job_max_attempts.max(1),
+                max_job_run_time: Duration::from_secs_f64(a.jobs.job_max_run_s.clamp(0.01, 1e7)),
+                max_job_result_bytes: a.jobs.job_max_result_bytes,
                 ..Limits::default()
             },
             connections: ConnectionLimits {

@@ -32,14 +32,32 @@ window.tetherplanCommon = (function () {
     return { error: { ...err, field, message } };
   }
 
-  async function api(method, path, body) {
+  // API token (servers with TETHERPLAN_API_TOKENS answer 401 without one):
+  // asked for once, kept for the browser session only (sessionStorage).
+  const TOKEN_KEY = "tetherplan.apiToken";
+
+  function storedToken() {
+    try { return sessionStorage.getItem(TOKEN_KEY); } catch { return null; }
+  }
+
+  async function api(method, path, body, retried) {
     let res;
     try {
+      const headers = body === undefined ? {} : { "content-type": "application/json" };
+      const token = storedToken();
+      if (token) headers.authorization = `Bearer ${token}`;
       res = await fetch(path, {
         method,
-        headers: body === undefined ? {} : { "content-type": "application/json" },
+        headers,
         body: body === undefined ? undefined : JSON.stringify(body),
       });
+      if (res.status === 401 && !retried) {
+        const entered = window.prompt(token ? "The API token was refused. API token:" : "This server needs an API token:");
+        if (entered && entered.trim()) {
+          try { sessionStorage.setItem(TOKEN_KEY, entered.trim()); } catch { /* private mode: ask again next time */ }
+          return api(method, path, body, true);
+        }
+      }
     } catch (e) {
       return { ok: false, status: 0, body: { error: { code: "network", field: null, message: `cannot reach the server (${e.message})` } } };
     }

@@ -312,19 +312,22 @@ fn tip_perturbation_lowers_the_critical_time_at_higher_rates() {
 }
 
 /// Parallel and serial sweeps give the same chart, bit for bit, and the
-/// progress callback counts every point once.
+/// progress callback ends at the total, counted in thousandths of points.
 #[test]
 fn ge_chart_parallel_equals_serial() {
+    use tetherplan::numerics::ge::chart::PROGRESS_UNITS_PER_POINT;
     let mut request = GeChartRequest::table_7_1(vec![60.0, 90.0, 110.0], vec![1e3, 1e5]);
     request.net_buoyancies_n = vec![1000.0, 1500.0];
-    let count = AtomicUsize::new(0);
-    let progress = |_: usize, total: usize| {
-        assert_eq!(total, 12);
-        count.fetch_add(1, Ordering::Relaxed);
+    let last = AtomicUsize::new(0);
+    let progress = |done: usize, total: usize| {
+        assert_eq!(total, 12 * PROGRESS_UNITS_PER_POINT);
+        assert!(done <= total);
+        last.fetch_max(done, Ordering::Relaxed);
     };
     let serial = deployment_chart(&request, Parallelism::Serial, &progress, &never).unwrap();
+    assert_eq!(last.swap(0, Ordering::Relaxed), 12 * PROGRESS_UNITS_PER_POINT);
     let parallel = deployment_chart(&request, Parallelism::Rayon, &progress, &never).unwrap();
-    assert_eq!(count.load(Ordering::Relaxed), 24);
+    assert_eq!(last.load(Ordering::Relaxed), 12 * PROGRESS_UNITS_PER_POINT);
     assert_eq!(serial, parallel);
     assert_eq!(serial.len(), 4);
     // more buoyancy, higher h*
@@ -799,4 +802,32 @@ fn steady_wind_delays_the_instability() {
     for k in 1..3 {
         assert!((drag[k] / drag[0] - 1.0).abs() < 0.02);
     }
+}
+
+/// Progress is reported within a point, as its march advances (simulated
+/// time over the horizon), not only when it finishes: a one-point chart
+/// reports increasing values below one point before it ends.
+#[test]
+fn ge_chart_progress_advances_within_a_point() {
+    use std::sync::Mutex;
+    use tetherplan::numerics::ge::chart::PROGRESS_UNITS_PER_POINT;
+    let request = GeChartRequest::table_7_1(vec![60.0], vec![1e5]);
+    let seen = Mutex::new(Vec::new());
+    let progress = |done: usize, total: usize| {
+        assert_eq!(total, PROGRESS_UNITS_PER_POINT);
+        seen.lock().unwrap().push(done);
+    };
+    deployment_chart(&request, Parallelism::Serial, &progress, &never).unwrap();
+    let seen = seen.into_inner().unwrap();
+    let within: Vec<usize> = seen
+        .iter()
+        .copied()
+        .filter(|&d| d > 0 && d < PROGRESS_UNITS_PER_POINT)
+        .collect();
+    assert!(
+        within.len() >= 3,
+        "progress within the point: {seen:?}"
+    );
+    assert!(seen.windows(2).all(|w| w[0] < w[1]), "increasing: {seen:?}");
+    assert_eq!(*seen.last().unwrap(), PROGRESS_UNITS_PER_POINT);
 }

@@ -1,16 +1,24 @@
 //! `/api/v1/jobs`: submit, list, get and cancel batch jobs.
+//!
+//! Jobs belong to the token that submitted them ([`Caller`]): another
+//! token gets 404 for them and does not see them listed. `Idempotency-Key`
+//! makes a submission safe to repeat. A finished job's answer is sent as
+//! the stored JSON text, spliced into the view without being parsed or
+//! copied again.
 
-use axum::extract::{Path, Query, State};
-use axum::http::{StatusCode, header};
+use axum::body::{Body, Bytes};
+use axum::extract::{Extension, Path, Query, State};
+use axum::http::{HeaderMap, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 use utoipa::{IntoParams, ToSchema};
 
 use crate::api::AppState;
+use crate::api::auth::Caller;
 use crate::api::error::{ApiError, JsonBody};
 use crate::contract::dto::ErrorBody;
-use crate::jobs::SubmitError;
+use crate::jobs::{SubmitError, Submitter};
 use crate::jobs::kinds::JobSubmission;
 use crate::jobs::store::{InsertError, JobRecord, JobStatus};
 
@@ -19,13 +27,16 @@ use crate::jobs::store::{InsertError, JobRecord, JobStatus};
 pub struct JobView {
     /// Job id (path of `GET /api/v1/jobs/{id}`).
     pub id: i64,
-    /// `stability`, `critical`, `safe_rate`, `chart` or `batch`.
+    /// `stability`, `critical`, `safe_rate`, `chart`, `simulate`,
+    /// `frequency_response` or `batch`.
     pub kind: String,
     pub status: JobStatus,
     /// Fraction done, 0 to 1 (updated about every 0.2 s while running).
     #[schema(minimum = 0.0, maximum = 1.0)]
     pub progress: f64,
-    /// Times the job was started (more than 1 after an interrupted run).
+    /// Times the job was started (more than 1 after an interrupted run; a
+    /// job whose process died at every one of `TETHERPLAN_JOB_MAX_ATTEMPTS`
+    /// starts fails with `attempts_exhausted`).
     pub attempts: u32,
     /// When it was submitted (UTC, RFC 3339).
     pub created_at: String,
@@ -33,9 +44,8 @@ pub struct JobView {
     pub started_at: Option<String>,
     /// When it finished (UTC, RFC 3339).
     pub finished_at: Option<String>,
-    /// The answer, when `done`: the body the synchronous route returns
-    /// (`StabilityResponse`, `CriticalResponse`, `SafeRateResponse`,
-    /// `ChartResponse`), or `BatchOutcome` for a batch. Absent in lists.
+    /// The answer, when `done`: the body the synchronous route of `kind`
+    /// returns, or `BatchOutcome` for a batch. Absent in lists.
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(schema_with = job_result_schema)]
     pub result: Option<Box<RawValue>>,
@@ -43,17 +53,24 @@ pub struct JobView {
     pub error: Option<ErrorBody>,
 }
 
-fn job_result_schema() -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {
+/// The schemas a finished job's `result` may have: the answer of every
+/// synchronous route a job kind stands for, and a batch's outcome.
+pub const JOB_RESULT_SCHEMAS: &[&str] = &[
+    "StabilityResponse",
+    "CriticalResponse",
+    "SafeRateResponse",
+    "AnyChartResponse",
+    "AnySimulateResponse",
+    "AnyFrequencyResponseResponse",
+    "BatchOutcome",
+];
+
+pub(crate) fn job_result_schema()
+-> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {
     use utoipa::openapi::schema::{OneOfBuilder, Ref};
     let mut one_of = OneOfBuilder::new();
-    for name in [
-        "StabilityResponse",
-        "CriticalResponse",
-        "SafeRateResponse",
-        "ChartResponse",
-        "BatchOutcome",
-    ] {
-        one_of = one_of.item(Ref::from_schema_name(name));
+    for name in JOB_RESULT_SCHEMAS {
+        one_of = one_of.item(Ref::from_schema_name(*name));
     }
     one_of.description(Some(
         "The answer, when `done`; absent otherwise and in lists.",
@@ -75,13 +92,33 @@ impl JobView {
             error: rec.error.and_then(|e| serde_json::from_str(&e).ok()),
         }
     }
+
+    /// The view as a response body: the stored answer (JSON text, possibly
+    /// hundreds of MB) is spliced in as it is, not parsed or copied.
+    fn into_body(mut rec: JobRecord) -> Body {
+        let result = rec.result.take();
+        let mut head = serde_json::to_vec(&Self::new(rec)).expect("views serialise");
+        let Some(result) = result else {
+            return Body::from(head);
+        };
+        head.pop(); // the closing brace
+        head.extend_from_slice(br#","result":"#);
+        let parts: [Result<Bytes, std::convert::Infallible>; 3] = [
+            Ok(Bytes::from(head)),
+            Ok(Bytes::from(result)),
+            Ok(Bytes::from_static(b"}")),
+        ];
+        Body::from_stream(futures_util::stream::iter(parts))
+    }
 }
 
-/// Answer to a submission.
+/// Answer to a submission (202 new, 200 an earlier one with the same
+/// `Idempotency-Key`).
 #[derive(Debug, Serialize, Deserialize, ToSchema)]
 pub struct JobAccepted {
     pub id: i64,
     pub kind: String,
+    /// `queued` for a new job; the current status for a repeated key.
     pub status: JobStatus,
     /// Where to poll: `/api/v1/jobs/{id}`.
     pub location: String,
@@ -125,34 +162,84 @@ fn parse_id(id: &str) -> Result<i64, ApiError> {
         .map_err(|_| ApiError::not_found(format!("no job with id `{id}`")))
 }
 
+/// The `Idempotency-Key` header: 1 to 255 visible ASCII characters.
+pub const IDEMPOTENCY_KEY: &str = "idempotency-key";
+
+fn idempotency_key(headers: &HeaderMap) -> Result<Option<String>, ApiError> {
+    let Some(v) = headers.get(IDEMPOTENCY_KEY) else {
+        return Ok(None);
+    };
+    let bad = || {
+        ApiError::new(
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "invalid_input",
+            Some("Idempotency-Key"),
+            "Idempotency-Key: must be 1 to 255 visible ASCII characters",
+        )
+    };
+    let key = v.to_str().map_err(|_| bad())?.trim();
+    if key.is_empty() || key.len() > 255 || !key.bytes().all(|b| b.is_ascii_graphic()) {
+        return Err(bad());
+    }
+    Ok(Some(key.to_string()))
+}
+
 /// Submit a batch job.
 ///
-/// The request is validated now (422 naming the field, nothing stored);
-/// the answer is computed in the background on the job pool. Poll
+/// The request is validated now (422 naming the field, nothing stored),
+/// including an estimate of its answer's size against the job limit; the
+/// answer is computed in the background on the job pool. Poll
 /// `GET /api/v1/jobs/{id}`. Jobs survive restarts and crashes: an
-/// interrupted job runs again from the start.
+/// interrupted job runs again from the start. With `Idempotency-Key`, a
+/// repeated submission (same token, same key, same body) returns the
+/// first job with 200 instead of creating another; the same key with
+/// another body is 422.
 #[utoipa::path(
     post, path = "/api/v1/jobs", operation_id = "create_job", tag = "jobs",
     request_body(content = JobSubmission, description = "One request with its kind, or a batch"),
+    params(
+        ("Idempotency-Key" = Option<String>, Header,
+            description = "Client-chosen key (1 to 255 visible ASCII characters): a repeated key returns the first job"),
+    ),
     responses(
+        (status = 200, description = "Seen before: the job first submitted with this Idempotency-Key", body = JobAccepted,
+            headers(("Location" = String, description = "The job's URL")),
+            links(
+                ("GetJob" = (operation_id = "get_job", parameters(("id" = "$response.body#/id")),
+                    description = "The job: status, progress, answer")),
+                ("DeleteJob" = (operation_id = "delete_job", parameters(("id" = "$response.body#/id")),
+                    description = "Cancel the job")),
+            )),
         (status = 202, description = "Accepted and queued", body = JobAccepted,
-            headers(("Location" = String, description = "The job's URL"))),
+            headers(("Location" = String, description = "The job's URL")),
+            links(
+                ("GetJob" = (operation_id = "get_job", parameters(("id" = "$response.body#/id")),
+                    description = "The job: status, progress, answer")),
+                ("DeleteJob" = (operation_id = "delete_job", parameters(("id" = "$response.body#/id")),
+                    description = "Cancel the job")),
+            )),
         (status = 400, description = "Malformed JSON", body = ErrorBody),
         (status = 413, description = "Body larger than the limit", body = ErrorBody),
         (status = 415, description = "Content type is not JSON", body = ErrorBody),
-        (status = 422, description = "Invalid request; `field` names the culprit", body = ErrorBody),
-        (status = 429, description = "Queue full", body = ErrorBody,
+        (status = 422, description = "Invalid request, answer too large for a job, or an Idempotency-Key reused with another body; `field` names the culprit", body = ErrorBody),
+        (status = 429, description = "Queue full, or this token's quota of pending jobs reached", body = ErrorBody,
             headers(("Retry-After" = u32, description = "Seconds to wait before retrying"))),
         (status = 500, description = "Job store failure", body = ErrorBody),
     )
 )]
 pub async fn create_job(
     State(app): State<AppState>,
+    Extension(caller): Extension<Caller>,
+    headers: HeaderMap,
     JsonBody(body): JsonBody,
 ) -> Result<Response, ApiError> {
+    let who = Submitter {
+        owner: caller.owner,
+        idempotency_key: idempotency_key(&headers)?,
+    };
     let queue = app.queue.clone();
-    let (id, kind) = blocking(move || {
-        queue.submit(&body).map_err(|e| match e {
+    let submitted = blocking(move || {
+        queue.submit_as(&body, &who).map_err(|e| match e {
             SubmitError::Request(r) => ApiError::from(r),
             SubmitError::Queue(InsertError::QueueFull { .. }) => ApiError::new(
                 StatusCode::TOO_MANY_REQUESTS,
@@ -161,17 +248,35 @@ pub async fn create_job(
                 e.to_string(),
             )
             .retry_after(5),
+            SubmitError::Queue(InsertError::QuotaFull { .. }) => ApiError::new(
+                StatusCode::TOO_MANY_REQUESTS,
+                "quota_full",
+                None,
+                e.to_string(),
+            )
+            .retry_after(5),
+            SubmitError::Queue(InsertError::KeyReused { .. }) => ApiError::new(
+                StatusCode::UNPROCESSABLE_ENTITY,
+                "idempotency_key_reused",
+                Some("Idempotency-Key"),
+                e.to_string(),
+            ),
             SubmitError::Queue(InsertError::Store(s)) => ApiError::from(s),
         })
     })
     .await?;
-    let location = format!("/api/v1/jobs/{id}");
+    let location = format!("/api/v1/jobs/{}", submitted.id);
+    let status = if submitted.created {
+        StatusCode::ACCEPTED
+    } else {
+        StatusCode::OK
+    };
     let mut resp = json_response(
-        StatusCode::ACCEPTED,
+        status,
         &JobAccepted {
-            id,
-            kind: kind.into(),
-            status: JobStatus::Queued,
+            id: submitted.id,
+            kind: submitted.kind,
+            status: submitted.status,
             location: location.clone(),
         },
     );
@@ -192,6 +297,7 @@ pub async fn create_job(
 )]
 pub async fn list_jobs(
     State(app): State<AppState>,
+    Extension(caller): Extension<Caller>,
     query: Result<Query<ListQuery>, axum::extract::rejection::QueryRejection>,
 ) -> Result<Response, ApiError> {
     let Query(q) = query.map_err(|e| {
@@ -212,7 +318,12 @@ pub async fn list_jobs(
         ));
     }
     let queue = app.queue.clone();
-    let jobs = blocking(move || Ok(queue.store.list(q.status, limit)?)).await?;
+    let jobs = blocking(move || {
+        Ok(queue
+            .store
+            .list_owned(caller.owner.as_deref(), q.status, limit)?)
+    })
+    .await?;
     Ok(json_response(
         StatusCode::OK,
         &JobList {
@@ -233,13 +344,19 @@ pub async fn list_jobs(
 )]
 pub async fn get_job(
     State(app): State<AppState>,
+    Extension(caller): Extension<Caller>,
     Path(id): Path<String>,
 ) -> Result<Response, ApiError> {
     let id = parse_id(&id)?;
     let queue = app.queue.clone();
-    let rec = blocking(move || Ok(queue.store.get(id)?)).await?;
+    let rec = blocking(move || Ok(queue.store.get_owned(id, caller.owner.as_deref())?)).await?;
     let rec = rec.ok_or_else(|| ApiError::not_found(format!("no job with id {id}")))?;
-    Ok(json_response(StatusCode::OK, &JobView::new(rec)))
+    Ok((
+        StatusCode::OK,
+        [(header::CONTENT_TYPE, "application/json")],
+        JobView::into_body(rec),
+    )
+        .into_response())
 }
 
 /// Cancel a queued or running job (it stays listed, as `cancelled`).
@@ -255,13 +372,16 @@ pub async fn get_job(
 )]
 pub async fn delete_job(
     State(app): State<AppState>,
+    Extension(caller): Extension<Caller>,
     Path(id): Path<String>,
 ) -> Result<Response, ApiError> {
     let id = parse_id(&id)?;
     let queue = app.queue.clone();
+    let owner = caller.owner;
     let before = {
         let queue = queue.clone();
-        blocking(move || Ok(queue.store.status(id)?)).await?
+        let owner = owner.clone();
+        blocking(move || Ok(queue.store.status_owned(id, owner.as_deref())?)).await?
     };
     match before {
         None => Err(ApiError::not_found(format!("no job with id {id}"))),
@@ -275,7 +395,7 @@ pub async fn delete_job(
             ),
         )),
         Some(_) => {
-            let rec = blocking(move || Ok(queue.cancel(id)?)).await?;
+            let rec = blocking(move || Ok(queue.cancel(id, owner.as_deref())?)).await?;
             let rec = rec.ok_or_else(|| ApiError::not_found(format!("no job with id {id}")))?;
             Ok(json_response(StatusCode::OK, &JobView::new(rec)))
         }

@@ -10,6 +10,8 @@
 //! Every error is the one body of [`error::ApiError`].
 
 pub mod assets;
+pub mod auth;
+pub mod auth_doc;
 pub mod error;
 pub mod guard;
 pub mod jobs;
@@ -44,6 +46,8 @@ pub struct AppState {
     pub queue: Arc<JobQueue>,
     pub limits: Limits,
     solves: Arc<Semaphore>,
+    /// API tokens (none: open).
+    pub tokens: Arc<auth::Tokens>,
 }
 
 impl AppState {
@@ -54,7 +58,14 @@ impl AppState {
             queue,
             limits,
             solves,
+            tokens: Arc::new(auth::Tokens::default()),
         }
+    }
+
+    /// The same, requiring one of `tokens` on every `/api` route.
+    pub fn with_tokens(mut self, tokens: &[String]) -> Self {
+        self.tokens = Arc::new(auth::Tokens::new(tokens));
+        self
     }
 }
 
@@ -108,6 +119,7 @@ pub fn router(state: AppState, static_dir: &Path) -> Router {
 /// security headers ([`guard::security_headers`]).
 pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
     let body_limit = state.limits.max_body_bytes;
+    let tokens = state.tokens.clone();
     let routes = Router::new()
         .route("/healthz", get(get_health))
         .route("/api/v1/stability", post(solve::compute_stability))
@@ -127,6 +139,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
         .route("/api", any(api_not_found))
         .route("/api/{*rest}", any(api_not_found))
         .method_not_allowed_fallback(method_not_allowed)
+        .layer(axum::middleware::from_fn_with_state(tokens, auth::require_token))
         .with_state(state)
         .merge(SwaggerUi::new("/docs").url("/openapi.json", openapi::openapi()));
     let routes = match static_dir {
@@ -151,12 +164,13 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
         config.limits.clone(),
     ));
     let worker = queue.spawn_worker();
+    let state = AppState::new(queue.clone()).with_tokens(&config.api_tokens);
     let listener = tokio::net::TcpListener::bind(config.addr)
         .await
         .map_err(|e| format!("cannot listen on {}: {e}", config.addr))?;
     let addr = listener.local_addr()?;
     let hosts = guard::HostAllowList::new(addr, config.allowed_hosts.as_deref());
-    let app = app(AppState::new(queue.clone()), config.static_dir.as_deref())
+    let app = app(state, config.static_dir.as_deref())
         .layer(tower_http::timeout::RequestBodyTimeoutLayer::new(
             config.connections.body_timeout,
         ))
@@ -207,7 +221,7 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
             "the job worker did not stop within 10 s; its job will run again at the next start"
         );
     }
-    let requeued = queue.store.requeue_running()?;
+    let requeued = queue.store.release_all()?;
     tracing::info!(requeued, "stopped");
     Ok(())
 }

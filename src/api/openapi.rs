@@ -4,6 +4,7 @@
 
 use utoipa::OpenApi;
 
+use crate::api::auth_doc::BearerTokens;
 use crate::api::{Health, jobs, solve};
 use crate::contract::dto::*;
 use crate::jobs::kinds::{
@@ -19,7 +20,8 @@ use crate::jobs::store::JobStatus;
             deployment charts of a lengthening heavy cable. JSON in SI units; every field name ends in its unit \
             (`_m`, `_s`, `_m_s`, `_n`, `_kg`), non-dimensional values end in `_nondim`.\n\n\
             Every error is `{\"error\": {\"code\", \"field\", \"message\"}}`: 400 malformed JSON, 404 unknown \
-            job or path, 405 wrong method, 409 cancelling a finished job, 413 oversize body, 415 not JSON, \
+            job or path (or another token's job), 401 missing or wrong API token (when the server has tokens; \
+            `WWW-Authenticate: Bearer`), 405 wrong method, 409 cancelling a finished job, 413 oversize body, 415 not JSON, \
             422 invalid input or too large for a synchronous answer (`field` names the culprit), 429 job \
             queue full and 503 too many solves in flight (both with `Retry-After`), 504 no answer within the \
             solve timeout, 500 a bug."
@@ -44,6 +46,7 @@ use crate::jobs::store::JobStatus;
         Health,
         crate::contract::ge_critical::GeCriticalResponse, crate::contract::ge_critical::GeStabilityResponse,
     )),
+    modifiers(&BearerTokens),
     tags(
         (name = "solve", description = "Synchronous answers (about a second at most)"),
         (name = "jobs", description = "Persisted batch jobs for large or many requests"),

@@ -38,7 +38,13 @@ pub trait JobKind: Serialize + Sized {
     /// Computes the answer (JSON text). Long kinds report progress and stop
     /// when `progress.cancelled()`.
     fn run(&self, progress: &dyn Progress) -> Result<String, RequestError>;
+    /// An upper estimate of the answer's size, from the validated request
+    /// (see [`crate::jobs::estimate`]).
+    fn estimate(&self) -> Estimate;
 }
+
+pub use super::estimate::Estimate;
+use super::estimate::{self as est, Estimate as E};
 
 fn to_json(value: &impl Serialize) -> Result<String, RequestError> {
     Ok(serde_json::to_string(value).expect("responses serialise"))
@@ -72,6 +78,9 @@ impl JobKind for StabilityRequest {
     fn run(&self, _: &dyn Progress) -> Result<String, RequestError> {
         to_json(&run::stability(self)?)
     }
+    fn estimate(&self) -> Estimate {
+        E::new("modes", est::STABILITY_BASE + self.params.modes as u64 * est::PER_EIGENVALUE)
+    }
 }
 
 impl JobKind for CriticalRequest {
@@ -86,6 +95,9 @@ impl JobKind for CriticalRequest {
     }
     fn run(&self, _: &dyn Progress) -> Result<String, RequestError> {
         to_json(&run::critical(self)?)
+    }
+    fn estimate(&self) -> Estimate {
+        E::new("profile", est::SMALL_ANSWER)
     }
 }
 
@@ -109,6 +121,9 @@ impl JobKind for SafeRateRequest {
     }
     fn run(&self, _: &dyn Progress) -> Result<String, RequestError> {
         to_json(&run::safe_rate(self)?)
+    }
+    fn estimate(&self) -> Estimate {
+        E::new("target_elevation_m", est::SMALL_ANSWER)
     }
 }
 
@@ -203,6 +218,14 @@ impl JobKind for ChartRequest {
             converged: self.system.model.elements.is_none(),
         })
     }
+    fn estimate(&self) -> Estimate {
+        let series = self.params.net_buoyancies_n.len().max(1) as u64;
+        let points = series.saturating_mul(self.params.rates_m_s.count as u64);
+        E::new(
+            "rates_m_s.count",
+            est::CHART_BASE + series * est::PER_CHART_SERIES + points * est::PER_CHART_POINT,
+        )
+    }
 }
 
 trait Buoyancies {
@@ -259,6 +282,39 @@ impl JobKind for AnySimulateRequest {
     fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
         to_json(&simulate::simulate_any(self, progress)?)
     }
+    fn estimate(&self) -> Estimate {
+        match self {
+            Self::LinearString(r) => {
+                let samples = r.params.samples as u64;
+                let tracks = r.params.eigenvalues.as_ref().map_or(0, |e| {
+                    let every = e.interval_s.max(1e-9);
+                    let solves = (r.params.duration_s / every).ceil().clamp(0.0, 1e12) as u64 + 1;
+                    solves.saturating_mul(
+                        est::PER_EIGEN_TRACK + e.count as u64 * est::PER_EIGENVALUE,
+                    )
+                });
+                E::new(
+                    "samples",
+                    est::SIMULATE_BASE + samples * est::PER_SIMULATE_SAMPLE + tracks,
+                )
+            }
+            Self::GeometricallyExact(r) => {
+                let steps = (r.duration_s / r.time_step_s).ceil().clamp(0.0, 1e15);
+                let samples = (steps / r.output_every_steps.max(1) as f64).ceil() as u64 + 1;
+                let spectra = if r.eigenvalues_every_steps > 0 {
+                    (steps / r.eigenvalues_every_steps as f64).ceil() as u64 + 1
+                } else {
+                    0
+                };
+                E::new(
+                    "output_every_steps",
+                    est::SIMULATE_BASE
+                        + samples * est::PER_GE_SAMPLE
+                        + spectra * (est::PER_EIGEN_TRACK + r.modes as u64 * est::PER_EIGENVALUE),
+                )
+            }
+        }
+    }
 }
 
 impl JobKind for FrequencyResponseRequest {
@@ -275,6 +331,9 @@ impl JobKind for FrequencyResponseRequest {
             Parallelism::Rayon,
             progress,
         )?)
+    }
+    fn estimate(&self) -> Estimate {
+        AnyFrequencyResponseRequest::Wind(Box::new(self.clone())).estimate()
     }
 }
 
@@ -299,6 +358,18 @@ impl JobKind for AnyChartRequest {
             }
         }
     }
+    fn estimate(&self) -> Estimate {
+        match self {
+            Self::LinearString(r) => r.estimate(),
+            Self::GeometricallyExact(r) => {
+                let points = ge_charts::prepare_chart(r).map_or(0, |c| c.point_count()) as u64;
+                E::new(
+                    "rates_m_s",
+                    est::CHART_BASE + points * (est::PER_GE_CHART_POINT + est::PER_CHART_SERIES),
+                )
+            }
+        }
+    }
 }
 
 impl JobKind for AnyFrequencyResponseRequest {
@@ -317,6 +388,22 @@ impl JobKind for AnyFrequencyResponseRequest {
             Parallelism::Rayon,
             progress,
         )?)
+    }
+    fn estimate(&self) -> Estimate {
+        match self {
+            Self::Wind(r) => {
+                let f = r.params.frequencies_rad_s.count as u64;
+                let n = r.params.samples as u64;
+                E::new(
+                    "frequencies_rad_s.count",
+                    est::SIMULATE_BASE + f.saturating_mul(n + 4) * est::PER_NUMBER + n * est::PER_NUMBER,
+                )
+            }
+            Self::Base(r) => E::new(
+                "frequencies_rad_s.count",
+                est::SIMULATE_BASE + r.frequencies_rad_s.count as u64 * est::PER_BASE_POINT,
+            ),
+        }
     }
 }
 
@@ -404,6 +491,11 @@ macro_rules! job_kinds {
 
             fn run_kind(&self, progress: &dyn Progress) -> Result<String, RequestError> {
                 match self { $(Self::$variant(r) => r.run(progress)),* }
+            }
+
+            /// Upper estimate of the answer's size.
+            pub fn estimate(&self) -> Estimate {
+                match self { $(Self::$variant(r) => r.estimate()),* }
             }
         }
     };
@@ -518,11 +610,30 @@ pub struct BatchItemOutcome {
     pub kind: String,
     /// The answer, as the synchronous route gives it.
     #[serde(skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<Object>)]
+    #[schema(schema_with = item_result_schema)]
     pub result: Option<Box<RawValue>>,
     /// Why this request failed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<ErrorBody>,
+}
+
+/// The schemas of one request's answer: those of the synchronous routes.
+pub const ITEM_RESULT_SCHEMAS: &[&str] = &[
+    "StabilityResponse",
+    "CriticalResponse",
+    "SafeRateResponse",
+    "AnyChartResponse",
+    "AnySimulateResponse",
+    "AnyFrequencyResponseResponse",
+];
+
+fn item_result_schema() -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {
+    use utoipa::openapi::schema::{OneOfBuilder, Ref};
+    let mut one_of = OneOfBuilder::new();
+    for name in ITEM_RESULT_SCHEMAS {
+        one_of = one_of.item(Ref::from_schema_name(*name));
+    }
+    one_of.description(Some("The answer, as the synchronous route gives it; absent on error."))
 }
 
 /// The answer of a batch job, in submission order.
@@ -558,7 +669,12 @@ impl JobSubmission {
         let value: Value =
             serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
         if value.get("kind").and_then(Value::as_str) != Some("batch") {
-            return JobItem::parse(&value, "body").map(Self::One);
+            let item = JobItem::parse(&value, "body")?;
+            est::check(
+                &item.estimate().prefixed("request"),
+                limits.max_job_result_bytes,
+            )?;
+            return Ok(Self::One(item));
         }
         if let Some(obj) = value.as_object() {
             refuse_unknown_keys(obj, "body")?;
@@ -588,6 +704,10 @@ impl JobSubmission {
             .enumerate()
             .map(|(i, v)| JobItem::parse(v, &format!("request[{i}]")))
             .collect::<Result<Vec<_>, _>>()?;
+        est::check_batch(
+            request.iter().map(JobItem::estimate),
+            limits.max_job_result_bytes,
+        )?;
         Ok(Self::Batch(BatchSubmission {
             kind: BatchKind::Batch,
             request,

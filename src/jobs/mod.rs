@@ -1,16 +1,23 @@
-//! Batch jobs: a bounded queue persisted in SQLite ([`store`]), what a job
-//! computes ([`kinds`]), and the worker that runs them on a dedicated rayon
-//! pool, apart from the pool that answers synchronous requests.
+//! Batch jobs: a bounded queue persisted in a job store ([`store`]: the
+//! [`store::JobBackend`] trait, SQLite by default), what a job computes
+//! ([`kinds`]), and the worker that runs them on a dedicated rayon pool,
+//! apart from the pool that answers synchronous requests.
 //!
 //! The worker is a plain thread looping on [`try_execute_next`], which
-//! claims the oldest queued job, runs it, and records the outcome; tests
-//! call it directly to drain the queue deterministically. Progress is
+//! claims the oldest queued job under a lease ([`lease`]), runs it while a
+//! heartbeat renews the lease, and records the outcome with fenced writes;
+//! tests call it directly to drain the queue deterministically. Progress is
 //! written to the store at most every [`JobQueue::progress_interval`];
-//! cancellation (`DELETE`) and shutdown are seen between chunks of work.
-//! A job interrupted by shutdown goes back to `queued`; one interrupted by a
-//! crash is requeued when the store is next opened.
+//! cancellation (`DELETE`), lease loss, the run-time limit and shutdown are
+//! seen between chunks of work. A job interrupted by shutdown goes back to
+//! `queued`; one whose process died is taken over when its lease expires
+//! (at once by a restarted process on the same host), and failed after
+//! `max_job_attempts` such claims.
 
+pub mod estimate;
 pub mod kinds;
+pub mod lease;
+pub mod sqlite;
 pub mod store;
 
 use std::collections::HashMap;
@@ -23,7 +30,9 @@ use crate::config::Limits;
 use crate::contract::dto::ErrorBody;
 use crate::contract::{Progress, RequestError};
 use kinds::JobSubmission;
-use store::{InsertError, JobRecord, JobStatus, JobStore, StoreError};
+use store::{
+    ClaimPolicy, InsertError, Inserted, JobBackend, JobRecord, JobStatus, Lease, NewJob, StoreError,
+};
 
 /// Why a submission was refused.
 #[derive(Debug, thiserror::Error)]
@@ -34,21 +43,55 @@ pub enum SubmitError {
     Queue(#[from] InsertError),
 }
 
+/// Who submits: the owner (hash of the API token) and the idempotency key.
+#[derive(Clone, Debug, Default)]
+pub struct Submitter {
+    pub owner: Option<String>,
+    pub idempotency_key: Option<String>,
+}
+
+/// A stored submission.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Submitted {
+    pub id: i64,
+    pub kind: String,
+    pub status: JobStatus,
+    /// False when an earlier submission with the same idempotency key is returned.
+    pub created: bool,
+}
+
+/// A job running in this process: its lease and stop signals.
+struct RunningJob {
+    cancelled: AtomicBool,
+    lost: AtomicBool,
+}
+
 /// The queue: store, job pool, limits, and the worker's signals.
 pub struct JobQueue {
-    pub store: JobStore,
+    pub store: Box<dyn JobBackend>,
     pool: rayon::ThreadPool,
     limits: Limits,
     shutdown: AtomicBool,
     wake: (Mutex<bool>, Condvar),
-    running: Mutex<HashMap<i64, Arc<AtomicBool>>>,
+    running: Mutex<HashMap<i64, Arc<RunningJob>>>,
     /// Least time between two progress writes of one job.
     pub progress_interval: Duration,
 }
 
+/// Lowercase hex SHA-256 of `bytes`.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    let digest = sha2::Sha256::digest(bytes);
+    let mut s = String::with_capacity(64);
+    for b in digest.iter() {
+        s.push_str(&format!("{b:02x}"));
+    }
+    s
+}
+
 impl JobQueue {
     /// A queue over `store` with a pool of `threads` for the jobs.
-    pub fn new(store: JobStore, threads: usize, limits: Limits) -> Self {
+    pub fn new(store: impl JobBackend + 'static, threads: usize, limits: Limits) -> Self {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.max(1))
             .thread_name(|i| format!("job-{i}"))
@@ -56,7 +99,7 @@ impl JobQueue {
             .build()
             .expect("the job pool starts");
         Self {
-            store,
+            store: Box::new(store),
             pool,
             limits,
             shutdown: AtomicBool::new(false),
@@ -70,22 +113,76 @@ impl JobQueue {
         &self.limits
     }
 
-    /// Validates and stores a submission; returns its id. Nothing is stored
-    /// when the request is invalid or the queue is full.
+    /// Validates and stores a submission without owner or key; returns its id.
     pub fn submit(&self, body: &[u8]) -> Result<(i64, &'static str), SubmitError> {
-        let submission = JobSubmission::parse(body, &self.limits)?;
-        let kind = submission.kind();
-        let request =
-            std::str::from_utf8(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
-        let id = self
-            .store
-            .insert(kind, request, self.limits.max_pending_jobs)?;
-        self.notify();
-        Ok((id, kind))
+        let kind = JobSubmission::parse(body, &self.limits)?.kind();
+        let s = self.submit_as(body, &Submitter::default())?;
+        Ok((s.id, kind))
     }
 
-    /// Cancels a queued or running job; None for an unknown id.
-    pub fn cancel(&self, id: i64) -> Result<Option<JobRecord>, StoreError> {
+    /// Validates and stores a submission (nothing is stored when the
+    /// request is invalid, too large, or the queue or the owner's quota is
+    /// full); a repeated idempotency key with the same body returns the
+    /// first job.
+    pub fn submit_as(&self, body: &[u8], who: &Submitter) -> Result<Submitted, SubmitError> {
+        let request =
+            std::str::from_utf8(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
+        let request_hash = sha256_hex(body);
+        // A retry is answered before the (possibly long) validation.
+        if let (Some(key), Some(first)) = (
+            who.idempotency_key.as_deref(),
+            self.store
+                .find_by_key(who.owner.as_deref(), who.idempotency_key.as_deref().unwrap_or(""))
+                .map_err(InsertError::Store)?,
+        ) {
+            if first.request_hash != request_hash {
+                return Err(InsertError::KeyReused {
+                    key: key.to_string(),
+                    id: first.id,
+                }
+                .into());
+            }
+            return Ok(Submitted {
+                id: first.id,
+                kind: first.kind,
+                status: first.status,
+                created: false,
+            });
+        }
+        let submission = JobSubmission::parse(body, &self.limits)?;
+        let kind = submission.kind();
+        let new = NewJob {
+            kind,
+            request,
+            owner: who.owner.as_deref(),
+            idempotency_key: who.idempotency_key.as_deref(),
+            request_hash: &request_hash,
+            max_pending: self.limits.max_pending_jobs,
+            max_pending_per_owner: self.limits.max_pending_jobs_per_token,
+        };
+        let submitted = match self.store.insert(&new)? {
+            Inserted::New(id) => {
+                self.notify();
+                Submitted {
+                    id,
+                    kind: kind.into(),
+                    status: JobStatus::Queued,
+                    created: true,
+                }
+            }
+            Inserted::Existing { id, kind, status } => Submitted {
+                id,
+                kind,
+                status,
+                created: false,
+            },
+        };
+        Ok(submitted)
+    }
+
+    /// Cancels a queued or running job of `owner` (None: any); None for an
+    /// unknown id or another owner's job.
+    pub fn cancel(&self, id: i64, owner: Option<&str>) -> Result<Option<JobRecord>, StoreError> {
         let body = ErrorBody::new(
             "cancelled",
             None,
@@ -93,15 +190,17 @@ impl JobQueue {
         );
         let record = self.store.cancel(
             id,
+            owner,
             &serde_json::to_string(&body).expect("error bodies serialise"),
         )?;
-        if let Some(flag) = self
-            .running
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .get(&id)
+        if record.as_ref().is_some_and(|r| r.status == JobStatus::Cancelled)
+            && let Some(job) = self
+                .running
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .get(&id)
         {
-            flag.store(true, Ordering::Relaxed);
+            job.cancelled.store(true, Ordering::Relaxed);
         }
         Ok(record)
     }
@@ -135,6 +234,8 @@ impl JobQueue {
     }
 
     /// Starts the worker thread; it runs until [`JobQueue::shutdown`].
+    /// An idle worker looks for work at least every second (jobs submitted
+    /// by other processes, expired leases).
     pub fn spawn_worker(self: &Arc<Self>) -> std::thread::JoinHandle<()> {
         let queue = Arc::clone(self);
         std::thread::Builder::new()
@@ -180,10 +281,21 @@ fn lower_thread_priority() {
 
 /// Progress and cancellation of one running job.
 struct JobControl<'a> {
-    id: i64,
+    lease: &'a Lease,
     queue: &'a JobQueue,
-    cancelled: Arc<AtomicBool>,
+    job: Arc<RunningJob>,
+    started: Instant,
     last_write: Mutex<Instant>,
+}
+
+impl JobControl<'_> {
+    fn timed_out(&self) -> bool {
+        self.started.elapsed() > self.queue.limits.max_job_run_time
+    }
+
+    fn lose(&self) {
+        self.job.lost.store(true, Ordering::Relaxed);
+    }
 }
 
 impl Progress for JobControl<'_> {
@@ -198,17 +310,37 @@ impl Progress for JobControl<'_> {
         match self
             .queue
             .store
-            .set_progress(self.id, done as f64 / total.max(1) as f64)
+            .set_progress(self.lease, done as f64 / total.max(1) as f64)
         {
             Ok(true) => {}
-            // No longer running: cancelled meanwhile (possibly by another process).
-            Ok(false) => self.cancelled.store(true, Ordering::Relaxed),
-            Err(e) => tracing::warn!(job = self.id, error = %e, "progress not recorded"),
+            // Cancelled or taken over meanwhile (possibly by another process).
+            Ok(false) => self.lose(),
+            Err(e) => tracing::warn!(job = self.lease.job_id, error = %e, "progress not recorded"),
         }
     }
 
     fn cancelled(&self) -> bool {
-        self.cancelled.load(Ordering::Relaxed) || self.queue.is_shut_down()
+        self.job.cancelled.load(Ordering::Relaxed)
+            || self.job.lost.load(Ordering::Relaxed)
+            || self.queue.is_shut_down()
+            || self.timed_out()
+    }
+}
+
+/// Renews `ctl`'s lease every third of the lease length until `stop`
+/// fires; a lost lease stops the job.
+fn heartbeat(ctl: &JobControl<'_>, stop: std::sync::mpsc::Receiver<()>) {
+    let every = ctl.queue.limits.job_lease / 3;
+    while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = stop.recv_timeout(every) {
+        match ctl.queue.store.renew(ctl.lease, ctl.queue.limits.job_lease) {
+            Ok(true) => {}
+            Ok(false) => {
+                tracing::warn!(job = ctl.lease.job_id, "lease lost: the job stops here");
+                ctl.lose();
+                return;
+            }
+            Err(e) => tracing::warn!(job = ctl.lease.job_id, error = %e, "lease not renewed"),
+        }
     }
 }
 
@@ -219,72 +351,124 @@ pub struct Executed {
     pub status: JobStatus,
 }
 
-/// Runs the oldest queued job to its end, if there is one: the worker's
-/// step, also called directly by tests.
+fn error_json(body: ErrorBody) -> String {
+    serde_json::to_string(&body).expect("error bodies serialise")
+}
+
+/// Runs the oldest queued job (or one whose lease expired) to its end, if
+/// there is one: the worker's step, also called directly by tests.
 pub fn try_execute_next(queue: &JobQueue) -> Result<Option<Executed>, StoreError> {
-    let Some(job) = queue.store.claim_next()? else {
+    let limits = &queue.limits;
+    let exhausted = error_json(ErrorBody::new(
+        "attempts_exhausted",
+        None,
+        format!(
+            "the job was started {} times and each time the process running it stopped before it \
+             finished (crash, out of memory or kill); it is not started again",
+            limits.max_job_attempts
+        ),
+    ));
+    let policy = ClaimPolicy {
+        lease: limits.job_lease,
+        max_attempts: limits.max_job_attempts,
+        exhausted_error: &exhausted,
+    };
+    let Some(job) = queue.store.claim(&policy)? else {
         return Ok(None);
     };
-    let span = tracing::info_span!("job", id = job.id, kind = %job.kind);
+    let span = tracing::info_span!("job", id = job.id, kind = %job.kind, attempt = job.attempts);
     let _enter = span.enter();
     let started = Instant::now();
-    let flag = Arc::new(AtomicBool::new(false));
+    let running = Arc::new(RunningJob {
+        cancelled: AtomicBool::new(false),
+        lost: AtomicBool::new(false),
+    });
     queue
         .running
         .lock()
         .unwrap_or_else(|e| e.into_inner())
-        .insert(job.id, flag.clone());
+        .insert(job.id, running.clone());
     let ctl = JobControl {
-        id: job.id,
+        lease: &job.lease,
         queue,
-        cancelled: flag,
+        job: running,
+        started,
         last_write: Mutex::new(Instant::now()),
     };
-    let outcome = catch_unwind(AssertUnwindSafe(|| {
-        queue.pool.install(|| {
-            let submission = JobSubmission::parse(job.request.as_bytes(), &queue.limits)?;
-            submission.run(&ctl)
-        })
-    }));
+    let outcome = std::thread::scope(|scope| {
+        let (stop, stopped) = std::sync::mpsc::channel::<()>();
+        let ctl = &ctl;
+        scope.spawn(move || heartbeat(ctl, stopped));
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            queue.pool.install(|| {
+                let submission = JobSubmission::parse(job.request.as_bytes(), &queue.limits)?;
+                submission.run(ctl)
+            })
+        }));
+        drop(stop);
+        outcome
+    });
     queue
         .running
         .lock()
         .unwrap_or_else(|e| e.into_inner())
         .remove(&job.id);
-    let error_json =
-        |body: ErrorBody| serde_json::to_string(&body).expect("error bodies serialise");
+    let lease = &job.lease;
+    let lost = ctl.job.lost.load(Ordering::Relaxed);
+    let now = |queue: &JobQueue| -> Result<JobStatus, StoreError> {
+        Ok(queue.store.status(job.id)?.unwrap_or(JobStatus::Cancelled))
+    };
+    let fail = |body: ErrorBody| -> Result<JobStatus, StoreError> {
+        if queue.store.finish_failed(lease, &error_json(body))? {
+            Ok(JobStatus::Failed)
+        } else {
+            now(queue)
+        }
+    };
     let status = match outcome {
+        Ok(Ok(result)) if result.len() as u64 > limits.max_job_result_bytes => fail(ErrorBody::new(
+            "result_too_large",
+            None,
+            format!(
+                "the answer has {} bytes, more than the limit of {} bytes (TETHERPLAN_JOB_MAX_RESULT_BYTES); \
+                 ask for fewer points",
+                result.len(),
+                limits.max_job_result_bytes
+            ),
+        ))?,
         Ok(Ok(result)) => {
-            if queue.store.finish_done(job.id, &result)? {
+            if queue.store.finish_done(lease, &result)? {
                 JobStatus::Done
             } else {
-                queue.store.status(job.id)?.unwrap_or(JobStatus::Cancelled)
+                now(queue)?
             }
         }
-        Ok(Err(RequestError::Cancelled))
-            if queue.is_shut_down() && !ctl.cancelled.load(Ordering::Relaxed) =>
-        {
-            queue.store.requeue(job.id)?;
-            queue.store.status(job.id)?.unwrap_or(JobStatus::Queued)
+        Ok(Err(RequestError::Cancelled)) if lost => now(queue)?,
+        Ok(Err(RequestError::Cancelled)) if ctl.job.cancelled.load(Ordering::Relaxed) => {
+            now(queue)?
         }
-        Ok(Err(RequestError::Cancelled)) => {
-            queue.store.status(job.id)?.unwrap_or(JobStatus::Cancelled)
+        Ok(Err(RequestError::Cancelled)) if queue.is_shut_down() => {
+            queue.store.release(lease)?;
+            now(queue)?
         }
-        Ok(Err(e)) => {
-            queue.store.finish_failed(job.id, &error_json(e.body()))?;
-            JobStatus::Failed
-        }
+        Ok(Err(RequestError::Cancelled)) if ctl.timed_out() => fail(ErrorBody::new(
+            "run_time_exceeded",
+            None,
+            format!(
+                "the job ran longer than the limit of {} s (TETHERPLAN_JOB_MAX_RUN_S) and was stopped",
+                limits.max_job_run_time.as_secs_f64()
+            ),
+        ))?,
+        Ok(Err(RequestError::Cancelled)) => now(queue)?,
+        Ok(Err(e)) => fail(e.body())?,
         Err(_) => {
             tracing::error!("job panicked");
-            queue.store.finish_failed(
-                job.id,
-                &error_json(ErrorBody::new("internal", None, "the job panicked")),
-            )?;
-            JobStatus::Failed
+            fail(ErrorBody::new("internal", None, "the job panicked"))?
         }
     };
     tracing::info!(
         status = status.as_str(),
+        lost,
         elapsed_ms = started.elapsed().as_millis() as u64,
         "job ended"
     );

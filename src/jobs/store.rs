@@ -1,37 +1,26 @@
-//! The SQLite job store (one file, WAL mode). A job row holds the submitted
-//! request, its status, progress, and the answer or error body as JSON text.
+//! The job store: what a job row holds and the operations a backend offers
+//! ([`JobBackend`]); SQLite ([`JobStore`], in `sqlite.rs`) is the embedded
+//! default, and another database (PostgreSQL: `FOR UPDATE SKIP LOCKED`)
+//! implements the same trait.
 //!
 //! Status moves `queued → running → done | failed`, or `→ cancelled` from
-//! `queued`/`running`. A `running` row whose process died (SIGKILL, power
-//! loss) goes back to `queued` when the store is next opened, so no accepted
-//! job is lost and every one runs to completion.
+//! `queued`/`running`. A worker claims a job under a lease ([`Lease`]:
+//! owner, expiry, epoch) and renews it while the job runs; every write of
+//! progress, result or failure is fenced by that lease. A `running` job
+//! whose lease expired (its process died) is claimed again by any worker;
+//! one that was claimed `max_attempts` times without finishing is failed
+//! instead (it probably kills the process that runs it).
+//!
+//! Jobs carry an owner (the hash of the API token that submitted them, or
+//! none without tokens) and optionally an idempotency key, unique per owner.
 
-use std::path::Path;
-use std::sync::Mutex;
 use std::time::Duration;
 
-use rusqlite::{Connection, OptionalExtension, params};
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-const SCHEMA: &str = "
-CREATE TABLE IF NOT EXISTS jobs (
-    id          INTEGER PRIMARY KEY AUTOINCREMENT,
-    kind        TEXT NOT NULL,
-    request     TEXT NOT NULL,
-    status      TEXT NOT NULL CHECK (status IN ('queued', 'running', 'done', 'failed', 'cancelled')),
-    progress    REAL NOT NULL DEFAULT 0,
-    attempts    INTEGER NOT NULL DEFAULT 0,
-    result      TEXT,
-    error       TEXT,
-    created_at  TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
-    started_at  TEXT,
-    finished_at TEXT
-);
-CREATE INDEX IF NOT EXISTS jobs_by_status ON jobs (status, id);
-";
-
-const NOW: &str = "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')";
+pub use super::lease::{Lease, WorkerId};
+pub use super::sqlite::JobStore;
 
 /// Where a job is in its life.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
@@ -60,7 +49,7 @@ impl JobStatus {
         }
     }
 
-    fn parse(s: &str) -> Self {
+    pub fn parse(s: &str) -> Self {
         match s {
             "queued" => Self::Queued,
             "running" => Self::Running,
@@ -75,18 +64,74 @@ impl JobStatus {
     }
 }
 
-/// A failure of the database itself (disk full, corrupt file).
+/// A failure of the database itself (disk full, corrupt file, lost connection).
 #[derive(Debug, thiserror::Error)]
 #[error("job store: {0}")]
-pub struct StoreError(#[from] rusqlite::Error);
+pub struct StoreError(pub String);
+
+impl From<rusqlite::Error> for StoreError {
+    fn from(e: rusqlite::Error) -> Self {
+        Self(e.to_string())
+    }
+}
 
 /// Why a job was not accepted.
 #[derive(Debug, thiserror::Error)]
 pub enum InsertError {
     #[error("the job queue is full ({pending} jobs queued or running, at most {limit})")]
     QueueFull { pending: usize, limit: usize },
+    #[error(
+        "this token has {pending} jobs queued or running, at most {limit}: wait for some to finish"
+    )]
+    QuotaFull { pending: usize, limit: usize },
+    #[error(
+        "Idempotency-Key `{key}` was first used for job {id} with a different body; \
+         use a new key for a different request"
+    )]
+    KeyReused { key: String, id: i64 },
     #[error(transparent)]
     Store(#[from] StoreError),
+}
+
+/// A submission to store.
+#[derive(Clone, Debug)]
+pub struct NewJob<'a> {
+    pub kind: &'a str,
+    /// The submitted body, JSON text.
+    pub request: &'a str,
+    /// Hash of the submitting token (None without tokens).
+    pub owner: Option<&'a str>,
+    /// The client's `Idempotency-Key`, unique per owner.
+    pub idempotency_key: Option<&'a str>,
+    /// Hash of the body, to tell a retry from a different request under one key.
+    pub request_hash: &'a str,
+    /// Jobs queued or running at once, all owners.
+    pub max_pending: usize,
+    /// Jobs queued or running at once, this owner (with an owner).
+    pub max_pending_per_owner: usize,
+}
+
+/// What an insert did.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Inserted {
+    /// A new queued job.
+    New(i64),
+    /// The job first stored under the same idempotency key and body.
+    Existing {
+        id: i64,
+        kind: String,
+        status: JobStatus,
+    },
+}
+
+/// The job first stored under an idempotency key.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct KeyedJob {
+    pub id: i64,
+    pub kind: String,
+    pub status: JobStatus,
+    /// Hash of the body it was stored with.
+    pub request_hash: String,
 }
 
 /// One job row.
@@ -104,6 +149,8 @@ pub struct JobRecord {
     pub result: Option<String>,
     /// The error body (JSON text) when failed or cancelled.
     pub error: Option<String>,
+    /// The worker holding (or that last held) the job's lease.
+    pub worker: Option<String>,
 }
 
 /// A job taken from the queue by a worker.
@@ -113,232 +160,81 @@ pub struct ClaimedJob {
     pub kind: String,
     /// The submitted body, JSON text.
     pub request: String,
+    /// Claims so far, this one included.
+    pub attempts: u32,
+    /// The claim; fenced writes carry it.
+    pub lease: Lease,
 }
 
-/// The job table behind one connection (SQLite serialises writers anyway).
-pub struct JobStore {
-    conn: Mutex<Connection>,
+/// How a worker claims.
+#[derive(Clone, Debug)]
+pub struct ClaimPolicy<'a> {
+    /// Lease length (renewed by the heartbeat).
+    pub lease: Duration,
+    /// A job whose lease expired after this many claims is failed, not claimed.
+    pub max_attempts: u32,
+    /// The error body (JSON text) such a job gets.
+    pub exhausted_error: &'a str,
 }
 
-impl JobStore {
-    /// Opens (or creates) the database at `path`, in WAL mode, and puts
-    /// jobs left `running` by a dead process back in the queue.
-    pub fn open(path: &Path) -> Result<Self, StoreError> {
-        let conn = Connection::open(path)?;
-        conn.busy_timeout(Duration::from_secs(5))?;
-        conn.pragma_update(None, "journal_mode", "WAL")?;
-        conn.pragma_update(None, "synchronous", "NORMAL")?;
-        Self::init(conn)
-    }
-
-    /// A private in-memory store (tests).
-    pub fn open_in_memory() -> Result<Self, StoreError> {
-        Self::init(Connection::open_in_memory()?)
-    }
-
-    fn init(conn: Connection) -> Result<Self, StoreError> {
-        conn.execute_batch(SCHEMA)?;
-        let store = Self {
-            conn: Mutex::new(conn),
-        };
-        let requeued = store.requeue_running()?;
-        if requeued > 0 {
-            tracing::info!(requeued, "interrupted jobs put back in the queue");
-        }
-        Ok(store)
-    }
-
-    fn conn(&self) -> std::sync::MutexGuard<'_, Connection> {
-        // A panic while holding the lock leaves the connection usable.
-        self.conn.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
-    /// The SQLite journal mode (`wal` for a file database).
-    pub fn journal_mode(&self) -> Result<String, StoreError> {
-        Ok(self
-            .conn()
-            .query_row("PRAGMA journal_mode", [], |r| r.get(0))?)
-    }
-
-    /// Every `running` job back to `queued` (at start-up and shutdown).
-    pub fn requeue_running(&self) -> Result<usize, StoreError> {
-        Ok(self.conn().execute(
-            "UPDATE jobs SET status = 'queued' WHERE status = 'running'",
-            [],
-        )?)
-    }
-
-    /// Stores a new queued job unless `limit` jobs are already pending.
-    pub fn insert(&self, kind: &str, request: &str, limit: usize) -> Result<i64, InsertError> {
-        let mut conn = self.conn();
-        let tx = conn.transaction().map_err(StoreError)?;
-        let pending: i64 = tx
-            .query_row(
-                "SELECT count(*) FROM jobs WHERE status IN ('queued', 'running')",
-                [],
-                |r| r.get(0),
-            )
-            .map_err(StoreError)?;
-        let pending = pending as usize;
-        if pending >= limit {
-            return Err(InsertError::QueueFull { pending, limit });
-        }
-        tx.execute(
-            "INSERT INTO jobs (kind, request, status) VALUES (?1, ?2, 'queued')",
-            params![kind, request],
-        )
-        .map_err(StoreError)?;
-        let id = tx.last_insert_rowid();
-        tx.commit().map_err(StoreError)?;
-        Ok(id)
-    }
-
-    /// Marks the oldest queued job `running` and returns it.
-    pub fn claim_next(&self) -> Result<Option<ClaimedJob>, StoreError> {
-        let conn = self.conn();
-        let sql = format!(
-            "UPDATE jobs SET status = 'running', progress = 0, attempts = attempts + 1, started_at = {NOW}
-             WHERE id = (SELECT id FROM jobs WHERE status = 'queued' ORDER BY id LIMIT 1)
-             RETURNING id, kind, request"
-        );
-        Ok(conn
-            .query_row(&sql, [], |r| {
-                Ok(ClaimedJob {
-                    id: r.get(0)?,
-                    kind: r.get(1)?,
-                    request: r.get(2)?,
-                })
-            })
-            .optional()?)
-    }
-
-    /// Records progress of a running job; `false` when it is no longer
-    /// running (cancelled meanwhile).
-    pub fn set_progress(&self, id: i64, progress: f64) -> Result<bool, StoreError> {
-        let n = self.conn().execute(
-            "UPDATE jobs SET progress = ?2 WHERE id = ?1 AND status = 'running'",
-            params![id, progress.clamp(0.0, 1.0)],
-        )?;
-        Ok(n == 1)
-    }
-
-    /// Whether the job is still `running` (not cancelled meanwhile).
-    pub fn is_running(&self, id: i64) -> Result<bool, StoreError> {
-        Ok(self.status(id)? == Some(JobStatus::Running))
-    }
-
-    pub fn status(&self, id: i64) -> Result<Option<JobStatus>, StoreError> {
-        let s: Option<String> = self
-            .conn()
-            .query_row("SELECT status FROM jobs WHERE id = ?1", [id], |r| r.get(0))
-            .optional()?;
-        Ok(s.map(|s| JobStatus::parse(&s)))
-    }
-
-    /// A running job finished with `result` (JSON text). No effect if it
-    /// was cancelled meanwhile.
-    pub fn finish_done(&self, id: i64, result: &str) -> Result<bool, StoreError> {
-        let sql = format!(
-            "UPDATE jobs SET status = 'done', progress = 1, result = ?2, error = NULL, finished_at = {NOW}
-             WHERE id = ?1 AND status = 'running'"
-        );
-        Ok(self.conn().execute(&sql, params![id, result])? == 1)
-    }
-
-    /// A running job failed with `error` (JSON error body).
-    pub fn finish_failed(&self, id: i64, error: &str) -> Result<bool, StoreError> {
-        let sql = format!(
-            "UPDATE jobs SET status = 'failed', result = NULL, error = ?2, finished_at = {NOW}
-             WHERE id = ?1 AND status = 'running'"
-        );
-        Ok(self.conn().execute(&sql, params![id, error])? == 1)
-    }
-
-    /// A running job interrupted by shutdown goes back to the queue.
-    pub fn requeue(&self, id: i64) -> Result<bool, StoreError> {
-        Ok(self.conn().execute(
-            "UPDATE jobs SET status = 'queued' WHERE id = ?1 AND status = 'running'",
-            [id],
-        )? == 1)
-    }
-
-    /// Cancels a queued or running job; returns the row afterwards (None:
-    /// unknown id). A finished job is left as it is.
-    pub fn cancel(&self, id: i64, error: &str) -> Result<Option<JobRecord>, StoreError> {
-        let sql = format!(
-            "UPDATE jobs SET status = 'cancelled', error = ?2, finished_at = {NOW}
-             WHERE id = ?1 AND status IN ('queued', 'running')"
-        );
-        self.conn().execute(&sql, params![id, error])?;
-        self.get(id)
-    }
-
-    const COLUMNS: &str =
-        "id, kind, status, progress, attempts, created_at, started_at, finished_at";
-
-    fn record(r: &rusqlite::Row<'_>, with_payload: bool) -> rusqlite::Result<JobRecord> {
-        let status: String = r.get(2)?;
-        Ok(JobRecord {
-            id: r.get(0)?,
-            kind: r.get(1)?,
-            status: JobStatus::parse(&status),
-            progress: r.get(3)?,
-            attempts: r.get(4)?,
-            created_at: r.get(5)?,
-            started_at: r.get(6)?,
-            finished_at: r.get(7)?,
-            result: if with_payload { r.get(8)? } else { None },
-            error: if with_payload { r.get(9)? } else { None },
-        })
-    }
-
-    /// One job with its answer or error.
-    pub fn get(&self, id: i64) -> Result<Option<JobRecord>, StoreError> {
-        let sql = format!(
-            "SELECT {}, result, error FROM jobs WHERE id = ?1",
-            Self::COLUMNS
-        );
-        Ok(self
-            .conn()
-            .query_row(&sql, [id], |r| Self::record(r, true))
-            .optional()?)
-    }
-
-    /// Jobs, newest first, without answers; optionally only one status.
-    pub fn list(
+/// A job store. Every method is one short transaction; `owner` scopes a
+/// request to one token's jobs (None: all jobs, as without tokens).
+pub trait JobBackend: Send + Sync {
+    /// The identity this store claims jobs under.
+    fn worker(&self) -> &WorkerId;
+    /// Stores a queued job, or returns the one stored under the same key.
+    fn insert(&self, job: &NewJob<'_>) -> Result<Inserted, InsertError>;
+    /// The job stored under `key` by `owner`, if any.
+    fn find_by_key(&self, owner: Option<&str>, key: &str) -> Result<Option<KeyedJob>, StoreError>;
+    /// Fails the expired jobs out of attempts, then claims the oldest
+    /// queued (or expired `running`) job under a new lease.
+    fn claim(&self, policy: &ClaimPolicy<'_>) -> Result<Option<ClaimedJob>, StoreError>;
+    /// Extends a lease; false when it was lost (taken over, cancelled).
+    fn renew(&self, lease: &Lease, duration: Duration) -> Result<bool, StoreError>;
+    /// Records progress (0 to 1); false when the lease was lost.
+    fn set_progress(&self, lease: &Lease, progress: f64) -> Result<bool, StoreError>;
+    /// The job is done with `result` (JSON text); false when the lease was lost.
+    fn finish_done(&self, lease: &Lease, result: &str) -> Result<bool, StoreError>;
+    /// The job failed with `error` (JSON error body); false when the lease was lost.
+    fn finish_failed(&self, lease: &Lease, error: &str) -> Result<bool, StoreError>;
+    /// Hands a running job back to the queue (shutdown); false when the lease was lost.
+    fn release(&self, lease: &Lease) -> Result<bool, StoreError>;
+    /// Hands back every job this store's worker holds; returns how many.
+    fn release_all(&self) -> Result<usize, StoreError>;
+    /// Expires at once the leases of dead processes on this host (start-up).
+    fn recover_local(&self) -> Result<usize, StoreError>;
+    /// Cancels a queued or running job; the row afterwards (None: unknown
+    /// or another owner's). A finished job is left as it is.
+    fn cancel(
         &self,
+        id: i64,
+        owner: Option<&str>,
+        error: &str,
+    ) -> Result<Option<JobRecord>, StoreError>;
+    /// One job with its answer or error (None: unknown or another owner's).
+    fn get_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobRecord>, StoreError>;
+    /// Jobs, newest first, without answers.
+    fn list_owned(
+        &self,
+        owner: Option<&str>,
         status: Option<JobStatus>,
         limit: usize,
-    ) -> Result<Vec<JobRecord>, StoreError> {
-        let conn = self.conn();
-        let sql = format!(
-            "SELECT {}, error FROM jobs WHERE (?1 IS NULL OR status = ?1) ORDER BY id DESC LIMIT ?2",
-            Self::COLUMNS
-        );
-        let mut stmt = conn.prepare(&sql)?;
-        let rows = stmt.query_map(params![status.map(JobStatus::as_str), limit as i64], |r| {
-            let mut rec = Self::record(r, false)?;
-            rec.error = r.get(8)?;
-            Ok(rec)
-        })?;
-        Ok(rows.collect::<Result<_, _>>()?)
-    }
+    ) -> Result<Vec<JobRecord>, StoreError>;
+    /// Status of a job (None: unknown or another owner's).
+    fn status_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobStatus>, StoreError>;
+    /// Jobs queued or running (all owners).
+    fn pending(&self) -> Result<usize, StoreError>;
 
-    /// The submitted request of a job (JSON text).
-    pub fn request(&self, id: i64) -> Result<Option<String>, StoreError> {
-        Ok(self
-            .conn()
-            .query_row("SELECT request FROM jobs WHERE id = ?1", [id], |r| r.get(0))
-            .optional()?)
+    /// One job, any owner.
+    fn get(&self, id: i64) -> Result<Option<JobRecord>, StoreError> {
+        self.get_owned(id, None)
     }
-
-    /// Number of jobs queued or running.
-    pub fn pending(&self) -> Result<usize, StoreError> {
-        let n: i64 = self.conn().query_row(
-            "SELECT count(*) FROM jobs WHERE status IN ('queued', 'running')",
-            [],
-            |r| r.get(0),
-        )?;
-        Ok(n as usize)
+    /// Jobs of every owner.
+    fn list(&self, status: Option<JobStatus>, limit: usize) -> Result<Vec<JobRecord>, StoreError> {
+        self.list_owned(None, status, limit)
+    }
+    /// Status of a job, any owner.
+    fn status(&self, id: i64) -> Result<Option<JobStatus>, StoreError> {
+        self.status_owned(id, None)
     }
 }

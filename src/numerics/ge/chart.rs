@@ -11,7 +11,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use super::critical::{
-    CriticalConfig, CriticalProblem, GeOnset, StartState, TipPerturbation, critical_time,
+    CriticalConfig, CriticalProblem, GeOnset, StartState, TipPerturbation,
+    critical_time_observed,
 };
 use super::extensible::ExtensibleString;
 use super::{GeModel, Section, TipBody};
@@ -390,6 +391,33 @@ pub fn chart_point(
     start: StartState,
     cancel: &(dyn Fn() -> bool + Sync),
 ) -> Result<GeChartPoint, InvalidInput> {
+    chart_point_observed(
+        model,
+        system,
+        rate_m_s,
+        net_buoyancy_n,
+        perturbation,
+        aero,
+        config,
+        cancel,
+        &|_| {},
+    )
+}
+
+/// [`chart_point`], reporting the fraction of its march (see
+/// [`critical_time_observed`]).
+#[allow(clippy::too_many_arguments)]
+pub fn chart_point_observed(
+    model: &GeModel,
+    system: &GeChartSystem,
+    rate_m_s: f64,
+    net_buoyancy_n: f64,
+    perturbation: Option<TipPerturbation>,
+    aero: Option<Aerodynamics>,
+    config: &CriticalConfig,
+    cancel: &(dyn Fn() -> bool + Sync),
+    march: &(dyn Fn(f64) + Sync),
+) -> Result<GeChartPoint, InvalidInput> {
     let profile = Profile::constant_rate(system.initial_length_m, rate_m_s, None)?;
     let windy = aero.is_some();
     let problem = CriticalProblem {
@@ -399,7 +427,7 @@ pub fn chart_point(
         aero,
         start,
     };
-    let r = critical_time(model, &problem, config, cancel)?;
+    let r = critical_time_observed(model, &problem, config, cancel, march)?;
     let string = |axial_stiffness_n: f64| {
         ExtensibleString {
             net_buoyancy_n,
@@ -425,9 +453,16 @@ pub fn chart_point(
     })
 }
 
-/// Computes the chart. `progress(done, total)` is called as points finish
-/// (from worker threads, in no particular order); `cancel()` is polled
-/// during each search.
+/// Units of progress per chart point: `progress(done, total)` counts
+/// thousandths of points, so that a chart of a few slow points (about a
+/// second each) shows progress within each point (its simulated time over
+/// its horizon), not only as points finish.
+pub const PROGRESS_UNITS_PER_POINT: usize = 1000;
+
+/// Computes the chart. `progress(done, total)` is called as the searches
+/// advance, in [`PROGRESS_UNITS_PER_POINT`]ths of a point (from worker
+/// threads, in no particular order; `done` never decreases); `cancel()` is
+/// polled during each search.
 pub fn deployment_chart(
     request: &GeChartRequest,
     parallelism: Parallelism,
@@ -453,7 +488,22 @@ pub fn deployment_chart(
     let rates = &request.rates_m_s;
     let total = request.point_count();
     let done = AtomicUsize::new(0);
+    let units = PROGRESS_UNITS_PER_POINT;
+    let total_units = total * units;
     let point = |index: usize| -> Result<GeChartPoint, InvalidInput> {
+        // Units of this point reported so far (only this closure's thread adds).
+        let mine = AtomicUsize::new(0);
+        let advance = |to: usize| {
+            let before = mine.load(Ordering::Relaxed);
+            if to > before {
+                mine.store(to, Ordering::Relaxed);
+                let now = done.fetch_add(to - before, Ordering::Relaxed) + (to - before);
+                progress(now, total_units);
+            }
+        };
+        let march = |fraction: f64| {
+            advance(((fraction.clamp(0.0, 1.0) * units as f64) as usize).min(units - 1));
+        };
         let (s, r) = (index / rates.len(), index % rates.len());
         let (m, _, f0, fb, a0) = series_keys[s];
         let aero = match (&request.wind, a0) {
@@ -465,7 +515,7 @@ pub fn deployment_chart(
             ramp_s: request.perturbation_ramp_s,
             hold_s: request.perturbation_hold_s,
         });
-        let p = chart_point(
+        let p = chart_point_observed(
             &models[m],
             &request.system,
             rates[r],
@@ -475,8 +525,9 @@ pub fn deployment_chart(
             &request.config,
             request.start,
             cancel,
+            &march,
         );
-        progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+        advance(units);
         p
     };
     let flat: Vec<GeChartPoint> = match parallelism {

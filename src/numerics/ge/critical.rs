@@ -388,6 +388,19 @@ pub fn critical_time(
     config: &CriticalConfig,
     cancel: &(dyn Fn() -> bool + Sync),
 ) -> Result<GeCriticalTime, InvalidInput> {
+    critical_time_observed(model, problem, config, cancel, &|_| {})
+}
+
+/// [`critical_time`], also calling `march(fraction)` with the fraction of
+/// the horizon marched so far (simulated time / horizon, 0 to 1) each time
+/// `cancel()` is polled.
+pub fn critical_time_observed(
+    model: &GeModel,
+    problem: &CriticalProblem,
+    config: &CriticalConfig,
+    cancel: &(dyn Fn() -> bool + Sync),
+    march: &(dyn Fn(f64) + Sync),
+) -> Result<GeCriticalTime, InvalidInput> {
     config.validate()?;
     require_positive("net_buoyancy_n", problem.net_buoyancy_n)?;
     if let Some(p) = problem.perturbation {
@@ -436,6 +449,9 @@ pub fn critical_time(
     let mut stable_sample = first;
     let mut step = 0;
     while step < total_steps {
+        if step % 256 == 0 {
+            march(step as f64 / total_steps as f64);
+        }
         if step % 16 == 0 && cancel() {
             out.onset = GeOnset::Cancelled {
                 time_s: integrator.state.time_s,

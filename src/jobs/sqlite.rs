@@ -1,0 +1,476 @@
+//! The SQLite job store (one file, WAL mode): [`JobStore`], the embedded
+//! default [`JobBackend`]. Several processes may share one file; SQLite
+//! serialises writers, claims run in `BEGIN IMMEDIATE` transactions, and
+//! leases (owner, expiry in ms since the Unix epoch, epoch) fence writes.
+//!
+//! Schema versions (`PRAGMA user_version`), applied at open:
+//! 1. the `jobs` table;
+//! 2. owner, idempotency key and body hash, lease owner/expiry/epoch.
+
+use std::path::Path;
+use std::sync::Mutex;
+use std::time::Duration;
+
+use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
+
+use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
+use super::store::{
+    ClaimPolicy, ClaimedJob, InsertError, Inserted, JobBackend, JobRecord, JobStatus, KeyedJob, NewJob,
+    StoreError,
+};
+
+const SCHEMA_V1: &str = "
+CREATE TABLE IF NOT EXISTS jobs (
+    id          INTEGER PRIMARY KEY AUTOINCREMENT,
+    kind        TEXT NOT NULL,
+    request     TEXT NOT NULL,
+    status      TEXT NOT NULL CHECK (status IN ('queued', 'running', 'done', 'failed', 'cancelled')),
+    progress    REAL NOT NULL DEFAULT 0,
+    attempts    INTEGER NOT NULL DEFAULT 0,
+    result      TEXT,
+    error       TEXT,
+    created_at  TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+    started_at  TEXT,
+    finished_at TEXT
+);
+CREATE INDEX IF NOT EXISTS jobs_by_status ON jobs (status, id);
+";
+
+const SCHEMA_V2: &str = "
+ALTER TABLE jobs ADD COLUMN owner TEXT;
+ALTER TABLE jobs ADD COLUMN idempotency_key TEXT;
+ALTER TABLE jobs ADD COLUMN request_hash TEXT;
+ALTER TABLE jobs ADD COLUMN lease_owner TEXT;
+ALTER TABLE jobs ADD COLUMN lease_expires_ms INTEGER;
+ALTER TABLE jobs ADD COLUMN lease_epoch INTEGER NOT NULL DEFAULT 0;
+CREATE UNIQUE INDEX jobs_by_idempotency_key ON jobs (ifnull(owner, ''), idempotency_key)
+    WHERE idempotency_key IS NOT NULL;
+CREATE INDEX jobs_by_owner ON jobs (owner, status);
+";
+
+/// The current schema version.
+pub const SCHEMA_VERSION: i64 = 2;
+
+const NOW: &str = "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')";
+
+/// The fence of a write: the row is still running under this lease.
+const FENCE: &str = "id = ?1 AND status = 'running' AND lease_owner = ?2 AND lease_epoch = ?3";
+
+/// The job table behind one connection, claiming as one worker.
+pub struct JobStore {
+    conn: Mutex<Connection>,
+    worker: WorkerId,
+}
+
+impl JobStore {
+    /// Opens (or creates) the database at `path`, in WAL mode, migrates it,
+    /// and takes over the jobs of dead processes on this host.
+    pub fn open(path: &Path) -> Result<Self, StoreError> {
+        let conn = Connection::open(path)?;
+        conn.busy_timeout(Duration::from_secs(10))?;
+        conn.pragma_update(None, "journal_mode", "WAL")?;
+        conn.pragma_update(None, "synchronous", "NORMAL")?;
+        Self::init(conn)
+    }
+
+    /// A private in-memory store (tests).
+    pub fn open_in_memory() -> Result<Self, StoreError> {
+        Self::init(Connection::open_in_memory()?)
+    }
+
+    fn init(mut conn: Connection) -> Result<Self, StoreError> {
+        migrate(&mut conn)?;
+        let store = Self {
+            conn: Mutex::new(conn),
+            worker: WorkerId::this_process(),
+        };
+        let recovered = store.recover_local()?;
+        if recovered > 0 {
+            tracing::info!(
+                recovered,
+                "jobs of a dead process on this host taken over at start-up"
+            );
+        }
+        Ok(store)
+    }
+
+    fn conn(&self) -> std::sync::MutexGuard<'_, Connection> {
+        // A panic while holding the lock leaves the connection usable.
+        self.conn.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The SQLite journal mode (`wal` for a file database).
+    pub fn journal_mode(&self) -> Result<String, StoreError> {
+        Ok(self
+            .conn()
+            .query_row("PRAGMA journal_mode", [], |r| r.get(0))?)
+    }
+
+    /// Stores a queued job without owner or key (tests, tools).
+    pub fn insert_simple(
+        &self,
+        kind: &str,
+        request: &str,
+        limit: usize,
+    ) -> Result<i64, InsertError> {
+        let job = NewJob {
+            kind,
+            request,
+            owner: None,
+            idempotency_key: None,
+            request_hash: "",
+            max_pending: limit,
+            max_pending_per_owner: limit,
+        };
+        match self.insert(&job)? {
+            Inserted::New(id) | Inserted::Existing { id, .. } => Ok(id),
+        }
+    }
+
+    /// Claims the next job with a 30 s lease and no attempt cap (tests, tools).
+    pub fn claim_next(&self) -> Result<Option<ClaimedJob>, StoreError> {
+        self.claim(&ClaimPolicy {
+            lease: Duration::from_secs(30),
+            max_attempts: u32::MAX,
+            exhausted_error: "{}",
+        })
+    }
+
+    const COLUMNS: &str =
+        "id, kind, status, progress, attempts, created_at, started_at, finished_at, lease_owner";
+
+    fn record(r: &rusqlite::Row<'_>) -> rusqlite::Result<JobRecord> {
+        let status: String = r.get(2)?;
+        Ok(JobRecord {
+            id: r.get(0)?,
+            kind: r.get(1)?,
+            status: JobStatus::parse(&status),
+            progress: r.get(3)?,
+            attempts: r.get(4)?,
+            created_at: r.get(5)?,
+            started_at: r.get(6)?,
+            finished_at: r.get(7)?,
+            worker: r.get(8)?,
+            result: None,
+            error: None,
+        })
+    }
+
+    fn fenced(&self, sql_set: &str, lease: &Lease, extra: Option<&dyn rusqlite::ToSql>) -> Result<bool, StoreError> {
+        let sql = format!("UPDATE jobs SET {sql_set} WHERE {FENCE}");
+        let n = match extra {
+            Some(x) => self
+                .conn()
+                .execute(&sql, params![lease.job_id, lease.owner, lease.epoch, x])?,
+            None => self
+                .conn()
+                .execute(&sql, params![lease.job_id, lease.owner, lease.epoch])?,
+        };
+        Ok(n == 1)
+    }
+}
+
+fn migrate(conn: &mut Connection) -> Result<(), StoreError> {
+    let version: i64 = conn.query_row("PRAGMA user_version", [], |r| r.get(0))?;
+    if version >= SCHEMA_VERSION {
+        return Ok(());
+    }
+    let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
+    // Re-read under the write lock: another process may have migrated meanwhile.
+    let version: i64 = tx.query_row("PRAGMA user_version", [], |r| r.get(0))?;
+    if version < 1 {
+        tx.execute_batch(SCHEMA_V1)?;
+    }
+    if version < 2 {
+        tx.execute_batch(SCHEMA_V2)?;
+    }
+    tx.pragma_update(None, "user_version", SCHEMA_VERSION)?;
+    tx.commit()?;
+    Ok(())
+}
+
+fn find_by_key(
+    conn: &Connection,
+    owner: Option<&str>,
+    key: &str,
+) -> Result<Option<KeyedJob>, StoreError> {
+    Ok(conn
+        .query_row(
+            "SELECT id, kind, status, request_hash FROM jobs
+             WHERE ifnull(owner, '') = ifnull(?1, '') AND idempotency_key = ?2",
+            params![owner, key],
+            |r| {
+                let status: String = r.get(2)?;
+                Ok(KeyedJob {
+                    id: r.get(0)?,
+                    kind: r.get(1)?,
+                    status: JobStatus::parse(&status),
+                    request_hash: r.get::<_, Option<String>>(3)?.unwrap_or_default(),
+                })
+            },
+        )
+        .optional()?)
+}
+
+impl JobBackend for JobStore {
+    fn worker(&self) -> &WorkerId {
+        &self.worker
+    }
+
+    fn find_by_key(&self, owner: Option<&str>, key: &str) -> Result<Option<KeyedJob>, StoreError> {
+        find_by_key(&self.conn(), owner, key)
+    }
+
+    fn insert(&self, job: &NewJob<'_>) -> Result<Inserted, InsertError> {
+        let mut conn = self.conn();
+        let tx = conn
+            .transaction_with_behavior(TransactionBehavior::Immediate)
+            .map_err(StoreError::from)?;
+        if let Some(key) = job.idempotency_key
+            && let Some(first) = find_by_key(&tx, job.owner, key)?
+        {
+            if first.request_hash != job.request_hash {
+                return Err(InsertError::KeyReused {
+                    key: key.to_string(),
+                    id: first.id,
+                });
+            }
+            return Ok(Inserted::Existing {
+                id: first.id,
+                kind: first.kind,
+                status: first.status,
+            });
+        }
+        let count = |sql: &str, p: &[&dyn rusqlite::ToSql]| -> Result<usize, StoreError> {
+            let n: i64 = tx.query_row(sql, p, |r| r.get(0))?;
+            Ok(n as usize)
+        };
+        let pending = count(
+            "SELECT count(*) FROM jobs WHERE status IN ('queued', 'running')",
+            &[],
+        )?;
+        if pending >= job.max_pending {
+            return Err(InsertError::QueueFull {
+                pending,
+                limit: job.max_pending,
+            });
+        }
+        if let Some(owner) = job.owner {
+            let mine = count(
+                "SELECT count(*) FROM jobs WHERE owner = ?1 AND status IN ('queued', 'running')",
+                &[&owner],
+            )?;
+            if mine >= job.max_pending_per_owner {
+                return Err(InsertError::QuotaFull {
+                    pending: mine,
+                    limit: job.max_pending_per_owner,
+                });
+            }
+        }
+        tx.execute(
+            "INSERT INTO jobs (kind, request, status, owner, idempotency_key, request_hash)
+             VALUES (?1, ?2, 'queued', ?3, ?4, ?5)",
+            params![
+                job.kind,
+                job.request,
+                job.owner,
+                job.idempotency_key,
+                job.request_hash
+            ],
+        )
+        .map_err(StoreError::from)?;
+        let id = tx.last_insert_rowid();
+        tx.commit().map_err(StoreError::from)?;
+        Ok(Inserted::New(id))
+    }
+
+    fn claim(&self, policy: &ClaimPolicy<'_>) -> Result<Option<ClaimedJob>, StoreError> {
+        let mut conn = self.conn();
+        let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
+        let now = now_ms();
+        let exhausted = tx.execute(
+            &format!(
+                "UPDATE jobs SET status = 'failed', result = NULL, error = ?1, finished_at = {NOW},
+                    lease_expires_ms = NULL
+                 WHERE status = 'running' AND ifnull(lease_expires_ms, 0) < ?2 AND attempts >= ?3"
+            ),
+            params![policy.exhausted_error, now, policy.max_attempts],
+        )?;
+        if exhausted > 0 {
+            tracing::warn!(
+                jobs = exhausted,
+                attempts = policy.max_attempts,
+                "jobs whose process died at every attempt were failed"
+            );
+        }
+        let expires = now.saturating_add(policy.lease.as_millis().min(i64::MAX as u128) as i64);
+        let claimed = tx
+            .query_row(
+                &format!(
+                    "UPDATE jobs SET status = 'running', progress = 0, attempts = attempts + 1,
+                        started_at = {NOW}, lease_owner = ?1, lease_expires_ms = ?2,
+                        lease_epoch = lease_epoch + 1
+                     WHERE id = (SELECT id FROM jobs
+                                 WHERE status = 'queued'
+                                    OR (status = 'running' AND ifnull(lease_expires_ms, 0) < ?3)
+                                 ORDER BY id LIMIT 1)
+                     RETURNING id, kind, request, attempts, lease_epoch"
+                ),
+                params![self.worker.as_str(), expires, now],
+                |r| {
+                    Ok(ClaimedJob {
+                        id: r.get(0)?,
+                        kind: r.get(1)?,
+                        request: r.get(2)?,
+                        attempts: r.get(3)?,
+                        lease: Lease {
+                            job_id: r.get(0)?,
+                            owner: self.worker.as_str().to_string(),
+                            epoch: r.get(4)?,
+                        },
+                    })
+                },
+            )
+            .optional()?;
+        tx.commit()?;
+        Ok(claimed)
+    }
+
+    fn renew(&self, lease: &Lease, duration: Duration) -> Result<bool, StoreError> {
+        self.fenced("lease_expires_ms = ?4", lease, Some(&expiry_ms(duration)))
+    }
+
+    fn set_progress(&self, lease: &Lease, progress: f64) -> Result<bool, StoreError> {
+        self.fenced("progress = ?4", lease, Some(&progress.clamp(0.0, 1.0)))
+    }
+
+    fn finish_done(&self, lease: &Lease, result: &str) -> Result<bool, StoreError> {
+        self.fenced(
+            &format!(
+                "status = 'done', progress = 1, result = ?4, error = NULL, finished_at = {NOW},
+                 lease_expires_ms = NULL"
+            ),
+            lease,
+            Some(&result),
+        )
+    }
+
+    fn finish_failed(&self, lease: &Lease, error: &str) -> Result<bool, StoreError> {
+        self.fenced(
+            &format!(
+                "status = 'failed', result = NULL, error = ?4, finished_at = {NOW},
+                 lease_expires_ms = NULL"
+            ),
+            lease,
+            Some(&error),
+        )
+    }
+
+    fn release(&self, lease: &Lease) -> Result<bool, StoreError> {
+        self.fenced("status = 'queued', lease_expires_ms = NULL", lease, None)
+    }
+
+    fn release_all(&self) -> Result<usize, StoreError> {
+        Ok(self.conn().execute(
+            "UPDATE jobs SET status = 'queued', lease_expires_ms = NULL
+             WHERE status = 'running' AND lease_owner = ?1",
+            [self.worker.as_str()],
+        )?)
+    }
+
+    fn recover_local(&self) -> Result<usize, StoreError> {
+        let conn = self.conn();
+        let owners: Vec<String> = {
+            let mut stmt = conn.prepare(
+                "SELECT DISTINCT lease_owner FROM jobs
+                 WHERE status = 'running' AND lease_owner IS NOT NULL",
+            )?;
+            stmt.query_map([], |r| r.get(0))?
+                .collect::<Result<_, _>>()?
+        };
+        let mut n = 0;
+        for owner in owners.iter().filter(|o| self.worker.is_dead_local(o)) {
+            n += conn.execute(
+                "UPDATE jobs SET lease_expires_ms = 0 WHERE status = 'running' AND lease_owner = ?1",
+                [owner],
+            )?;
+        }
+        Ok(n)
+    }
+
+    fn cancel(
+        &self,
+        id: i64,
+        owner: Option<&str>,
+        error: &str,
+    ) -> Result<Option<JobRecord>, StoreError> {
+        let sql = format!(
+            "UPDATE jobs SET status = 'cancelled', error = ?2, finished_at = {NOW}, lease_expires_ms = NULL
+             WHERE id = ?1 AND status IN ('queued', 'running') AND (?3 IS NULL OR owner = ?3)"
+        );
+        self.conn().execute(&sql, params![id, error, owner])?;
+        self.get_owned(id, owner)
+    }
+
+    fn get_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobRecord>, StoreError> {
+        let sql = format!(
+            "SELECT {}, result, error FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
+            Self::COLUMNS
+        );
+        Ok(self
+            .conn()
+            .query_row(&sql, params![id, owner], |r| {
+                let mut rec = Self::record(r)?;
+                rec.result = r.get(9)?;
+                rec.error = r.get(10)?;
+                Ok(rec)
+            })
+            .optional()?)
+    }
+
+    fn list_owned(
+        &self,
+        owner: Option<&str>,
+        status: Option<JobStatus>,
+        limit: usize,
+    ) -> Result<Vec<JobRecord>, StoreError> {
+        let conn = self.conn();
+        let sql = format!(
+            "SELECT {}, error FROM jobs
+             WHERE (?1 IS NULL OR status = ?1) AND (?3 IS NULL OR owner = ?3)
+             ORDER BY id DESC LIMIT ?2",
+            Self::COLUMNS
+        );
+        let mut stmt = conn.prepare(&sql)?;
+        let rows = stmt.query_map(
+            params![status.map(JobStatus::as_str), limit as i64, owner],
+            |r| {
+                let mut rec = Self::record(r)?;
+                rec.error = r.get(9)?;
+                Ok(rec)
+            },
+        )?;
+        Ok(rows.collect::<Result<_, _>>()?)
+    }
+
+    fn status_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobStatus>, StoreError> {
+        let s: Option<String> = self
+            .conn()
+            .query_row(
+                "SELECT status FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
+                params![id, owner],
+                |r| r.get(0),
+            )
+            .optional()?;
+        Ok(s.map(|s| JobStatus::parse(&s)))
+    }
+
+    fn pending(&self) -> Result<usize, StoreError> {
+        let n: i64 = self.conn().query_row(
+            "SELECT count(*) FROM jobs WHERE status IN ('queued', 'running')",
+            [],
+            |r| r.get(0),
+        )?;
+        Ok(n as usize)
+    }
+}
