@@ -13,6 +13,7 @@ pub mod error;
 pub mod jobs;
 pub mod openapi;
 pub mod solve;
+pub mod tether;
 
 use std::path::Path;
 use std::sync::Arc;
@@ -107,6 +108,8 @@ pub fn router(state: AppState, static_dir: &Path) -> Router {
             "/api/v1/frequency-response",
             post(solve::compute_frequency_response),
         )
+        .route("/api/v1/equilibrium", post(tether::compute_equilibrium))
+        .route("/api/v1/envelope", post(tether::compute_envelope))
         .route("/api/v1/jobs", post(jobs::create_job).get(jobs::list_jobs))
         .route(
             "/api/v1/jobs/{id}",

@@ -12,6 +12,7 @@
 
 pub mod kinds;
 pub mod store;
+pub mod tether;
 
 use std::collections::HashMap;
 use std::panic::{AssertUnwindSafe, catch_unwind};
