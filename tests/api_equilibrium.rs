@@ -12,7 +12,7 @@ use serde_json::{Value, json};
 use tetherplan::api::{self, AppState};
 use tetherplan::config::Limits;
 use tetherplan::contract::envelope::dto::EnvelopeRequest;
-use tetherplan::contract::equilibrium::dto::EquilibriumRequest;
+use tetherplan::contract::equilibrium::dto::{EquilibriumRequest, WindFlowInput};
 use tetherplan::contract::run::NoProgress;
 use tetherplan::contract::{self, envelope, equilibrium};
 use tetherplan::jobs::store::{JobStatus, JobStore};
@@ -174,8 +174,23 @@ fn envelope_points_equal_single_point_answers() {
                 "wind": {"flow": flow, "air_density_kg_m3": 1.225},
                 "required_safety_factor_nondim": 5.0, "payout_rate_m_s": 5.0,
             });
-            let one = equilibrium::equilibrium(&parse_equilibrium(&single)).unwrap();
-            assert_eq!(p.aerostat_altitude_m, one.aerostat_altitude_m);
+            // JSON parsing may round a float by an ulp (serde_json without
+            // float_roundtrip): set the numbers directly.
+            let mut single = parse_equilibrium(&single);
+            single.tether_length_m = p.tether_length_m;
+            single.wind.flow = match single.wind.flow {
+                WindFlowInput::Uniform { .. } => WindFlowInput::Uniform { speed_m_s: u },
+                WindFlowInput::PowerLaw { exponent_nondim, .. } => WindFlowInput::PowerLaw {
+                    coefficient_m_s: u / 10f64.powf(0.14),
+                    exponent_nondim,
+                },
+                WindFlowInput::LogLaw { reference_height_m, roughness_length_m, .. } => {
+                    WindFlowInput::LogLaw { reference_speed_m_s: u, reference_height_m, roughness_length_m }
+                }
+                other => other,
+            };
+            let one = equilibrium::equilibrium(&single).unwrap();
+            assert_eq!(p.aerostat_altitude_m, one.aerostat_altitude_m, "{shape} {u} {}", p.tether_length_m);
             assert_eq!(p.aerostat_downwind_m, one.aerostat_downwind_m);
             assert_eq!(p.winch_tension_n, one.winch_tension_n);
             assert_eq!(p.top_tension_n, one.top_tension_n);
@@ -227,4 +242,122 @@ async fn envelope_runs_as_a_job_with_progress() {
     assert_eq!(job["status"], serde_json::to_value(JobStatus::Done).unwrap(), "{job}");
     assert_eq!(job["result"]["points"].as_array().unwrap().len(), 40 * 200);
     assert_eq!(job["progress"], 1.0);
+}
+
+/// Every path of a JSON value (object keys, array indices).
+fn paths(v: &Value, prefix: Vec<String>, out: &mut Vec<Vec<String>>) {
+    match v {
+        Value::Object(m) => {
+            for (k, x) in m {
+                let mut p = prefix.clone();
+                p.push(k.clone());
+                out.push(p.clone());
+                paths(x, p, out);
+            }
+        }
+        Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                let mut p = prefix.clone();
+                p.push(i.to_string());
+                out.push(p.clone());
+                paths(x, p, out);
+            }
+        }
+        _ => {}
+    }
+}
+
+fn replaced(v: &Value, path: &[String], new: Value) -> Value {
+    let mut out = v.clone();
+    let mut cur = &mut out;
+    for key in path {
+        cur = match cur {
+            Value::Object(m) => m.get_mut(key).unwrap(),
+            Value::Array(a) => &mut a[key.parse::<usize>().unwrap()],
+            _ => unreachable!(),
+        };
+    }
+    *cur = new;
+    out
+}
+
+#[tokio::test]
+async fn any_one_field_replaced_never_gives_a_5xx() {
+    let (app, _) = app();
+    let mut env = example::<EnvelopeRequest>();
+    env["wind_speeds_m_s"]["count"] = json!(3);
+    env["tether_lengths_m"]["count"] = json!(3);
+    let mut tabulated = example::<EquilibriumRequest>();
+    tabulated["wind"]["flow"] = json!({"kind": "tabulated", "points": [
+        {"elevation_m": 0.0, "speed_m_s": 3.0}, {"elevation_m": 500.0, "speed_m_s": 12.0}]});
+    let bad = [
+        json!(null),
+        json!(-1.0),
+        json!(0.0),
+        json!(1e-300),
+        json!(1e300),
+        json!(-1e300),
+        json!("x"),
+        json!([]),
+        json!({}),
+        json!(true),
+    ];
+    for (route, body) in [
+        ("/api/v1/equilibrium", example::<EquilibriumRequest>()),
+        ("/api/v1/equilibrium", tabulated),
+        ("/api/v1/envelope", env),
+    ] {
+        let mut all = vec![];
+        paths(&body, vec![], &mut all);
+        for path in &all {
+            for new in &bad {
+                let b = replaced(&body, path, new.clone());
+                let (status, answer) = send(&app, "POST", route, Some(&b)).await;
+                assert!(status.as_u16() < 500, "{route} {path:?} = {new} → {status} {answer}");
+                if status.is_success() {
+                    let text = answer.to_string();
+                    assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
+                } else {
+                    assert!(answer["error"]["message"].is_string(), "{answer}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn cli_answers_equilibrium_and_envelope() {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let run = |cmd: &str, body: &Value| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_tetherplan"))
+            .arg(cmd)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(body.to_string().as_bytes())
+            .unwrap();
+        let out = child.wait_with_output().unwrap();
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        (out.status.code().unwrap(), v)
+    };
+    let req = example::<EquilibriumRequest>();
+    let (code, v) = run("equilibrium", &req);
+    assert_eq!(code, 0, "{v}");
+    let direct = equilibrium::equilibrium(&parse_equilibrium(&req)).unwrap();
+    assert_eq!(v["aerostat_altitude_m"].as_f64().unwrap(), direct.aerostat_altitude_m);
+    let mut env = example::<EnvelopeRequest>();
+    env["wind_speeds_m_s"]["count"] = json!(4);
+    let (code, v) = run("envelope", &env);
+    assert_eq!(code, 0, "{v}");
+    assert_eq!(v["points"].as_array().unwrap().len(), 200);
+    let (code, v) = run("equilibrium", &json!({"cable": {}}));
+    assert_eq!(code, 2);
+    assert!(v["error"]["field"].is_string());
 }

@@ -110,6 +110,11 @@ fn aerostat_drag_only_is_the_catenary_to_1e_6() {
         assert!(v > w * l, "the case must stay airborne");
         let (x, z) = catenary_top(h, v, w, l);
         let tol = 1e-6;
+        eprintln!(
+            "catenary U = {u}: rel. err altitude {:.1e}, downwind {:.1e}",
+            ((e.altitude_m - z) / z).abs(),
+            ((e.downwind_m - x) / x).abs()
+        );
         assert!(((e.altitude_m - z) / z).abs() < tol, "{u}: z {} vs {z}", e.altitude_m);
         assert!(((e.downwind_m - x) / x).abs() < tol, "{u}: x {} vs {x}", e.downwind_m);
         let top = h.hypot(v);
@@ -159,6 +164,7 @@ fn tether_drag_converges_at_fourth_order_in_the_step() {
         let oz = observed_order(&p, n, |e| e.altitude_m);
         let ox = observed_order(&p, n, |e| e.downwind_m);
         let ot = observed_order(&p, n, |e| e.winch_tension_n);
+        eprintln!("observed order at N = {n}: altitude {oz:.3}, downwind {ox:.3}, winch tension {ot:.3}");
         for (what, o) in [("altitude", oz), ("downwind", ox), ("winch tension", ot)] {
             assert!((3.6..=4.4).contains(&o), "{what} order {o} at N = {n}");
         }
@@ -210,6 +216,12 @@ fn tether_drag_agrees_with_an_independent_polar_integrator() {
         let p = problem(u, 1.2, None);
         let e = p.solve(&config(200)).unwrap();
         let (z, x, t0) = polar_reference(&p, u, 200_000);
+        eprintln!(
+            "polar check U = {u}: rel. diff altitude {:.1e}, downwind {:.1e}, winch tension {:.1e}",
+            ((e.altitude_m - z) / z).abs(),
+            ((e.downwind_m - x) / x).abs(),
+            ((e.winch_tension_n - t0) / t0).abs()
+        );
         assert!(((e.altitude_m - z) / z).abs() < 1e-7, "{u}: {} vs {z}", e.altitude_m);
         assert!(((e.downwind_m - x) / x).abs() < 1e-7, "{u}: {} vs {x}", e.downwind_m);
         assert!(((e.winch_tension_n - t0) / t0).abs() < 1e-7);
@@ -228,6 +240,7 @@ fn small_wind_matches_the_linear_string_blowdown() {
         let want = fd / w * (f / (f - w * l)).ln();
         // the difference is O((F_D/F)²) relative
         let rel = ((e.downwind_m - want) / want).abs();
+        eprintln!("small wind U = {u}: F_D = {fd:.4} N, rel. diff from the string's blow-down {rel:.1e}");
         assert!(rel < 10.0 * (fd / (f - w * l)).powi(2) + 1e-9, "{u}: {} vs {want} ({rel:e})", e.downwind_m);
         assert!(rel < 1e-4);
     }
