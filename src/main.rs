@@ -56,6 +56,10 @@ enum Command {
     /// Response against forcing frequency: wind on the linear string, or
     /// `"excitation": "base"` (shaken platform, GE cable).
     FrequencyResponse(InputArg),
+    /// Static tether in a steady wind: altitude, blow-down, tensions, shape.
+    Equilibrium(InputArg),
+    /// Operating envelope over wind speed × tether length.
+    Envelope(InputArg),
 }
 
 /// A progress bar on standard error for `total` units of `what`.
@@ -215,6 +219,22 @@ fn main() -> ExitCode {
             bar.0.finish_and_clear();
             out
         }),
+        Command::Equilibrium(arg) => answer_with(
+            arg,
+            contract::parse_plain::<contract::equilibrium::dto::EquilibriumRequest>,
+            contract::equilibrium::equilibrium,
+        ),
+        Command::Envelope(arg) => answer_with(
+            arg,
+            contract::parse_plain::<contract::envelope::dto::EnvelopeRequest>,
+            |req| {
+                req.validate()?;
+                let bar = progress_bar(req.wind_speeds_m_s.count as u64, "wind speeds");
+                let out = contract::envelope::envelope(req, Parallelism::Rayon, &bar);
+                bar.0.finish_and_clear();
+                out
+            },
+        ),
         Command::FrequencyResponse(arg) => {
             answer_with(arg, ge_charts::parse_frequency_response, |req| {
                 let runs = match req {

@@ -61,6 +61,18 @@ fn every_route_is_documented_with_its_statuses() {
         ),
         (
             "post",
+            "/api/v1/equilibrium",
+            "compute_equilibrium",
+            &["200", "400", "413", "415", "422", "500", "503", "504"],
+        ),
+        (
+            "post",
+            "/api/v1/envelope",
+            "compute_envelope",
+            &["200", "400", "413", "415", "422", "500", "503", "504"],
+        ),
+        (
+            "post",
             "/api/v1/jobs",
             "create_job",
             &["200", "202", "400", "401", "413", "415", "422", "429", "500"],
@@ -125,7 +137,7 @@ fn every_route_is_documented_with_its_statuses() {
 fn numeric_fields_name_their_unit() {
     const UNITS: &[&str] = &[
         "_m", "_s", "_m_s", "_m_s2", "_n", "_kg", "_kg_m", "_kg_m3", "_m2", "_1_s", "_hz",
-        "_nondim", "_db",
+        "_nondim", "_db", "_deg", "_m3",
     ];
     // Counts, ids and fractions; RateGrid's bounds are described in m/s by its parent `rates_m_s`.
     const UNITLESS: &[&str] = &[

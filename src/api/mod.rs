@@ -19,6 +19,7 @@ pub mod openapi;
 pub mod server;
 pub mod solve;
 pub mod spec;
+pub mod tether;
 
 use std::path::Path;
 use std::sync::Arc;
@@ -131,6 +132,8 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
             "/api/v1/frequency-response",
             post(solve::compute_frequency_response),
         )
+        .route("/api/v1/equilibrium", post(tether::compute_equilibrium))
+        .route("/api/v1/envelope", post(tether::compute_envelope))
         .route("/api/v1/jobs", post(jobs::create_job).get(jobs::list_jobs))
         .route(
             "/api/v1/jobs/{id}",

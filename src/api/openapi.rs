@@ -33,6 +33,8 @@ use crate::jobs::store::JobStatus;
         solve::create_chart,
         solve::run_simulation,
         solve::compute_frequency_response,
+        crate::api::tether::compute_equilibrium,
+        crate::api::tether::compute_envelope,
         jobs::create_job,
         jobs::list_jobs,
         jobs::get_job,

@@ -4,6 +4,8 @@
 //! ([`run`]). Everything here is synchronous and CPU-bound.
 
 pub mod dto;
+pub mod envelope;
+pub mod equilibrium;
 pub mod ge;
 pub mod ge_charts;
 pub mod ranges;

@@ -514,6 +514,10 @@ job_kinds!(
     Simulate(AnySimulateRequest),
     /// `POST /api/v1/frequency-response`.
     FrequencyResponse(AnyFrequencyResponseRequest),
+    /// `POST /api/v1/equilibrium`.
+    Equilibrium(crate::contract::equilibrium::dto::EquilibriumRequest),
+    /// `POST /api/v1/envelope`, up to 250 000 points (with progress).
+    Envelope(crate::contract::envelope::dto::EnvelopeRequest),
 );
 
 impl JobItem {
@@ -774,6 +778,9 @@ mod tests {
     use serde_json::json;
 
     fn valid(kind: &str) -> Value {
+        if let Some(v) = crate::jobs::tether::example_request(kind) {
+            return v;
+        }
         let mut v = json!({"cable": {"mass_per_length_kg_m": 0.078}, "aerostat": {"net_buoyancy_n": 1000.0}});
         let extra = match kind {
             "stability" => json!({"state": {"length_m": 10.0}}),

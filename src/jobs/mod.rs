@@ -19,6 +19,7 @@ pub mod kinds;
 pub mod lease;
 pub mod sqlite;
 pub mod store;
+pub mod tether;
 
 use std::collections::HashMap;
 use std::panic::{AssertUnwindSafe, catch_unwind};

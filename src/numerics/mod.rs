@@ -13,4 +13,5 @@ pub mod profile;
 pub mod qep;
 pub mod reduced;
 pub mod string;
+pub mod tether;
 pub mod tridiag;

@@ -1,0 +1,75 @@
+//! Speed of the static tether in wind (issue 12 targets in brackets): one
+//! equilibrium with tether drag in a uniform and a log-law wind, 200 RK4
+//! steps [≤ 100 µs]; an envelope of 40 winds × 50 lengths without stability,
+//! power-law wind, on rayon [≤ 0.5 s on 2 cores].
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::tether::envelope::{EnvelopeProblem, Limits, WindShape};
+use tetherplan::numerics::tether::presets::CablePreset;
+use tetherplan::numerics::tether::{
+    Body, Cable, EquilibriumConfig, EquilibriumProblem, WindProfile,
+};
+
+fn problem(wind: WindProfile) -> EquilibriumProblem {
+    let p = CablePreset::Dyneema.at_diameter(0.006);
+    EquilibriumProblem {
+        cable: Cable {
+            mass_per_length_kg_m: p.mass_per_length_kg_m,
+            diameter_m: 0.006,
+            normal_drag_coefficient: p.normal_drag_coefficient,
+            axial_stiffness_n: Some(p.axial_stiffness_n),
+            breaking_strength_n: Some(p.breaking_strength_n),
+        },
+        body: Body {
+            net_buoyancy_n: 2000.0,
+            drag_coefficient: 0.3,
+            lift_coefficient: 0.0,
+            reference_area_m2: 20.0,
+        },
+        wind,
+        air_density_kg_m3: 1.225,
+        tether_length_m: 1500.0,
+        gravity_m_s2: 9.81,
+    }
+}
+
+fn benches(c: &mut Criterion) {
+    let config = EquilibriumConfig::default();
+    let uniform = problem(WindProfile::uniform(12.0));
+    c.bench_function("equilibrium_tether_drag_uniform_200_steps", |b| {
+        b.iter(|| black_box(&uniform).solve(&config).unwrap())
+    });
+    let log = problem(WindProfile::log_law(12.0, 10.0, 0.03, "wind").unwrap());
+    c.bench_function("equilibrium_tether_drag_log_law_200_steps", |b| {
+        b.iter(|| black_box(&log).solve(&config).unwrap())
+    });
+    let env = EnvelopeProblem {
+        base: problem(WindProfile::calm()),
+        wind: WindShape::PowerLaw {
+            exponent: 0.14,
+            reference_height_m: 10.0,
+        },
+        wind_speeds_m_s: (0..40).map(|i| i as f64 * 30.0 / 39.0).collect(),
+        tether_lengths_m: (0..50).map(|j| 100.0 + j as f64 * 2900.0 / 49.0).collect(),
+        limits: Limits {
+            required_safety_factor: 5.0,
+            ceiling_m: None,
+            payout_rate_m_s: None,
+        },
+    };
+    let mut group = c.benchmark_group("envelope");
+    group.sample_size(10);
+    group.bench_function("envelope_40x50_power_law_rayon", |b| {
+        b.iter(|| {
+            env.solve(&config, Parallelism::Rayon, &|_, _| {}, &|| false)
+                .unwrap()
+                .unwrap()
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(tether, benches);
+criterion_main!(tether);

@@ -1,0 +1,100 @@
+//! The tether routes (SPEC §6): `POST /api/v1/equilibrium` (one static
+//! equilibrium in a steady wind) and `POST /api/v1/envelope` (equilibria
+//! over wind speed × tether length; large ones go to the job queue).
+
+use axum::extract::State;
+use axum::response::Response;
+
+use crate::api::AppState;
+use crate::api::error::{ApiError, JsonBody};
+use crate::config::Limits;
+use crate::contract::dto::ErrorBody;
+use crate::contract::envelope::dto::{EnvelopeRequest, EnvelopeResponse};
+use crate::contract::envelope::{self, MAX_SYNC_ENVELOPE_POINTS};
+use crate::contract::equilibrium::dto::{EquilibriumRequest, EquilibriumResponse};
+use crate::contract::run::NoProgress;
+use crate::contract::{self, equilibrium};
+use crate::numerics::chart::Parallelism;
+
+fn to_json(value: &impl serde::Serialize) -> Result<Vec<u8>, ApiError> {
+    Ok(serde_json::to_vec(value).expect("responses serialise"))
+}
+
+/// Static equilibrium of the tether in a steady wind: altitude, downwind
+/// distance, winch and top tension, safety factor, blow-down and shape.
+///
+/// A heavy, optionally elastic tether under its weight, normal wind drag
+/// and the aerostat's drag, lift and net buoyancy, integrated from the
+/// aerostat down (RK4, shooting on the altitude). Slack (part of the
+/// tether on the ground) is an answer, not an error. Presets
+/// (`cable.preset`, `aerostat.preset`) fill the fields left out.
+#[utoipa::path(
+    post, path = "/api/v1/equilibrium", tag = "solve", operation_id = "compute_equilibrium",
+    request_body(content = EquilibriumRequest, description = "Tether, aerostat, length and wind (SI units)"),
+    responses(
+        (status = 200, description = "The answer", body = EquilibriumResponse),
+        (status = 400, description = "Malformed JSON", body = ErrorBody),
+        (status = 413, description = "Body larger than the limit", body = ErrorBody),
+        (status = 415, description = "Content type is not JSON", body = ErrorBody),
+        (status = 422, description = "Invalid input (`invalid_input`); `field` names the culprit", body = ErrorBody),
+        (status = 500, description = "Numerical failure on valid input (a bug)", body = ErrorBody),
+        (status = 503, description = "Too many solves in flight", body = ErrorBody,
+            headers(("Retry-After" = u32, description = "Seconds to wait before retrying"))),
+        (status = 504, description = "No answer within the solve timeout", body = ErrorBody),
+    )
+)]
+pub async fn compute_equilibrium(
+    State(app): State<AppState>,
+    JsonBody(body): JsonBody,
+) -> Result<Response, ApiError> {
+    app.solve(move |_: &Limits| {
+        let req: EquilibriumRequest = contract::parse_plain(&body)?;
+        to_json(&equilibrium::equilibrium(&req)?)
+    })
+    .await
+}
+
+/// Operating envelope over wind speed × tether length: altitude,
+/// blow-down, tensions, safety factor, slack and stability at each point,
+/// the largest operating wind per length and the highest altitude per wind.
+///
+/// Each point is judged against slack, the required safety factor, an
+/// optional ceiling and (with `payout_rate_m_s`) stability; the first
+/// violated is its binding limit. Synchronously at most 5 000 points;
+/// larger envelopes (up to 250 000 points) go to `POST /api/v1/jobs` with
+/// `"kind": "envelope"`.
+#[utoipa::path(
+    post, path = "/api/v1/envelope", tag = "solve", operation_id = "compute_envelope",
+    request_body(content = EnvelopeRequest, description = "Tether, aerostat, wind shape, grids and limits (SI units)"),
+    responses(
+        (status = 200, description = "The answer", body = EnvelopeResponse),
+        (status = 400, description = "Malformed JSON", body = ErrorBody),
+        (status = 413, description = "Body larger than the limit", body = ErrorBody),
+        (status = 415, description = "Content type is not JSON", body = ErrorBody),
+        (status = 422, description = "Invalid input (`invalid_input`) or too large for a synchronous answer (`too_large`: use /api/v1/jobs); `field` names the culprit", body = ErrorBody),
+        (status = 500, description = "Numerical failure on valid input (a bug)", body = ErrorBody),
+        (status = 503, description = "Too many solves in flight", body = ErrorBody,
+            headers(("Retry-After" = u32, description = "Seconds to wait before retrying"))),
+        (status = 504, description = "No answer within the solve timeout", body = ErrorBody),
+    )
+)]
+pub async fn compute_envelope(
+    State(app): State<AppState>,
+    JsonBody(body): JsonBody,
+) -> Result<Response, ApiError> {
+    app.solve(move |_: &Limits| {
+        let req: EnvelopeRequest = contract::parse_plain(&body)?;
+        req.validate()?;
+        let points = req.points();
+        if points > MAX_SYNC_ENVELOPE_POINTS {
+            return Err(ApiError::too_large(
+                "tether_lengths_m.count",
+                format!(
+                    "the envelope has {points} points; synchronous envelopes have at most {MAX_SYNC_ENVELOPE_POINTS} (submit a job with \"kind\": \"envelope\")"
+                ),
+            ));
+        }
+        to_json(&envelope::envelope(&req, Parallelism::Rayon, &NoProgress)?)
+    })
+    .await
+}

@@ -1,0 +1,178 @@
+//! Request and response bodies of `POST /api/v1/envelope`.
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use crate::contract::equilibrium::dto::{
+    ResolvedAerostatOutput, ResolvedCableOutput, TetherAerostatInput, TetherCableInput,
+    default_air_density, default_gravity, default_reference_height, default_safety_factor,
+    default_steps,
+};
+
+/// How the grid's wind speed sets the profile: the speed is the wind at
+/// the reference height (or everywhere, when uniform).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum WindShapeInput {
+    /// U(z) = U.
+    Uniform,
+    /// U(z) = U (z/z_ref)^p.
+    PowerLaw {
+        #[schema(example = 0.14, minimum = 0.0, maximum = 2.0)]
+        exponent_nondim: f64,
+        #[serde(default = "default_reference_height")]
+        #[schema(example = 10.0, exclusive_minimum = 0.0, maximum = 10000.0)]
+        reference_height_m: f64,
+    },
+    /// U(z) = U ln(z/z0)/ln(z_ref/z0).
+    LogLaw {
+        #[schema(example = 0.03, exclusive_minimum = 0.0, maximum = 10.0)]
+        roughness_length_m: f64,
+        #[serde(default = "default_reference_height")]
+        #[schema(example = 10.0, exclusive_minimum = 0.0, maximum = 10000.0)]
+        reference_height_m: f64,
+    },
+}
+
+/// The air of the envelope.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EnvelopeWindInput {
+    pub shape: WindShapeInput,
+    /// Air density (kg/m³), default 1.225.
+    #[serde(default = "default_air_density")]
+    #[schema(example = 1.225, exclusive_minimum = 0.0, maximum = 5.0)]
+    pub air_density_kg_m3: f64,
+}
+
+/// Evenly spaced wind speeds (m/s).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WindGridInput {
+    #[schema(example = 0.0, minimum = 0.0, maximum = 150.0)]
+    pub min: f64,
+    #[schema(example = 30.0, minimum = 0.0, maximum = 150.0)]
+    pub max: f64,
+    #[schema(example = 40, minimum = 1, maximum = 1000)]
+    pub count: usize,
+}
+
+/// Evenly spaced tether lengths (m).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LengthGridInput {
+    #[schema(example = 100.0, exclusive_minimum = 0.0, maximum = 100000.0)]
+    pub min: f64,
+    #[schema(example = 3000.0, exclusive_minimum = 0.0, maximum = 100000.0)]
+    pub max: f64,
+    #[schema(example = 50, minimum = 1, maximum = 1000)]
+    pub count: usize,
+}
+
+/// `POST /api/v1/envelope`: equilibria over wind speed × tether length,
+/// each judged against slack, tension, ceiling and (with a payout rate) stability.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({
+    "cable": {"preset": "dyneema", "diameter_m": 0.006},
+    "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
+                 "reference_area_m2": 20.0},
+    "wind": {"shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0},
+             "air_density_kg_m3": 1.225},
+    "wind_speeds_m_s": {"min": 0.0, "max": 30.0, "count": 40},
+    "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 50},
+    "required_safety_factor_nondim": 5.0,
+    "ceiling_m": 2500.0,
+    "payout_rate_m_s": 5.0
+}))]
+pub struct EnvelopeRequest {
+    pub cable: TetherCableInput,
+    pub aerostat: TetherAerostatInput,
+    pub wind: EnvelopeWindInput,
+    pub wind_speeds_m_s: WindGridInput,
+    pub tether_lengths_m: LengthGridInput,
+    #[serde(default = "default_gravity")]
+    #[schema(example = 9.81, exclusive_minimum = 0.0, maximum = 100.0)]
+    pub gravity_m_s2: f64,
+    /// Required breaking strength / largest tension (default 5).
+    #[serde(default = "default_safety_factor")]
+    #[schema(example = 5.0, minimum = 1.0, maximum = 100.0)]
+    pub required_safety_factor_nondim: f64,
+    /// Highest allowed altitude (m); absent: none.
+    #[serde(default)]
+    #[schema(example = 2500.0, exclusive_minimum = 0.0, maximum = 100000.0)]
+    pub ceiling_m: Option<f64>,
+    /// Payout rate (m/s) for the stability limit; absent: stability not judged.
+    #[serde(default)]
+    #[schema(example = 5.0, minimum = 0.0, maximum = 1000.0)]
+    pub payout_rate_m_s: Option<f64>,
+    /// RK4 steps per equilibrium (default 200).
+    #[serde(default = "default_steps")]
+    #[schema(example = 200, minimum = 8, maximum = 100000)]
+    pub integration_steps: usize,
+}
+
+/// One grid point.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct EnvelopePointOutput {
+    /// Wind at the reference height (m/s).
+    pub wind_speed_m_s: f64,
+    pub tether_length_m: f64,
+    pub aerostat_altitude_m: f64,
+    pub aerostat_downwind_m: f64,
+    pub blowdown_angle_deg: f64,
+    pub winch_tension_n: f64,
+    pub top_tension_n: f64,
+    pub max_tension_n: f64,
+    pub min_tension_n: f64,
+    pub safety_factor_nondim: Option<f64>,
+    pub slack: bool,
+    /// With a payout rate: `min T − ρA v²` (N).
+    pub stability_margin_n: Option<f64>,
+    /// With a payout rate: stable or not; null without one.
+    pub stable: Option<bool>,
+    /// Inside every limit.
+    pub feasible: bool,
+    /// The first limit violated: `slack`, `tension`, `ceiling`, `stability`, `not_converged`.
+    pub binding_limit: Option<String>,
+}
+
+/// The largest operating wind at one length.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct LengthLimitOutput {
+    pub tether_length_m: f64,
+    /// Largest grid wind up to which every grid wind is inside; null: not even the lowest.
+    pub max_wind_speed_m_s: Option<f64>,
+    /// Altitude at that wind (m).
+    pub altitude_at_max_wind_m: Option<f64>,
+    /// The limit met at the next wind; null: the whole grid is inside.
+    pub binding_limit: Option<String>,
+}
+
+/// The highest altitude at one wind.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct WindLimitOutput {
+    pub wind_speed_m_s: f64,
+    /// Highest altitude inside the envelope (m); null: no length is inside.
+    pub max_altitude_m: Option<f64>,
+    /// The tether length that reaches it (m).
+    pub tether_length_m: Option<f64>,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct EnvelopeResponse {
+    pub wind_speeds_m_s: Vec<f64>,
+    pub tether_lengths_m: Vec<f64>,
+    /// Row by row: one row per wind speed, the lengths inside.
+    pub points: Vec<EnvelopePointOutput>,
+    pub max_wind_per_length: Vec<LengthLimitOutput>,
+    pub max_altitude_per_wind: Vec<WindLimitOutput>,
+    pub required_safety_factor_nondim: f64,
+    pub ceiling_m: Option<f64>,
+    pub payout_rate_m_s: Option<f64>,
+    /// What "stable" means here.
+    pub stability_criterion: String,
+    pub cable: ResolvedCableOutput,
+    pub aerostat: ResolvedAerostatOutput,
+    pub integration_steps: usize,
+}

@@ -1,0 +1,272 @@
+//! `POST /api/v1/envelope`, `tetherplan envelope` and the `envelope` job:
+//! equilibria over wind speed × tether length with their limits
+//! ([`crate::numerics::tether::envelope`]). Each point is the answer of
+//! `POST /api/v1/equilibrium` for the same inputs (a test checks it).
+
+pub mod dto;
+
+use crate::contract::equilibrium::dto::{ResolvedAerostatOutput, ResolvedCableOutput};
+use crate::contract::equilibrium::{require_count, require_range};
+use crate::contract::{Progress, RequestError};
+use crate::numerics::chart::Parallelism;
+use crate::numerics::params::InvalidInput;
+use crate::numerics::tether::envelope::{EnvelopeProblem, Limits, MAX_ENVELOPE_POINTS, WindShape};
+use crate::numerics::tether::{EquilibriumConfig, EquilibriumProblem, WindProfile};
+use dto::*;
+
+/// Points a synchronous envelope may have (about 0.1 s at 200 steps).
+pub const MAX_SYNC_ENVELOPE_POINTS: usize = 5_000;
+
+/// What "stable" means in the envelope.
+pub const STABILITY_CRITERION: &str = "continuum linear-string criterion of SPEC §1 applied to the blown-down tether: stable while the smallest tension exceeds the kinematic term ρA v² (calm air: h* = (F/ρA − v²)/g)";
+
+fn grid(min: f64, max: f64, count: usize) -> Vec<f64> {
+    if count == 1 {
+        return vec![min];
+    }
+    (0..count)
+        .map(|k| min + (max - min) * k as f64 / (count - 1) as f64)
+        .collect()
+}
+
+impl WindShapeInput {
+    pub fn shape(&self) -> Result<WindShape, InvalidInput> {
+        Ok(match *self {
+            Self::Uniform => WindShape::Uniform,
+            Self::PowerLaw {
+                exponent_nondim,
+                reference_height_m,
+            } => WindShape::PowerLaw {
+                exponent: require_range(
+                    "wind.shape.exponent_nondim",
+                    exponent_nondim,
+                    0.0,
+                    false,
+                    2.0,
+                )?,
+                reference_height_m: require_range(
+                    "wind.shape.reference_height_m",
+                    reference_height_m,
+                    0.0,
+                    true,
+                    1e4,
+                )?,
+            },
+            Self::LogLaw {
+                roughness_length_m,
+                reference_height_m,
+            } => {
+                let z0 = require_range(
+                    "wind.shape.roughness_length_m",
+                    roughness_length_m,
+                    0.0,
+                    true,
+                    10.0,
+                )?;
+                let zr = require_range(
+                    "wind.shape.reference_height_m",
+                    reference_height_m,
+                    0.0,
+                    true,
+                    1e4,
+                )?;
+                WindProfile::log_law(0.0, zr, z0, "wind.shape")?;
+                WindShape::LogLaw {
+                    roughness_length_m: z0,
+                    reference_height_m: zr,
+                }
+            }
+        })
+    }
+}
+
+impl EnvelopeRequest {
+    /// Number of grid points.
+    pub fn points(&self) -> usize {
+        self.wind_speeds_m_s
+            .count
+            .saturating_mul(self.tether_lengths_m.count)
+    }
+
+    /// The validated sweep and its configuration.
+    pub fn problem(&self) -> Result<(EnvelopeProblem, EquilibriumConfig), InvalidInput> {
+        let w = &self.wind_speeds_m_s;
+        let wmin = require_range("wind_speeds_m_s.min", w.min, 0.0, false, 150.0)?;
+        let wmax = require_range("wind_speeds_m_s.max", w.max, 0.0, false, 150.0)?;
+        if wmax < wmin {
+            return Err(InvalidInput::new(
+                "wind_speeds_m_s.max",
+                format!("must be at least wind_speeds_m_s.min = {wmin}, got {wmax}"),
+            ));
+        }
+        require_count("wind_speeds_m_s.count", w.count, 1, 1000)?;
+        let l = &self.tether_lengths_m;
+        let lmin = require_range("tether_lengths_m.min", l.min, 0.0, true, 1e5)?;
+        let lmax = require_range("tether_lengths_m.max", l.max, 0.0, true, 1e5)?;
+        if lmax < lmin {
+            return Err(InvalidInput::new(
+                "tether_lengths_m.max",
+                format!("must be at least tether_lengths_m.min = {lmin}, got {lmax}"),
+            ));
+        }
+        require_count("tether_lengths_m.count", l.count, 1, 1000)?;
+        if self.points() > MAX_ENVELOPE_POINTS {
+            return Err(InvalidInput::new(
+                "tether_lengths_m.count",
+                format!(
+                    "the envelope would have {} points; at most {MAX_ENVELOPE_POINTS}",
+                    self.points()
+                ),
+            ));
+        }
+        let base = EquilibriumProblem {
+            cable: self.cable.cable("cable")?,
+            body: self.aerostat.body("aerostat")?,
+            wind: WindProfile::calm(),
+            air_density_kg_m3: require_range(
+                "wind.air_density_kg_m3",
+                self.wind.air_density_kg_m3,
+                0.0,
+                true,
+                5.0,
+            )?,
+            tether_length_m: lmin,
+            gravity_m_s2: require_range("gravity_m_s2", self.gravity_m_s2, 0.0, true, 100.0)?,
+        };
+        let required = require_range(
+            "required_safety_factor_nondim",
+            self.required_safety_factor_nondim,
+            1.0,
+            false,
+            100.0,
+        )?;
+        if let Some(c) = self.ceiling_m {
+            require_range("ceiling_m", c, 0.0, true, 1e5)?;
+        }
+        if let Some(v) = self.payout_rate_m_s {
+            require_range("payout_rate_m_s", v, 0.0, false, 1000.0)?;
+        }
+        let steps = require_count("integration_steps", self.integration_steps, 8, 100_000)?;
+        Ok((
+            EnvelopeProblem {
+                base,
+                wind: self.wind.shape.shape()?,
+                wind_speeds_m_s: grid(wmin, wmax, w.count),
+                tether_lengths_m: grid(lmin, lmax, l.count),
+                limits: Limits {
+                    required_safety_factor: required,
+                    ceiling_m: self.ceiling_m,
+                    payout_rate_m_s: self.payout_rate_m_s,
+                },
+            },
+            EquilibriumConfig {
+                steps,
+                keep_shape: false,
+                ..EquilibriumConfig::default()
+            },
+        ))
+    }
+
+    pub fn validate(&self) -> Result<(), RequestError> {
+        self.problem()?;
+        Ok(())
+    }
+}
+
+/// Computes the envelope; progress counts wind rows.
+pub fn envelope(
+    req: &EnvelopeRequest,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<EnvelopeResponse, RequestError> {
+    let (problem, config) = req.problem()?;
+    let report = |done: usize, total: usize| progress.report(done, total);
+    let cancelled = || progress.cancelled();
+    let Some(env) = problem.solve(&config, parallelism, &report, &cancelled)? else {
+        return Err(RequestError::Cancelled);
+    };
+    let name = |l: Option<crate::numerics::tether::envelope::Limit>| l.map(|l| l.name().to_string());
+    let points: Vec<EnvelopePointOutput> = env
+        .points
+        .iter()
+        .map(|p| {
+            let e = &p.equilibrium;
+            EnvelopePointOutput {
+                wind_speed_m_s: p.wind_speed_m_s,
+                tether_length_m: p.tether_length_m,
+                aerostat_altitude_m: e.altitude_m,
+                aerostat_downwind_m: e.downwind_m,
+                blowdown_angle_deg: e.blowdown_angle_deg,
+                winch_tension_n: e.winch_tension_n,
+                top_tension_n: e.top_tension_n,
+                max_tension_n: e.max_tension_n,
+                min_tension_n: e.min_tension_n,
+                safety_factor_nondim: e.safety_factor,
+                slack: e.slack,
+                stability_margin_n: p.verdict.stability_margin_n,
+                stable: p.verdict.stable,
+                feasible: p.verdict.limit.is_none(),
+                binding_limit: name(p.verdict.limit),
+            }
+        })
+        .collect();
+    let nl = problem.tether_lengths_m.len();
+    let max_wind_per_length = problem
+        .tether_lengths_m
+        .iter()
+        .zip(&env.max_wind_per_length)
+        .enumerate()
+        .map(|(j, (&l, &(wind, limit)))| {
+            let altitude = wind.and_then(|w| {
+                problem
+                    .wind_speeds_m_s
+                    .iter()
+                    .position(|&u| u == w)
+                    .map(|i| points[i * nl + j].aerostat_altitude_m)
+            });
+            LengthLimitOutput {
+                tether_length_m: l,
+                max_wind_speed_m_s: wind,
+                altitude_at_max_wind_m: altitude,
+                binding_limit: name(limit),
+            }
+        })
+        .collect();
+    let max_altitude_per_wind = problem
+        .wind_speeds_m_s
+        .iter()
+        .zip(&env.max_altitude_per_wind)
+        .map(|(&u, best)| WindLimitOutput {
+            wind_speed_m_s: u,
+            max_altitude_m: best.map(|b| b.0),
+            tether_length_m: best.map(|b| b.1),
+        })
+        .collect();
+    let c = &problem.base.cable;
+    let b = &problem.base.body;
+    Ok(EnvelopeResponse {
+        wind_speeds_m_s: problem.wind_speeds_m_s.clone(),
+        tether_lengths_m: problem.tether_lengths_m.clone(),
+        points,
+        max_wind_per_length,
+        max_altitude_per_wind,
+        required_safety_factor_nondim: req.required_safety_factor_nondim,
+        ceiling_m: req.ceiling_m,
+        payout_rate_m_s: req.payout_rate_m_s,
+        stability_criterion: STABILITY_CRITERION.to_string(),
+        cable: ResolvedCableOutput {
+            mass_per_length_kg_m: c.mass_per_length_kg_m,
+            diameter_m: c.diameter_m,
+            normal_drag_coefficient_nondim: c.normal_drag_coefficient,
+            axial_stiffness_n: c.axial_stiffness_n,
+            breaking_strength_n: c.breaking_strength_n,
+        },
+        aerostat: ResolvedAerostatOutput {
+            net_buoyancy_n: b.net_buoyancy_n,
+            drag_coefficient_nondim: b.drag_coefficient,
+            lift_coefficient_nondim: b.lift_coefficient,
+            reference_area_m2: b.reference_area_m2,
+        },
+        integration_steps: config.steps,
+    })
+}

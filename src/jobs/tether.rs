@@ -1,0 +1,52 @@
+//! The tether job kinds: `equilibrium` and `envelope` (SPEC §6). The
+//! envelope reports progress per wind row and stops when cancelled.
+
+use serde_json::Value;
+
+use crate::contract::envelope::dto::EnvelopeRequest;
+use crate::contract::equilibrium::dto::EquilibriumRequest;
+use crate::contract::{self, Progress, RequestError, envelope, equilibrium};
+use crate::jobs::kinds::JobKind;
+use crate::numerics::chart::Parallelism;
+
+fn to_json(value: &impl serde::Serialize) -> Result<String, RequestError> {
+    Ok(serde_json::to_string(value).expect("responses serialise"))
+}
+
+impl JobKind for EquilibriumRequest {
+    const NAME: &'static str = "equilibrium";
+    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
+        contract::parse_plain(body)
+    }
+    fn validate(&self) -> Result<(), RequestError> {
+        EquilibriumRequest::validate(self)
+    }
+    fn run(&self, _: &dyn Progress) -> Result<String, RequestError> {
+        to_json(&equilibrium::equilibrium(self)?)
+    }
+}
+
+impl JobKind for EnvelopeRequest {
+    const NAME: &'static str = "envelope";
+    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
+        contract::parse_plain(body)
+    }
+    fn validate(&self) -> Result<(), RequestError> {
+        EnvelopeRequest::validate(self)
+    }
+    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
+        to_json(&envelope::envelope(self, Parallelism::Rayon, progress)?)
+    }
+}
+
+/// A valid request of the tether kinds (their schema examples), for tests.
+pub fn example_request(kind: &str) -> Option<Value> {
+    use utoipa::PartialSchema;
+    let schema = match kind {
+        "equilibrium" => EquilibriumRequest::schema(),
+        "envelope" => EnvelopeRequest::schema(),
+        _ => return None,
+    };
+    let value = serde_json::to_value(&schema).ok()?;
+    value.get("example").cloned()
+}

@@ -1,0 +1,16 @@
+//! Tether tension and steady wind (SPEC §6, beyond the thesis): the static
+//! large-deflection shape of a heavy, optionally elastic tether under its
+//! weight, normal wind drag and the aerostat's drag, lift and net buoyancy
+//! ([`equilibrium`]); wind profiles including the log law ([`wind`]);
+//! tether and aerostat presets with their sources ([`presets`]); the
+//! operating envelope over wind speed × tether length ([`envelope`]).
+
+pub mod envelope;
+pub mod equilibrium;
+pub mod presets;
+pub mod wind;
+
+pub use equilibrium::{
+    Body, Cable, Equilibrium, EquilibriumConfig, EquilibriumProblem, ShapePoint, catenary_top,
+};
+pub use wind::WindProfile;
