@@ -56,6 +56,8 @@ enum Command {
     /// Response against forcing frequency: wind on the linear string, or
     /// `"excitation": "base"` (shaken platform, GE cable).
     FrequencyResponse(InputArg),
+    /// The fastest safe deployment (or retrieval) schedule, with the haul-down deadline.
+    Plan(InputArg),
 }
 
 /// A progress bar on standard error for `total` units of `what`.
@@ -198,6 +200,9 @@ fn main() -> ExitCode {
             let out = simulate::simulate_any(req, &bar);
             bar.0.finish_and_clear();
             out
+        }),
+        Command::Plan(arg) => answer_with(arg, contract::plan::parse_plan, |req| {
+            contract::plan::plan(req, &run::NoProgress)
         }),
         Command::FrequencyResponse(arg) => {
             answer_with(arg, ge_charts::parse_frequency_response, |req| {

@@ -31,6 +31,7 @@ use crate::jobs::store::JobStatus;
         solve::create_chart,
         solve::run_simulation,
         solve::compute_frequency_response,
+        solve::compute_plan,
         jobs::create_job,
         jobs::list_jobs,
         jobs::get_job,

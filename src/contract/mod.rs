@@ -6,6 +6,7 @@
 pub mod dto;
 pub mod ge;
 pub mod ge_charts;
+pub mod plan;
 pub mod run;
 pub mod simulate;
 pub mod transient;
