@@ -72,7 +72,7 @@ async fn unknown_fields_and_bad_values_name_their_path() {
     body["winch"]["max_jerk"] = json!(1.0);
     let (status, r) = post(&body).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
-    assert_eq!(r["error"]["field"], "winch", "{r}");
+    assert_eq!(r["error"]["field"], "winch.max_jerk", "{r}");
     assert!(r["error"]["message"].as_str().unwrap().contains("max_jerk"));
 
     let mut body = example();

@@ -73,14 +73,22 @@ fn cases() -> Vec<Case> {
             max_acc: 0.3,
         },
         Case {
-            name: "thesis data, tight reserve (r = 0.075: 9.3 m/s ceiling at 1200 m)",
-            body: thesis_body(1200.0, 0.075),
+            // The static ceiling at 1200 m is 9.3 m/s; braking at up to
+            // 6 m/s² > g/2 makes the bound follow that ceiling down, while
+            // the plan may brake from above it (the braking raises the roller
+            // tension by (m + ρA L)|L̈|): faster than the bound.
+            name: "thesis data, tight reserve r = 0.075, 6 m/s² winch",
+            body: {
+                let mut b = thesis_body(1200.0, 0.075);
+                b["winch"]["max_acceleration_m_s2"] = json!(6.0);
+                b
+            },
             rho_a: 0.078,
             f: 1000.0,
             m: 10.0,
             reserve: 0.075,
             max_rate: 40.0,
-            max_acc: 2.0,
+            max_acc: 6.0,
         },
     ]
 }
@@ -160,7 +168,9 @@ fn every_sample_is_qep_stable_within_the_limits_and_near_the_bound() {
         );
         let tc = r.transient_check.as_ref().unwrap();
         assert_eq!(tc.outcome, "completed", "{}", c.name);
-        assert!(r.constant_rate.as_ref().unwrap().time_saved_s >= -1e-6);
+        // Never slower than the constant-rate plan (up to the grid error of
+        // the pass when the two coincide).
+        assert!(r.constant_rate.as_ref().unwrap().time_saved_s >= -1e-4 * d);
     }
 }
 
@@ -174,12 +184,17 @@ fn thesis_plan_meets_the_spec_bound_of_50_s() {
     assert!((d - 49.975).abs() < 0.01, "{d}");
     assert_eq!(format!("{d:.1}"), "50.0");
     // The best constant rate is the static ceiling at 1200 m with the
-    // reserve, √(950/0.078 − 9.81·1200) = 20.19 m/s: 1199/v + v/a.
-    let v = (950.0f64 / 0.078 - 9.81 * 1200.0).sqrt();
+    // reserve and the margin ε = 1e-3, √(0.999·950/0.078 − 9.81·1200) =
+    // 19.88 m/s: 1199/v + v/a.
+    let v = (0.999 * 950.0f64 / 0.078 - 9.81 * 1200.0).sqrt();
     let c = r.constant_rate.unwrap();
     assert!((c.rate_m_s / v - 1.0).abs() < 2e-3, "{} vs {v}", c.rate_m_s);
     assert!((c.duration_s - (1199.0 / c.rate_m_s + c.rate_m_s / 2.0)).abs() < 1e-9);
     assert!(c.time_saved_s > 19.0, "{}", c.time_saved_s);
+    eprintln!(
+        "thesis 1200 m: plan {d:.3} s, constant {:.3} m/s in {:.3} s, saves {:.3} s",
+        c.rate_m_s, c.duration_s, c.time_saved_s
+    );
     let phases: Vec<&str> = r.phases.iter().map(|p| p.limit.as_str()).collect();
     assert_eq!(phases, ["winch_acceleration", "winch_rate", "winch_braking"]);
 }
@@ -190,7 +205,8 @@ fn beyond_the_lift_limit_is_infeasible_and_names_it() {
     let r = run(thesis_body(1290.0, 0.05));
     assert!(!r.feasible && !r.go);
     assert_eq!(r.binding_limit.as_deref(), Some("static_lift_limit"));
-    assert!(r.reason.contains("1241"), "{}", r.reason);
+    // 950/(0.078·9.81) = 1241.5 m, less the margin ε = 1e-3: 1240.3 m.
+    assert!(r.reason.contains("1240.3 m"), "{}", r.reason);
     assert!(r.schedule.is_empty() && r.duration_s.is_none());
     // Without the reserve 1290 m is below F/(ρA g) = 1306.9 m: feasible.
     assert!(run(thesis_body(1290.0, 0.0)).feasible);
@@ -230,7 +246,7 @@ fn the_pass_converges_with_the_grid() {
     let p0 = PlanProblem::new(
         AerostatSystem::thesis(),
         1200.0,
-        Winch::new(40.0, 2.0).unwrap(),
+        Winch::new(40.0, 6.0).unwrap(),
         0.075,
         None,
     )

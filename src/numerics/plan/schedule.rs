@@ -441,9 +441,15 @@ fn label(
             return SegmentLimit::Tension;
         }
     }
-    // Slower than every own limit: on the way down to a backward curve
-    // that rides the stability ceiling.
-    SegmentLimit::Stability
+    // Limited by the backward curve alone: the segment in which the rate
+    // reaches the cruise rate, or starts braking for the target.
+    if uj >= w2 - tol_u {
+        SegmentLimit::Cruise
+    } else if alpha >= 0.0 {
+        SegmentLimit::Accelerate
+    } else {
+        SegmentLimit::Brake
+    }
 }
 
 /// Drops knots inside runs of one acceleration and one limit.
@@ -518,10 +524,12 @@ fn trapezoid_ok(p: &PlanProblem, v: f64) -> bool {
         return false;
     }
     let at = |s: f64| l0 + sigma * s;
-    // (s_start, s_end, u_start, u_end, α)
+    // (s_start, s_end, u_start, u_end, α). A constant rate is safe to the
+    // target (SPEC §1 safe rate): the cruise is checked up to the target,
+    // without credit for the braking that ends it.
     let phases = [
         (0.0, ramp, 0.0, v * v, a),
-        (ramp, total - ramp, v * v, v * v, 0.0),
+        (ramp, total, v * v, v * v, 0.0),
         (total - ramp, total, v * v, 0.0, -a),
     ];
     let f = STABILITY_MARGIN * p.reserve_buoyancy_n();
@@ -537,7 +545,9 @@ fn trapezoid_ok(p: &PlanProblem, v: f64) -> bool {
 }
 
 /// The best constant-rate plan with the same limits: the largest cruise
-/// rate whose trapezoid (ramps at the acceleration limit) is admissible,
+/// rate that is stable at constant rate all the way to the target (the
+/// SPEC §1 safe rate, with the reserve and the margin) and whose ramps at
+/// the acceleration limit are admissible,
 /// found by bisection (60 halvings). `None` when no rate is.
 pub fn best_constant_rate(p: &PlanProblem) -> Option<ConstantRatePlan> {
     if static_check(p).is_some() {
