@@ -27,8 +27,8 @@
       lift_reserve_nondim: "0.075" },
   };
 
-  const inputs = () => Array.from(form.querySelectorAll("[data-field]"));
-  const byField = (f) => form.querySelector(`[data-field="${f}"]`);
+  const inputs = () => Array.from(form.querySelectorAll("[data-plan-field]"));
+  const byField = (f) => form.querySelector(`[data-plan-field="${f}"]`);
 
   function num(field) {
     const el = byField(field);
@@ -72,7 +72,7 @@
   // ---- URL state ----
   function writeUrl() {
     const params = new URLSearchParams(window.location.search);
-    for (const el of inputs()) params.set(`plan.${el.dataset.field}`, el.value.trim());
+    for (const el of inputs()) params.set(`plan.${el.dataset.planField}`, el.value.trim());
     params.set("plan.preset", $("plan-preset").value);
     history.replaceState(null, "", `${window.location.pathname}?${params.toString()}${window.location.hash}`);
   }
@@ -82,7 +82,7 @@
     let any = false;
     if (params.has("plan.preset")) $("plan-preset").value = params.get("plan.preset");
     for (const el of inputs()) {
-      const key = `plan.${el.dataset.field}`;
+      const key = `plan.${el.dataset.planField}`;
       if (params.has(key)) {
         el.value = params.get(key);
         any = true;
@@ -99,6 +99,8 @@
 
   // ---- formatting ----
   const fmt = (v, d = 1) => (v === null || v === undefined || !Number.isFinite(v) ? "–" : v.toFixed(d));
+  // Legend values: blank until the cursor is on the plot.
+  const lv = (d) => (u, v) => (v == null ? "" : fmt(v, d));
 
   // ---- plots ----
   const plots = {};
@@ -113,7 +115,7 @@
     return new uPlot(
       {
         ...plotSize(el),
-        series: [{ label: "t (s)", value: (u, v) => fmt(v, 1) }, ...series],
+        series: [{ label: "t (s)", value: lv(1) }, ...series],
         scales: { x: { time: false } },
         axes: [
           { ...axis, label: "Time t (s)" },
@@ -133,21 +135,21 @@
     const col = (k) => s.map((x) => x[k]);
     const absRate = s.map((x) => Math.abs(x.rate_m_s));
     plots.length = makePlot($("plan-plot-length"), "Length L (m)",
-      [{ label: "L (m)", stroke: "#0b5cad", width: 2, value: (u, v) => fmt(v, 1) }], [t, col("length_m")]);
+      [{ label: "L (m)", stroke: "#0b5cad", width: 2, value: lv(1) }], [t, col("length_m")]);
     plots.rate = makePlot($("plan-plot-rate"), "Rate (m/s)", [
-      { label: "|L̇| (m/s)", stroke: "#0b5cad", width: 2, value: (u, v) => fmt(v, 2) },
-      { label: "stability ceiling (m/s)", stroke: "#b00020", width: 1.5, dash: [6, 4], value: (u, v) => fmt(v, 2) },
+      { label: "|L̇| (m/s)", stroke: "#0b5cad", width: 2, value: lv(2) },
+      { label: "stability ceiling (m/s)", stroke: "#b00020", width: 1.5, dash: [6, 4], value: lv(2) },
     ], [t, absRate, col("rate_ceiling_m_s")]);
-    const tension = [{ label: "winch (N)", stroke: "#0b5cad", width: 2, value: (u, v) => fmt(v, 1) },
-      { label: "peak, at aerostat (N)", stroke: "#7a4a00", width: 1.5, value: (u, v) => fmt(v, 1) }];
+    const tension = [{ label: "winch (N)", stroke: "#0b5cad", width: 2, value: lv(1) },
+      { label: "peak, at aerostat (N)", stroke: "#7a4a00", width: 1.5, value: lv(1) }];
     const tdata = [t, col("winch_tension_n"), col("max_tension_n")];
     if (r.limits.allowable_tension_n) {
-      tension.push({ label: "allowable (N)", stroke: "#b00020", width: 1.5, dash: [6, 4], value: (u, v) => fmt(v, 1) });
+      tension.push({ label: "allowable (N)", stroke: "#b00020", width: 1.5, dash: [6, 4], value: lv(1) });
       tdata.push(s.map(() => r.limits.allowable_tension_n));
     }
     plots.tension = makePlot($("plan-plot-tension"), "Tension (N)", tension, tdata);
     plots.margin = makePlot($("plan-plot-margin"), "Margin (m/s)",
-      [{ label: "stability margin (m/s)", stroke: "#1a7f37", width: 2, value: (u, v) => fmt(v, 2) }],
+      [{ label: "stability margin (m/s)", stroke: "#1a7f37", width: 2, value: lv(2) }],
       [t, col("stability_margin_m_s")]);
   }
 

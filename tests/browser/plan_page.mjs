@@ -43,7 +43,7 @@ try {
     check(Math.abs(plan.duration_s - 50.0) < 0.05, `duration ${plan.duration_s?.toFixed(3)} s ≈ 50.0 s (SPEC §7 bound)`);
     const verdict = (await page.textContent("#plan-verdict .word"))?.trim();
     check(verdict === "GO", `verdict shows GO (${verdict})`);
-    const canvases = await page.locator("#plan-output .plot-area canvas").count();
+    const canvases = await page.locator("#plan-output .plan-plot-area canvas").count();
     check(canvases === 4, `four plan plots drawn (${canvases})`);
     const phases = await page.locator("#plan-phases tbody tr").count();
     check(phases === plan.phases.length && phases === 3, `operator's table has one row per phase (${phases})`);
