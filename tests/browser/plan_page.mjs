@@ -10,7 +10,7 @@
 // the URL carries the inputs, and reopens that URL in a fresh page: the same
 // plan. A target beyond the lift limit gives a no-go naming it. Then the phone
 // width (375 px). Screenshots: plan_page.png, plan_page_print.png,
-// plan_page_print.pdf, plan_page_375.png in tests/artifacts/.
+// plan_page_print.pdf, plan_page_375*.png in tests/artifacts/.
 
 import path from "node:path";
 import { checker, launch, target, watchConsole } from "./harness.mjs";
@@ -128,6 +128,11 @@ try {
   const overflow = await p2.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
   check(overflow <= 1, `no horizontal overflow at 375 px (${overflow} px)`);
   await p2.screenshot({ path: path.join(artifacts, "plan_page_375.png"), fullPage: false });
+  await p2.locator("#plan-verdict").scrollIntoViewIfNeeded();
+  await p2.evaluate(() => document.getElementById("plan-verdict").scrollIntoView({ block: "start" }));
+  await p2.screenshot({ path: path.join(artifacts, "plan_page_375_result.png"), fullPage: false });
+  await p2.evaluate(() => document.getElementById("plan-phases").scrollIntoView({ block: "start" }));
+  await p2.screenshot({ path: path.join(artifacts, "plan_page_375_table.png"), fullPage: false });
   await phone.close();
 
   const unexpected = consoleErrors.filter((e) => !(e.phase === "none"));

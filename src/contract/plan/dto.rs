@@ -207,12 +207,12 @@ pub struct TransientCheckOutput {
     pub elements: usize,
     pub time_step_s: f64,
     pub steps: usize,
-    /// The schedule plus one first-mode period at rest at the end (s).
+    /// The schedule (s).
     pub run_duration_s: f64,
     /// First-mode disturbance at the start (m).
     pub initial_tip_deflection_m: f64,
     pub peak_tip_deflection_m: f64,
-    /// Tip amplitude over the period at rest after the schedule (m).
+    /// First-mode tip amplitude at the end, at rest (m): projection of the final state on the rest mode.
     pub final_tip_amplitude_m: f64,
     /// final / initial.
     pub amplification_nondim: f64,
@@ -225,6 +225,8 @@ pub struct TransientCheckOutput {
 pub struct OscillationOutput {
     /// WKB tip-amplitude ratio end/start, [ψ(2m̃+l)]^(-1/2); null beyond the one-mode model's limit.
     pub wkb_amplification_nondim: Option<f64>,
+    /// The same WKB invariant with the FE string's own first rest mode in place of sin(πζ/2): A ∝ (ω φᵀMφ)^(-1/2).
+    pub wkb_fe_mode_amplification_nondim: Option<f64>,
     /// WKB mode-energy ratio end/start (ψ₁/ψ₀).
     pub wkb_energy_amplification_nondim: Option<f64>,
     /// From the transient run.

@@ -378,6 +378,7 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
     let wkb = retrieval::wkb_growth(&v.model, l_start, l_end);
     let oscillation = OscillationOutput {
         wkb_amplification_nondim: wkb.map(|w| w.amplitude),
+        wkb_fe_mode_amplification_nondim: retrieval::wkb_growth_fe(&v.model, l_start, l_end),
         wkb_energy_amplification_nondim: wkb.map(|w| w.energy),
         transient_amplification_nondim: Some(check.amplification),
         max_amplification_nondim: v.amplification_limit,

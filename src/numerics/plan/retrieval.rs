@@ -16,7 +16,7 @@
 //! A retrieval with an amplification limit is slowed (rate limit halved,
 //! then bisected) until the transient amplification is within it.
 
-use crate::numerics::params::Kinematics;
+use crate::numerics::params::{Kinematics, NondimState};
 use crate::numerics::plan::schedule::{self, PlanOutcome, Schedule};
 use crate::numerics::plan::{BindingLimit, PlanProblem};
 use crate::numerics::profile::Profile;
@@ -56,19 +56,45 @@ pub fn wkb_growth(model: &StringModel, start_m: f64, end_m: f64) -> Option<WkbGr
     Some(WkbGrowth { amplitude, energy })
 }
 
+/// The same adiabatic invariant with the FE string's own first rest mode
+/// `φ` (unit tip) in place of `sin(πζ/2)`: the symmetric part of `C` is
+/// `dM/dt̄`, so `(ω φᵀMφ) A²` is conserved and `A₁/A₀ = √(ω₀ m₀ / (ω₁ m₁))`.
+/// `None` when either length cannot hang at rest.
+pub fn wkb_growth_fe(model: &StringModel, start_m: f64, end_m: f64) -> Option<f64> {
+    let l0 = model.system.initial_length_m;
+    let action = |length_m: f64| -> Option<f64> {
+        let l = length_m / l0;
+        let (phi, omega) = transient::rest_mode_shape(model, l, 0.0, 1).ok()?;
+        if !(omega > 0.0) {
+            return None;
+        }
+        let mass = model
+            .matrices(NondimState {
+                length: l,
+                rate: 0.0,
+                acceleration: 0.0,
+            })
+            .mass;
+        let mut m_phi = vec![0.0; phi.len()];
+        mass.mul_vec(&phi, &mut m_phi);
+        let m: f64 = phi.iter().zip(&m_phi).map(|(a, b)| a * b).sum();
+        Some(omega * m)
+    };
+    Some((action(start_m)? / action(end_m)?).sqrt())
+}
+
 /// The response of the FE string to the schedule.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TransientCheck {
     pub elements: usize,
     pub time_step_s: f64,
     pub steps: usize,
-    /// Run length: the schedule plus one period of the first mode at rest
-    /// at the final length (s).
+    /// Run length: the schedule (s).
     pub run_duration_s: f64,
     pub initial_tip_deflection_m: f64,
     /// Largest `|y_tip|` over the run (m).
     pub peak_tip_deflection_m: f64,
-    /// Largest `|y_tip|` over the period at rest after the schedule (m).
+    /// First-mode tip amplitude at the end, at rest (m).
     pub final_tip_amplitude_m: f64,
     /// `final / initial`.
     pub amplification: f64,
@@ -96,15 +122,12 @@ pub fn rate_table(s: &Schedule, initial_length_m: f64) -> Result<Profile, Transi
     )?)
 }
 
-/// First-mode period at rest at `length_m` (s), from the one-mode model.
-fn rest_period_s(model: &StringModel, length_m: f64) -> Option<f64> {
-    let reduced = ReducedModel::new(model.system);
-    let psi = reduced.frequency(length_m / model.system.initial_length_m)?;
-    Some(2.0 * std::f64::consts::PI / model.system.eigenvalue_to_si(psi))
-}
-
 /// Runs the schedule on the FE string from the first mode at rest with
-/// the tip displaced by `disturbance_m`, then one period at rest.
+/// the tip displaced by `disturbance_m`. The final amplitude is the
+/// first-mode amplitude of the state at the end (the cable is then at rest
+/// and conservative): `√(a² + (b/ω)²)` with `a`, `b` the `M`-projections of
+/// the displacement and velocity on the rest mode `φ` (unit tip), `ω` its
+/// frequency.
 pub fn check_transient(
     model: &StringModel,
     s: &Schedule,
@@ -112,16 +135,12 @@ pub fn check_transient(
     observer: &dyn Observer,
 ) -> Result<TransientCheck, TransientError> {
     let l_start = s.knots.first().map_or(0.0, |k| k.length_m);
-    let l_end = s.knots.last().map_or(0.0, |k| k.length_m);
     // The run's length scale is the start of the schedule.
     let mut system = model.system;
     system.initial_length_m = l_start;
     let model = StringModel::with_operators(system, model.operators.clone());
     let profile = rate_table(s, l_start)?;
-    let hold = rest_period_s(&model, l_end)
-        .unwrap_or(0.1 * s.duration_s)
-        .min(s.duration_s.max(1.0));
-    let run_duration = s.duration_s + 1.05 * hold;
+    let run_duration = s.duration_s;
     let config = TransientConfig {
         duration_s: run_duration,
         time_step_s: None,
@@ -139,14 +158,26 @@ pub fn check_transient(
         .iter()
         .map(|x| x.tip_envelope_m.max(x.tip_deflection_m.abs()))
         .fold(0.0, f64::max);
-    let gap = run_duration / (TRANSIENT_SAMPLES - 1) as f64;
-    let settle_from = s.duration_s + gap;
-    let final_amp = run
-        .samples
-        .iter()
-        .filter(|x| x.time_s >= settle_from + gap)
-        .map(|x| x.tip_envelope_m.max(x.tip_deflection_m.abs()))
-        .fold(0.0, f64::max);
+    let final_amp = if matches!(run.outcome, RunOutcome::Completed) {
+        let l_end = run.final_kinematics.length_m / l_start;
+        let (phi, omega) = transient::rest_mode_shape(&model, l_end, 0.0, 1)?;
+        let mass = model
+            .matrices(NondimState {
+                length: l_end,
+                rate: 0.0,
+                acceleration: 0.0,
+            })
+            .mass;
+        let mut m_phi = vec![0.0; phi.len()];
+        mass.mul_vec(&phi, &mut m_phi);
+        let dot = |x: &[f64]| x.iter().zip(&m_phi).map(|(a, b)| a * b).sum::<f64>();
+        let norm = dot(&phi);
+        let a = dot(&run.final_state.displacement) / norm;
+        let b = dot(&run.final_state.velocity) / norm;
+        (a * a + (b / omega).powi(2)).sqrt() * l_start
+    } else {
+        f64::INFINITY
+    };
     Ok(TransientCheck {
         elements: model.elements(),
         time_step_s: run.time_step_s,
