@@ -60,6 +60,8 @@ enum Command {
     Equilibrium(InputArg),
     /// Operating envelope over wind speed × tether length.
     Envelope(InputArg),
+    /// The fastest safe deployment (or retrieval) schedule, with the haul-down deadline.
+    Plan(InputArg),
 }
 
 /// A progress bar on standard error for `total` units of `what`.
@@ -235,6 +237,9 @@ fn main() -> ExitCode {
                 out
             },
         ),
+        Command::Plan(arg) => answer_with(arg, contract::plan::parse_plan, |req| {
+            contract::plan::plan(req, &run::NoProgress)
+        }),
         Command::FrequencyResponse(arg) => {
             answer_with(arg, ge_charts::parse_frequency_response, |req| {
                 let runs = match req {

@@ -241,12 +241,16 @@
     return Math.abs(v) >= 1e5 ? v.toExponential(3) : v.toFixed(digits);
   }
 
+  // Legend values: blank until the cursor is on the plot (not a row of "–").
+  const legendValue = (digits) => (u, v) => (v == null ? "" : fmt(v, digits));
+  const curves = (n) => `${n} curve${n === 1 ? "" : "s"}`;
+
   // uPlot data and series for one quantity: x = rates, then per buoyancy the model
   // curve (solid) and the closed-form estimate (dashed).
   function plotSpec(chart, quantity, initialLength, log = false) {
     const x = chart.series[0].points.map((p) => p.rate_m_s);
     const data = [x];
-    const series = [{ label: "v (m/s)", value: (u, v) => fmt(v, 2) }];
+    const series = [{ label: "v (m/s)", value: legendValue(2) }];
     const unit = quantity === "time" ? "s" : "m";
     const sym = quantity === "time" ? "t*" : "h*";
     chart.series.forEach((s, i) => {
@@ -257,8 +261,8 @@
       const closed = s.points.map((p) => shown(quantity === "time" ? closedFormTime(p, initialLength) : p.closed_form_elevation_m));
       data.push(model, closed);
       series.push(
-        { label: `${sym}, ${s.net_buoyancy_n} N (${unit})`, color, stroke: color, width: 2, value: (u, v) => fmt(v, 1) },
-        { label: `closed form, ${s.net_buoyancy_n} N (${unit})`, color, stroke: color, width: 1.5, dash: [6, 4], value: (u, v) => fmt(v, 1) },
+        { label: `${sym}, ${s.net_buoyancy_n} N (${unit})`, color, stroke: color, width: 2, value: legendValue(1) },
+        { label: `closed form, ${s.net_buoyancy_n} N (${unit})`, color, stroke: color, width: 1.5, dash: [6, 4], value: legendValue(1) },
       );
     });
     return { data, series, unit, sym, log };
@@ -311,7 +315,7 @@
     $("#download-png").disabled = false;
     const pts = chart.series.reduce((n, s) => n + s.points.length, 0);
     statusEl.dataset.series = String(chart.series.length);
-    setStatus("ready", `${chart.series.length} curves, ${pts} points, ${chart.converged ? "converged, safe side of the error" : `${chart.elements} elements`}${via && via !== "direct" ? ` (${via})` : ""}.`);
+    setStatus("ready", `${curves(chart.series.length)}, ${pts} points, ${chart.converged ? "converged, safe side of the error" : `${chart.elements} elements`}${via && via !== "direct" ? ` (${via})` : ""}.`);
   }
 
   $("#log-time").addEventListener("change", () => {
@@ -384,12 +388,12 @@
     const x = [...new Set(curves.flatMap((c) => c.points.map(([v]) => v)))].sort((a, b) => a - b);
     const data = [x];
     const unit = quantity === "time" ? "s" : "m";
-    const series = [{ label: "v (m/s)", value: (u, v) => fmt(v, 2) }];
+    const series = [{ label: "v (m/s)", value: legendValue(2) }];
     curves.forEach((c, i) => {
       const map = new Map(c.points);
       data.push(x.map((v) => (map.has(v) && map.get(v) != null ? map.get(v) : null)));
       const color = COLORS[i % COLORS.length];
-      series.push({ label: `${c.label} (${unit})`, color, stroke: color, width: 2, dash: c.dash, spanGaps: true, value: (u, v) => fmt(v, 1) });
+      series.push({ label: `${c.label} (${unit})`, color, stroke: color, width: 2, dash: c.dash, spanGaps: true, value: legendValue(1) });
     });
     return { data, series, log: false };
   }
@@ -465,7 +469,7 @@
           const ge = await runChartJob(geReq, points);
           if (ge.chart) {
             renderGe(ge.chart, outcome.chart);
-            setStatus("ready", `String: ${outcome.chart.series.length} curves; GE: ${ge.chart.series.length} curves, ${points} points (${ge.via}).`);
+            setStatus("ready", `String: ${curves(outcome.chart.series.length)}; GE: ${curves(ge.chart.series.length)}, ${points} points (${ge.via}).`);
           } else if (ge.error?.error?.code === "cancelled") setStatus("idle", "GE job cancelled.");
           else setStatus("error", renderApiError(ge.status, geErrorBody(ge.error), $("#form-error")));
         }

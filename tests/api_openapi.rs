@@ -73,6 +73,12 @@ fn every_route_is_documented_with_its_statuses() {
         ),
         (
             "post",
+            "/api/v1/plan",
+            "compute_plan",
+            &["200", "400", "413", "415", "422", "500", "503", "504"],
+        ),
+        (
+            "post",
             "/api/v1/jobs",
             "create_job",
             &["200", "202", "400", "401", "413", "415", "422", "429", "500"],

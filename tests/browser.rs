@@ -5,6 +5,7 @@
 //!
 //! * `chart_page.mjs` submits the default chart form, checks the plotted
 //!   curves, an error rendered next to its field and the console.
+//! * `plan_page.mjs` plans the defaults, checks the print layout and a shared URL.
 //! * `transient_page.mjs` runs the default transient (thesis Fig 4.5) and
 //!   checks the resonance in the plotted envelope, runs a small frequency
 //!   response directly and a larger one as a job, checks API errors next to
@@ -189,4 +190,9 @@ fn transient_page_in_headless_chromium() {
 #[test]
 fn docs_try_it_out_in_headless_chromium() {
     run_page_script("docs_page.mjs");
+}
+
+#[test]
+fn plan_page_in_headless_chromium() {
+    run_page_script("plan_page.mjs");
 }

@@ -35,6 +35,7 @@ use crate::jobs::store::JobStatus;
         solve::compute_frequency_response,
         crate::api::tether::compute_equilibrium,
         crate::api::tether::compute_envelope,
+        solve::compute_plan,
         jobs::create_job,
         jobs::list_jobs,
         jobs::get_job,

@@ -396,3 +396,16 @@ solve_path!(
 
 /// Frequencies a synchronous frequency response may have.
 pub const MAX_SYNC_FREQUENCIES: usize = 16;
+
+solve_path!(
+    /// The fastest safe deployment (or retrieval) schedule (SPEC §7).
+    ///
+    /// Every instant stable with the lift reserve, within the winch limits
+    /// and the tension rating; the time saved against the best
+    /// constant-rate plan; the schedule run on the FE string; with a wind
+    /// forecast, the haul-down deadline. `feasible: false` names the
+    /// binding limit.
+    compute_plan, "/api/v1/plan", crate::contract::plan::PlanRequest, crate::contract::plan::PlanResponse,
+    parse = |body| contract::plan::parse_plan(body),
+    |req, limits| to_json(&contract::plan::plan(&req, &Deadline::after(limits))?)
+);

@@ -11,6 +11,7 @@ pub mod ge_charts;
 pub mod ranges;
 pub mod ge_critical;
 pub mod ge_numerics;
+pub mod plan;
 pub mod run;
 pub mod simulate;
 pub mod transient;

@@ -9,6 +9,7 @@ pub mod ge_reduced;
 pub mod mesh;
 pub mod newmark;
 pub mod params;
+pub mod plan;
 pub mod profile;
 pub mod qep;
 pub mod reduced;

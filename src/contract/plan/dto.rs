@@ -1,0 +1,326 @@
+//! Request and response bodies of `POST /api/v1/plan` (SPEC §7): SI
+//! units, every field name ends in its unit.
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use crate::contract::dto::{AerostatInput, CableInput, Groups, ModelInput};
+
+/// Winch limits.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WinchInput {
+    /// Largest winch rate |L̇| (m/s).
+    #[schema(example = 40.0, exclusive_minimum = 0.0, maximum = 1000.0)]
+    pub max_rate_m_s: f64,
+    /// Largest winch acceleration |L̈| (m/s²), speeding up and braking.
+    #[schema(example = 2.0, exclusive_minimum = 0.0, maximum = 100.0)]
+    pub max_acceleration_m_s2: f64,
+}
+
+/// The tether's rating.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TetherRatingInput {
+    /// Breaking strength (N).
+    #[schema(example = 20000.0, exclusive_minimum = 0.0, maximum = 1e9)]
+    pub breaking_strength_n: f64,
+    /// Safety factor on the breaking strength (FAA 14 CFR 31.25 practice: 5 for fibrous tethers).
+    #[serde(default = "default_safety_factor")]
+    #[schema(example = 5.0, minimum = 1.0, maximum = 100.0)]
+    pub safety_factor_nondim: f64,
+}
+
+fn default_safety_factor() -> f64 {
+    5.0
+}
+
+/// One point of a wind forecast (wind at the aerostat).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WindForecastPointInput {
+    /// Time from now (s).
+    #[schema(example = 600.0, minimum = 0.0, maximum = 1e9)]
+    pub time_s: f64,
+    /// Forecast wind speed (m/s).
+    #[schema(example = 8.0, minimum = 0.0, maximum = 200.0)]
+    pub wind_speed_m_s: f64,
+}
+
+/// Haul-down deadline: when must the retrieval start so the aerostat is
+/// down before the wind exceeds the operating limit?
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HaulDownInput {
+    /// Wind speed against time, times strictly increasing (1..=10000 points).
+    pub forecast: Vec<WindForecastPointInput>,
+    /// Largest wind in which the aerostat may stay aloft (m/s).
+    #[schema(example = 12.0, exclusive_minimum = 0.0, maximum = 200.0)]
+    pub max_operating_wind_m_s: f64,
+}
+
+/// `POST /api/v1/plan`: the fastest safe deployment (or retrieval) schedule.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({
+    "cable": {"mass_per_length_kg_m": 0.078},
+    "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+    "initial_length_m": 1.0,
+    "gravity_m_s2": 9.81,
+    "target_elevation_m": 1200.0,
+    "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0},
+    "lift_reserve_nondim": 0.05,
+    "tether": {"breaking_strength_n": 20000.0, "safety_factor_nondim": 5.0},
+    "haul_down": {
+        "forecast": [{"time_s": 0.0, "wind_speed_m_s": 5.0}, {"time_s": 3600.0, "wind_speed_m_s": 15.0}],
+        "max_operating_wind_m_s": 12.0
+    }
+}))]
+pub struct PlanRequest {
+    pub cable: CableInput,
+    pub aerostat: AerostatInput,
+    /// Cable length now (m): where the plan starts.
+    #[serde(default = "default_initial_length")]
+    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    pub initial_length_m: f64,
+    /// Gravitational acceleration (m/s²).
+    #[serde(default = "default_gravity")]
+    #[schema(example = 9.81, exclusive_minimum = 0.0)]
+    pub gravity_m_s2: f64,
+    /// Discretisation of the transient check (the plan itself uses the
+    /// converged continuum criterion).
+    #[serde(default)]
+    pub model: ModelInput,
+    /// Cable length to end at (m); below `initial_length_m` plans a retrieval.
+    #[schema(example = 1200.0, exclusive_minimum = 0.0, maximum = 1e6)]
+    pub target_elevation_m: f64,
+    pub winch: WinchInput,
+    /// Stay stable with the net buoyancy reduced by this fraction
+    /// (helium loss, temperature, downdraft).
+    #[serde(default = "default_reserve")]
+    #[schema(example = 0.05, minimum = 0.0, maximum = 0.9)]
+    pub lift_reserve_nondim: f64,
+    /// Tether rating: the plan keeps the largest tension within
+    /// breaking strength / safety factor.
+    #[serde(default)]
+    pub tether: Option<TetherRatingInput>,
+    /// Retrieval only: the largest growth of an oscillation's tip amplitude
+    /// over the retrieval (the winch is slowed to meet it when it can).
+    #[serde(default)]
+    #[schema(exclusive_minimum = 0.0, maximum = 1e6)]
+    pub max_amplification_nondim: Option<f64>,
+    /// Haul-down deadline under a wind forecast.
+    #[serde(default)]
+    pub haul_down: Option<HaulDownInput>,
+    /// Tip deflection of the first-mode disturbance of the transient check (m).
+    #[serde(default = "default_disturbance")]
+    #[schema(example = 0.1, exclusive_minimum = 0.0, maximum = 1e3)]
+    pub disturbance_tip_deflection_m: f64,
+    /// Evenly spaced schedule samples (phase boundaries are added).
+    #[serde(default = "default_samples")]
+    #[schema(example = 201, minimum = 2, maximum = 10000)]
+    pub samples: usize,
+}
+
+fn default_initial_length() -> f64 {
+    1.0
+}
+fn default_gravity() -> f64 {
+    9.81
+}
+fn default_reserve() -> f64 {
+    0.05
+}
+fn default_disturbance() -> f64 {
+    0.1
+}
+fn default_samples() -> usize {
+    201
+}
+
+/// One instant of the schedule.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct PlanSampleOutput {
+    pub time_s: f64,
+    /// Cable length L (m).
+    pub length_m: f64,
+    /// Winch rate L̇ (m/s); negative hauls in.
+    pub rate_m_s: f64,
+    /// Winch acceleration L̈ (m/s²) from this instant on.
+    pub acceleration_m_s2: f64,
+    /// Axial tension at the winch, F − mL̈ − ρA(g + L̈)L (N).
+    pub winch_tension_n: f64,
+    /// Largest axial tension along the cable (N): at the aerostat, F − mL̈.
+    pub max_tension_n: f64,
+    /// Largest stable rate here at this acceleration with the lift reserve (m/s).
+    pub rate_ceiling_m_s: f64,
+    /// rate_ceiling_m_s − |rate_m_s| (m/s): ≥ 0 is stable.
+    pub stability_margin_m_s: f64,
+    /// Effective tension at the roller with the reserve (N):
+    /// (1−r)F − mL̈ − ρA(g + L̈)L − ρA L̇² ≥ 0 is stable.
+    pub effective_tension_margin_n: f64,
+}
+
+/// A stretch of the schedule under one limit: a line of the operator's table.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct PlanPhaseOutput {
+    pub start_time_s: f64,
+    pub end_time_s: f64,
+    pub start_length_m: f64,
+    pub end_length_m: f64,
+    pub start_rate_m_s: f64,
+    pub end_rate_m_s: f64,
+    /// Mean acceleration over the phase (m/s²).
+    pub mean_acceleration_m_s2: f64,
+    /// `winch_acceleration`, `winch_rate`, `stability`, `tension` or `winch_braking`.
+    pub limit: String,
+    /// What the winch operator does.
+    pub instruction: String,
+}
+
+/// The best constant-rate plan with the same limits.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct ConstantRateOutput {
+    /// Cruise rate, ramps at the acceleration limit (m/s).
+    pub rate_m_s: f64,
+    pub duration_s: f64,
+    /// duration_s − the plan's duration (s).
+    pub time_saved_s: f64,
+    /// time_saved_s / duration_s.
+    pub time_saved_fraction_nondim: f64,
+}
+
+/// The SPEC §7 orientation bound.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct PlanBoundOutput {
+    /// Minimum time with the static ceiling v ≤ √((1−r)F/ρA − gL) and the winch limits (s).
+    pub duration_s: f64,
+    /// plan duration / bound − 1.
+    pub plan_excess_fraction_nondim: f64,
+    /// Why the plan differs from the bound.
+    pub explanation: String,
+}
+
+/// The FE transient run of the schedule.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct TransientCheckOutput {
+    pub elements: usize,
+    pub time_step_s: f64,
+    pub steps: usize,
+    /// The schedule (s).
+    pub run_duration_s: f64,
+    /// First-mode disturbance at the start (m).
+    pub initial_tip_deflection_m: f64,
+    pub peak_tip_deflection_m: f64,
+    /// First-mode tip amplitude at the end, at rest (m): projection of the final state on the rest mode.
+    pub final_tip_amplitude_m: f64,
+    /// final / initial.
+    pub amplification_nondim: f64,
+    /// `completed`, `diverged`, `length_collapsed` or `cancelled`.
+    pub outcome: String,
+}
+
+/// Oscillation growth (both directions) and, retrieving, the tension rise.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct OscillationOutput {
+    /// WKB tip-amplitude ratio end/start, [ψ(2m̃+l)]^(-1/2); null beyond the one-mode model's limit.
+    pub wkb_amplification_nondim: Option<f64>,
+    /// The same WKB invariant with the FE string's own first rest mode in place of sin(πζ/2): A ∝ (ω φᵀMφ)^(-1/2).
+    pub wkb_fe_mode_amplification_nondim: Option<f64>,
+    /// WKB mode-energy ratio end/start (ψ₁/ψ₀).
+    pub wkb_energy_amplification_nondim: Option<f64>,
+    /// From the transient run.
+    pub transient_amplification_nondim: Option<f64>,
+    /// The limit asked for, if any.
+    pub max_amplification_nondim: Option<f64>,
+    /// Whether the winch was slowed below its rate limit to meet it.
+    pub slowed_for_amplification: bool,
+    /// Rate limit the plan used (m/s).
+    pub rate_limit_used_m_s: f64,
+}
+
+/// Retrieval only.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct RetrievalOutput {
+    /// Largest winch-tension rise from hauling in, −(m + ρA L) L̈ (N).
+    pub tension_rise_n: f64,
+    /// Largest winch tension during the retrieval (N).
+    pub peak_winch_tension_n: f64,
+    /// Winch tension at rest at the start (N).
+    pub initial_winch_tension_n: f64,
+    /// Why a retrieval has no stability verdict.
+    pub note: String,
+}
+
+/// Haul-down deadline.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct HaulDownOutput {
+    /// First time the forecast wind exceeds the limit (s); null: never within the forecast.
+    pub wind_exceeds_limit_at_s: Option<f64>,
+    /// Fastest safe haul-down from the operating altitude (s).
+    pub retrieval_duration_s: f64,
+    /// Operating altitude the haul-down starts from (m).
+    pub from_length_m: f64,
+    /// Length it ends at (m).
+    pub to_length_m: f64,
+    /// Latest start of the haul-down (s from now); null without an exceedance.
+    pub latest_start_s: Option<f64>,
+    pub go: bool,
+    pub reason: String,
+}
+
+/// Limits and margins of the plan.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct PlanLimitsOutput {
+    /// (1 − r)F (N).
+    pub reserve_buoyancy_n: f64,
+    /// Static lift limit with the reserve and the margin (m).
+    pub lift_limit_m: f64,
+    /// Breaking strength / safety factor (N), if rated.
+    pub allowable_tension_n: Option<f64>,
+    /// Effective-tension margin kept at every instant, ε(1 − r)F (N).
+    pub stability_margin_n: f64,
+    /// Smallest stability margin over the samples (m/s).
+    pub min_stability_margin_m_s: Option<f64>,
+    /// Smallest effective tension over the samples (N).
+    pub min_effective_tension_margin_n: Option<f64>,
+    /// Largest tension over the samples (N).
+    pub peak_tension_n: Option<f64>,
+    /// Smallest tension safety factor over the samples (breaking strength / peak tension).
+    pub min_safety_factor_nondim: Option<f64>,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct PlanResponse {
+    /// Whether a schedule exists within every limit.
+    pub feasible: bool,
+    /// Overall go/no-go: feasible and, with a forecast, down before the wind limit.
+    pub go: bool,
+    /// `deployment` or `retrieval`.
+    pub direction: String,
+    /// Plan duration (s); null when infeasible.
+    pub duration_s: Option<f64>,
+    /// When infeasible: `static_lift_limit`, `tension_limit` or `amplification_limit`.
+    pub binding_limit: Option<String>,
+    /// Plain-language verdict.
+    pub reason: String,
+    /// The schedule, sampled (evenly spaced plus every phase boundary).
+    pub schedule: Vec<PlanSampleOutput>,
+    /// The operator's table: one line per phase.
+    pub phases: Vec<PlanPhaseOutput>,
+    pub constant_rate: Option<ConstantRateOutput>,
+    pub bound: Option<PlanBoundOutput>,
+    pub transient_check: Option<TransientCheckOutput>,
+    pub oscillation: Option<OscillationOutput>,
+    pub retrieval: Option<RetrievalOutput>,
+    pub haul_down: Option<HaulDownOutput>,
+    pub limits: PlanLimitsOutput,
+    /// How the schedule was found and checked.
+    pub method: String,
+    /// Computation time of the plan (s).
+    pub compute_time_s: f64,
+    /// The request as understood (every input, defaults filled in).
+    #[schema(value_type = Object)]
+    pub inputs: serde_json::Value,
+    pub groups: Groups,
+}

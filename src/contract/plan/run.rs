@@ -1,0 +1,464 @@
+//! Runs a plan request: validation, the speed-profile pass
+//! ([`crate::numerics::plan::schedule`]), the transient check and WKB
+//! growth ([`crate::numerics::plan::retrieval`]), the haul-down deadline
+//! ([`crate::numerics::plan::deadline`]), and the conversion to SI output.
+
+use std::time::Instant;
+
+use crate::contract::dto::SystemInput;
+use crate::contract::plan::dto::*;
+use crate::contract::run::{Progress, RequestError, groups};
+use crate::numerics::params::{InvalidInput, require_finite, require_positive};
+use crate::numerics::plan::deadline::{self, Forecast};
+use crate::numerics::plan::retrieval::{self, TransientCheck};
+use crate::numerics::plan::schedule::{self, PlanOutcome, Schedule};
+use crate::numerics::plan::{BindingLimit, PlanProblem, STABILITY_MARGIN, Winch};
+use crate::numerics::string::StringModel;
+use crate::numerics::string::transient::{Observer, RunOutcome, TransientError};
+
+/// Progress of the contract seen as a numerics observer.
+struct ProgressObserver<'a>(&'a dyn Progress);
+
+impl Observer for ProgressObserver<'_> {
+    fn report(&self, done: usize, total: usize) {
+        self.0.report(done, total);
+    }
+    fn cancelled(&self) -> bool {
+        self.0.cancelled()
+    }
+}
+
+fn from_transient(e: TransientError) -> RequestError {
+    match e {
+        TransientError::Invalid(e) => RequestError::Invalid(e),
+        TransientError::Qep(e) => RequestError::Numerical(e),
+    }
+}
+
+/// Most schedule samples.
+pub const MAX_PLAN_SAMPLES: usize = 10_000;
+
+/// The validated inputs.
+struct Validated {
+    model: StringModel,
+    problem: PlanProblem,
+    forecast: Option<(Forecast, f64)>,
+    amplification_limit: Option<f64>,
+    breaking_strength_n: Option<f64>,
+}
+
+fn bounded(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64, InvalidInput> {
+    require_finite(field, value)?;
+    if !(lo..=hi).contains(&value) {
+        return Err(InvalidInput::new(
+            field,
+            format!("must be between {lo} and {hi}, got {value}"),
+        ));
+    }
+    Ok(value)
+}
+
+fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
+    let system_input = SystemInput {
+        cable: req.cable.clone(),
+        aerostat: req.aerostat.clone(),
+        initial_length_m: req.initial_length_m,
+        gravity_m_s2: req.gravity_m_s2,
+        model: req.model.clone(),
+    };
+    let model = system_input.model()?;
+    let winch = Winch::new(req.winch.max_rate_m_s, req.winch.max_acceleration_m_s2)?;
+    let (allowable, breaking) = match &req.tether {
+        Some(t) => {
+            let b = require_positive("tether.breaking_strength_n", t.breaking_strength_n)?;
+            bounded("tether.breaking_strength_n", b, 0.0, 1e9)?;
+            let sf = bounded("tether.safety_factor_nondim", t.safety_factor_nondim, 1.0, 100.0)?;
+            (Some(b / sf), Some(b))
+        }
+        None => (None, None),
+    };
+    require_finite("target_elevation_m", req.target_elevation_m)?;
+    let problem = PlanProblem::new(
+        model.system,
+        req.target_elevation_m,
+        winch,
+        req.lift_reserve_nondim,
+        allowable,
+    )?;
+    if !(2..=MAX_PLAN_SAMPLES).contains(&req.samples) {
+        return Err(InvalidInput::new(
+            "samples",
+            format!(
+                "must be between 2 and {MAX_PLAN_SAMPLES}, got {}",
+                req.samples
+            ),
+        ));
+    }
+    require_positive(
+        "disturbance_tip_deflection_m",
+        req.disturbance_tip_deflection_m,
+    )?;
+    bounded(
+        "disturbance_tip_deflection_m",
+        req.disturbance_tip_deflection_m,
+        0.0,
+        1e3,
+    )?;
+    let amplification_limit = match req.max_amplification_nondim {
+        Some(a) => Some(bounded(
+            "max_amplification_nondim",
+            require_positive("max_amplification_nondim", a)?,
+            0.0,
+            1e6,
+        )?),
+        None => None,
+    };
+    let forecast = match &req.haul_down {
+        Some(h) => {
+            let pts: Vec<(f64, f64)> = h
+                .forecast
+                .iter()
+                .map(|p| (p.time_s, p.wind_speed_m_s))
+                .collect();
+            for (i, p) in h.forecast.iter().enumerate() {
+                bounded(
+                    &format!("haul_down.forecast[{i}].time_s"),
+                    p.time_s,
+                    0.0,
+                    1e9,
+                )?;
+                bounded(
+                    &format!("haul_down.forecast[{i}].wind_speed_m_s"),
+                    p.wind_speed_m_s,
+                    0.0,
+                    200.0,
+                )?;
+            }
+            let f = Forecast::new(&pts, "haul_down.forecast")?;
+            let limit = require_positive(
+                "haul_down.max_operating_wind_m_s",
+                h.max_operating_wind_m_s,
+            )?;
+            bounded("haul_down.max_operating_wind_m_s", limit, 0.0, 200.0)?;
+            Some((f, limit))
+        }
+        None => None,
+    };
+    Ok(Validated {
+        model,
+        problem,
+        forecast,
+        amplification_limit,
+        breaking_strength_n: breaking,
+    })
+}
+
+/// Checks a plan request without computing it (job submission).
+pub fn validate_plan(req: &PlanRequest) -> Result<(), RequestError> {
+    validate(req)?;
+    Ok(())
+}
+
+fn outcome_name(o: &RunOutcome) -> &'static str {
+    match o {
+        RunOutcome::Completed => "completed",
+        RunOutcome::Diverged { .. } => "diverged",
+        RunOutcome::LengthCollapsed { .. } => "length_collapsed",
+        RunOutcome::Cancelled { .. } => "cancelled",
+    }
+}
+
+fn check_output(c: &TransientCheck) -> TransientCheckOutput {
+    TransientCheckOutput {
+        elements: c.elements,
+        time_step_s: c.time_step_s,
+        steps: c.steps,
+        run_duration_s: c.run_duration_s,
+        initial_tip_deflection_m: c.initial_tip_deflection_m,
+        peak_tip_deflection_m: c.peak_tip_deflection_m,
+        final_tip_amplitude_m: c.final_tip_amplitude_m,
+        amplification_nondim: c.amplification,
+        outcome: outcome_name(&c.outcome).into(),
+    }
+}
+
+fn samples_output(p: &PlanProblem, s: &Schedule, count: usize) -> Vec<PlanSampleOutput> {
+    s.samples(count)
+        .into_iter()
+        .map(|(t, k)| {
+            let ceiling = p.rate_ceiling_m_s(k.length_m, k.acceleration_m_s2);
+            PlanSampleOutput {
+                time_s: t,
+                length_m: k.length_m,
+                rate_m_s: k.rate_m_s,
+                acceleration_m_s2: k.acceleration_m_s2,
+                winch_tension_n: p.winch_tension_n(k.length_m, k.acceleration_m_s2),
+                max_tension_n: p.max_tension_n(k.length_m, k.acceleration_m_s2),
+                rate_ceiling_m_s: ceiling,
+                stability_margin_m_s: ceiling - k.rate_m_s.abs(),
+                effective_tension_margin_n: p.effective_tension_n(
+                    k.length_m,
+                    k.rate_m_s,
+                    k.acceleration_m_s2,
+                ),
+            }
+        })
+        .collect()
+}
+
+fn phases_output(s: &Schedule) -> Vec<PlanPhaseOutput> {
+    s.phases()
+        .into_iter()
+        .map(|ph| {
+            let dt = ph.end.time_s - ph.start.time_s;
+            PlanPhaseOutput {
+                start_time_s: ph.start.time_s,
+                end_time_s: ph.end.time_s,
+                start_length_m: ph.start.length_m,
+                end_length_m: ph.end.length_m,
+                start_rate_m_s: ph.start.rate_m_s,
+                end_rate_m_s: ph.end.rate_m_s,
+                mean_acceleration_m_s2: if dt > 0.0 {
+                    (ph.end.rate_m_s - ph.start.rate_m_s) / dt
+                } else {
+                    0.0
+                },
+                limit: ph.limit.name().into(),
+                instruction: ph.limit.instruction().into(),
+            }
+        })
+        .collect()
+}
+
+const METHOD: &str = "Time-optimal speed-profile pass along the length (forward/backward, as in time-optimal \
+path planning): constant acceleration on each of 4000 length segments; a backward pass from rest at the target \
+gives the largest viable rate at each length (a two-variable LP per segment), a forward pass from rest takes the \
+largest admissible acceleration. Constraints at both ends of every segment (hence on all of it, since they are \
+linear in length there): winch rate and acceleration, the tension rating on the largest axial tension F − mL̈, and \
+stability with the lift reserve r in its converged continuum form (the FE critical length converges to it from \
+above, SPEC §5): effective roller tension (1−r)F − mL̈ − ρA(g+L̈)L − ρA L̇² ≥ ε(1−r)F with ε = 1e-3. The schedule \
+is then run on the FE string (Newmark, first-mode disturbance) and the oscillation growth compared with WKB \
+(thesis (3.12)).";
+
+/// Answers a plan request.
+pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, RequestError> {
+    let started = Instant::now();
+    let v = validate(req)?;
+    let p = v.problem;
+    let observer = ProgressObserver(progress);
+    let retrieving = p.direction() < 0.0;
+    let direction = if retrieving { "retrieval" } else { "deployment" };
+    let inputs = serde_json::to_value(req).expect("requests serialise");
+    let limits_base = PlanLimitsOutput {
+        reserve_buoyancy_n: p.reserve_buoyancy_n(),
+        lift_limit_m: p.lift_limit_m(),
+        allowable_tension_n: p.allowable_tension_n,
+        stability_margin_n: STABILITY_MARGIN * p.reserve_buoyancy_n(),
+        min_stability_margin_m_s: None,
+        min_effective_tension_margin_n: None,
+        peak_tension_n: None,
+        min_safety_factor_nondim: None,
+    };
+    let infeasible = |b: BindingLimit, limits: PlanLimitsOutput| PlanResponse {
+        feasible: false,
+        go: false,
+        direction: direction.into(),
+        duration_s: None,
+        binding_limit: Some(b.name().into()),
+        reason: format!("no-go: {}", b.reason(p.lift_reserve)),
+        schedule: vec![],
+        phases: vec![],
+        constant_rate: None,
+        bound: None,
+        transient_check: None,
+        oscillation: None,
+        retrieval: None,
+        haul_down: None,
+        limits,
+        method: METHOD.into(),
+        compute_time_s: started.elapsed().as_secs_f64(),
+        inputs: inputs.clone(),
+        groups: groups(&v.model.system),
+    };
+
+    // The schedule (slowed for an amplification limit when retrieving).
+    let (sched, check, rate_used, slowed) = match (retrieving, v.amplification_limit) {
+        (true, Some(limit)) => {
+            match retrieval::bounded_retrieval(
+                &p,
+                &v.model,
+                limit,
+                req.disturbance_tip_deflection_m,
+                &observer,
+            )
+            .map_err(from_transient)?
+            {
+                Ok(b) => (b.schedule, b.check, b.rate_limit_m_s, b.slowed),
+                Err(binding) => {
+                    // A static limit takes precedence over the amplification.
+                    if let PlanOutcome::Infeasible(b) = schedule::fastest(&p) {
+                        return Ok(infeasible(b, limits_base));
+                    }
+                    return Ok(infeasible(binding, limits_base));
+                }
+            }
+        }
+        _ => match schedule::fastest(&p) {
+            PlanOutcome::Infeasible(b) => return Ok(infeasible(b, limits_base)),
+            PlanOutcome::Feasible(s) => {
+                let c = retrieval::check_transient(
+                    &v.model,
+                    &s,
+                    req.disturbance_tip_deflection_m,
+                    &observer,
+                )
+                .map_err(from_transient)?;
+                (s, c, p.winch.max_rate_m_s, false)
+            }
+        },
+    };
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    let schedule_out = samples_output(&p, &sched, req.samples);
+    let min_of = |f: fn(&PlanSampleOutput) -> f64| {
+        schedule_out.iter().map(f).fold(f64::INFINITY, f64::min)
+    };
+    let peak_tension = schedule_out
+        .iter()
+        .map(|s| s.max_tension_n)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let limits = PlanLimitsOutput {
+        min_stability_margin_m_s: Some(min_of(|s| s.stability_margin_m_s)),
+        min_effective_tension_margin_n: Some(min_of(|s| s.effective_tension_margin_n)),
+        peak_tension_n: Some(peak_tension),
+        min_safety_factor_nondim: v.breaking_strength_n.map(|b| b / peak_tension),
+        ..limits_base
+    };
+
+    let constant_rate = {
+        let mut pc = p;
+        pc.winch.max_rate_m_s = rate_used;
+        schedule::best_constant_rate(&pc).map(|c| ConstantRateOutput {
+            rate_m_s: c.rate_m_s,
+            duration_s: c.duration_s,
+            time_saved_s: c.duration_s - sched.duration_s,
+            time_saved_fraction_nondim: (c.duration_s - sched.duration_s) / c.duration_s,
+        })
+    };
+    let bound = schedule::static_ceiling_bound_s(&p).map(|b| {
+        let excess = sched.duration_s / b - 1.0;
+        let explanation = if excess.abs() <= 1e-3 {
+            "the plan meets the bound: the stability ceiling does not bind during the acceleration phases".to_string()
+        } else if excess < 0.0 {
+            format!(
+                "the plan is {:.1} % faster than the bound: braking raises the roller tension by (m + ρA L)|L̈|, \
+                 so rates above the static ceiling are stable while slowing down",
+                -100.0 * excess
+            )
+        } else if slowed {
+            format!(
+                "the plan is {:.1} % slower than the bound: the winch was slowed to keep the oscillation growth within the limit",
+                100.0 * excess
+            )
+        } else {
+            format!(
+                "the plan is {:.1} % slower than the bound: speeding up lowers the roller tension by (m + ρA L)L̈ \
+                 (the bound ignores it), the tension rating limits braking, and ε keeps a margin",
+                100.0 * excess
+            )
+        };
+        PlanBoundOutput {
+            duration_s: b,
+            plan_excess_fraction_nondim: excess,
+            explanation,
+        }
+    });
+    let (l_start, l_end) = (p.system.initial_length_m, p.target_length_m);
+    let wkb = retrieval::wkb_growth(&v.model, l_start, l_end);
+    let oscillation = OscillationOutput {
+        wkb_amplification_nondim: wkb.map(|w| w.amplitude),
+        wkb_fe_mode_amplification_nondim: retrieval::wkb_growth_fe(&v.model, l_start, l_end),
+        wkb_energy_amplification_nondim: wkb.map(|w| w.energy),
+        transient_amplification_nondim: Some(check.amplification),
+        max_amplification_nondim: v.amplification_limit,
+        slowed_for_amplification: slowed,
+        rate_limit_used_m_s: rate_used,
+    };
+    let retrieval_out = retrieving.then(|| {
+        let samples = sched.samples(req.samples);
+        let (rise, peak) = retrieval::tension_rise_n(&p, &samples);
+        RetrievalOutput {
+            tension_rise_n: rise,
+            peak_winch_tension_n: peak,
+            initial_winch_tension_n: p.winch_tension_n(l_start, 0.0),
+            note: "Shortening is unstable at every instant (the symmetric part of the damping is −(|L̇|/L)·M: \
+                   negative), so a retrieval has no stability verdict; the plan keeps the roller tension positive \
+                   (no divergence) and reports how an oscillation grows."
+                .into(),
+        }
+    });
+
+    // Haul-down deadline: from the operating altitude down to the lower end.
+    let haul_down = match &v.forecast {
+        Some((forecast, limit)) => {
+            let (high, low) = (l_start.max(l_end), l_start.min(l_end));
+            let duration = if retrieving {
+                Some(sched.duration_s)
+            } else {
+                match schedule::fastest(&p.between(high, low)) {
+                    PlanOutcome::Feasible(s) => Some(s.duration_s),
+                    PlanOutcome::Infeasible(_) => None,
+                }
+            };
+            duration.map(|d| {
+                let aloft_from = if retrieving { 0.0 } else { sched.duration_s };
+                let h = deadline::haul_down(forecast, *limit, d, aloft_from);
+                HaulDownOutput {
+                    wind_exceeds_limit_at_s: h.exceeds_at_s,
+                    retrieval_duration_s: h.retrieval_duration_s,
+                    from_length_m: high,
+                    to_length_m: low,
+                    latest_start_s: h.latest_start_s,
+                    go: h.go,
+                    reason: h.reason,
+                }
+            })
+        }
+        None => None,
+    };
+    let go = haul_down.as_ref().is_none_or(|h| h.go);
+    let mut reason = format!(
+        "{}: {direction} from {l_start:.1} m to {l_end:.1} m in {:.1} s, stable with a {:.1} % lift reserve at every instant",
+        if go { "go" } else { "no-go" },
+        sched.duration_s,
+        100.0 * p.lift_reserve
+    );
+    if let Some(t) = p.allowable_tension_n {
+        reason.push_str(&format!(", tension within {t:.0} N"));
+    }
+    if let Some(h) = &haul_down {
+        reason.push_str(&format!("; haul-down: {}", h.reason));
+    }
+    Ok(PlanResponse {
+        feasible: true,
+        go,
+        direction: direction.into(),
+        duration_s: Some(sched.duration_s),
+        binding_limit: None,
+        reason,
+        schedule: schedule_out,
+        phases: phases_output(&sched),
+        constant_rate,
+        bound,
+        transient_check: Some(check_output(&check)),
+        oscillation: Some(oscillation),
+        retrieval: retrieval_out,
+        haul_down,
+        limits,
+        method: METHOD.into(),
+        compute_time_s: started.elapsed().as_secs_f64(),
+        inputs,
+        groups: groups(&v.model.system),
+    })
+}

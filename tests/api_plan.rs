@@ -1,0 +1,134 @@
+//! `POST /api/v1/plan` and `tetherplan plan`: the documented example posts
+//! as is, the route answers what the contract answers, unknown fields and
+//! bad values are refused with their field path, and the CLI prints the
+//! same plan.
+
+use std::io::Write;
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::sync::Arc;
+
+use axum::body::Body;
+use axum::http::{Request, StatusCode, header};
+use http_body_util::BodyExt;
+use serde_json::{Value, json};
+use tetherplan::api::{self, AppState};
+use tetherplan::config::Limits;
+use tetherplan::jobs::JobQueue;
+use tetherplan::jobs::store::JobStore;
+use tower::ServiceExt;
+
+fn app() -> axum::Router {
+    let queue = Arc::new(JobQueue::new(
+        JobStore::open_in_memory().unwrap(),
+        1,
+        Limits::default(),
+    ));
+    api::router(AppState::new(queue), Path::new("static"))
+}
+
+async fn post(body: &Value) -> (StatusCode, Value) {
+    let req = Request::builder()
+        .method("POST")
+        .uri("/api/v1/plan")
+        .header(header::CONTENT_TYPE, "application/json")
+        .body(Body::from(serde_json::to_vec(body).unwrap()))
+        .unwrap();
+    let resp = app().oneshot(req).await.unwrap();
+    let status = resp.status();
+    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
+    (status, serde_json::from_slice(&bytes).unwrap())
+}
+
+/// The request example of the OpenAPI document.
+fn example() -> Value {
+    let doc: Value = serde_json::from_str(&tetherplan::api::openapi::openapi_json()).unwrap();
+    doc["components"]["schemas"]["PlanRequest"]["example"].clone()
+}
+
+#[tokio::test]
+async fn the_documented_example_succeeds_as_is() {
+    let body = example();
+    assert!(body.is_object(), "PlanRequest has an example");
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::OK, "{r}");
+    assert_eq!(r["feasible"], true);
+    assert_eq!(r["go"], true, "{}", r["reason"]);
+    let d = r["duration_s"].as_f64().unwrap();
+    assert!((d - 49.975).abs() < 0.01, "{d}");
+    // Every input recorded, defaults filled in.
+    assert_eq!(r["inputs"]["lift_reserve_nondim"], 0.05);
+    assert_eq!(r["inputs"]["samples"], 201);
+    assert!(r["schedule"].as_array().unwrap().len() >= 201);
+    let h = &r["haul_down"];
+    // 5 → 15 m/s over an hour: 12 m/s at 2520 s.
+    assert!((h["wind_exceeds_limit_at_s"].as_f64().unwrap() - 2520.0).abs() < 1e-6);
+    assert_eq!(h["go"], true);
+}
+
+#[tokio::test]
+async fn unknown_fields_and_bad_values_name_their_path() {
+    let mut body = example();
+    body["winch"]["max_jerk"] = json!(1.0);
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
+    assert_eq!(r["error"]["field"], "winch.max_jerk", "{r}");
+    assert!(r["error"]["message"].as_str().unwrap().contains("max_jerk"));
+
+    let mut body = example();
+    body["lift_reserve_nondim"] = json!(1.5);
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(r["error"]["field"], "lift_reserve_nondim");
+
+    let mut body = example();
+    body["haul_down"]["forecast"][1]["time_s"] = json!(0.0);
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(r["error"]["field"], "haul_down.forecast[1].time_s");
+
+    let mut body = example();
+    body["target_elevation_m"] = json!(1.0);
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(r["error"]["field"], "target_elevation_m");
+
+    let mut body = example();
+    body["surprise"] = json!(true);
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert!(r["error"]["message"].as_str().unwrap().contains("surprise"));
+}
+
+#[tokio::test]
+async fn infeasible_is_an_answer_not_an_error() {
+    let mut body = example();
+    body["target_elevation_m"] = json!(1290.0);
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::OK);
+    assert_eq!(r["feasible"], false);
+    assert_eq!(r["binding_limit"], "static_lift_limit");
+    assert!(r["reason"].as_str().unwrap().starts_with("no-go"));
+}
+
+#[test]
+fn cli_prints_the_same_plan() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tetherplan"))
+        .arg("plan")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(example().to_string().as_bytes())
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success());
+    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["feasible"], true);
+    assert!((r["duration_s"].as_f64().unwrap() - 49.975).abs() < 0.01);
+}
