@@ -56,6 +56,9 @@ enum Command {
     /// Response against forcing frequency: wind on the linear string, or
     /// `"excitation": "base"` (shaken platform, GE cable).
     FrequencyResponse(InputArg),
+    /// Uncertainty bands of a deployment chart: 5/50/95 % of h* and t*
+    /// per rate under uncertain inputs (seeded Monte Carlo).
+    Bands(InputArg),
 }
 
 /// A progress bar on standard error for `total` units of `what`.
@@ -175,6 +178,12 @@ fn main() -> ExitCode {
         return serve(cli.serve);
     };
     match &command {
+        Command::Bands(arg) => answer_with(arg, contract::bands::parse_bands, |req| {
+            let bar = progress_bar(req.params.uncertainty.samples as u64, "samples");
+            let out = contract::bands::bands(req, Parallelism::Rayon, &bar);
+            bar.0.finish_and_clear();
+            out
+        }),
         Command::Serve(args) => serve(args.clone()),
         Command::Stability(arg) => answer(arg, run::stability),
         Command::Critical(arg) => answer(arg, run::critical),

@@ -107,6 +107,7 @@ pub fn router(state: AppState, static_dir: &Path) -> Router {
             "/api/v1/frequency-response",
             post(solve::compute_frequency_response),
         )
+        .route("/api/v1/bands", post(solve::compute_bands))
         .route("/api/v1/jobs", post(jobs::create_job).get(jobs::list_jobs))
         .route(
             "/api/v1/jobs/{id}",

@@ -31,6 +31,7 @@ use crate::jobs::store::JobStatus;
         solve::create_chart,
         solve::run_simulation,
         solve::compute_frequency_response,
+        solve::compute_bands,
         jobs::create_job,
         jobs::list_jobs,
         jobs::get_job,
@@ -41,7 +42,7 @@ use crate::jobs::store::JobStatus;
     components(schemas(
         ErrorBody, ErrorDetail, JobStatus, JobItem, JobSubmission, BatchSubmission, BatchKind,
         BatchOutcome, BatchItemOutcome, StabilityResponse, CriticalResponse, SafeRateResponse, ChartResponse,
-        Health,
+        Health, crate::contract::bands::BandsResponse,
     )),
     tags(
         (name = "solve", description = "Synchronous answers (about a second at most)"),

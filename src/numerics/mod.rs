@@ -14,3 +14,4 @@ pub mod qep;
 pub mod reduced;
 pub mod string;
 pub mod tridiag;
+pub mod uncertainty;
