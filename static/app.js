@@ -79,7 +79,10 @@
       },
       initial_length_m: readNumber("initial_length_m", errors),
       gravity_m_s2: readNumber("gravity_m_s2", errors),
-      model: { kind: "linear_string", elements: readNumber("model.elements", errors, { integer: true }) },
+      // No element count: the server converges every answer and gives the safe side of its error.
+      model: $("#elements").value.trim() === ""
+        ? { kind: "linear_string" }
+        : { kind: "linear_string", elements: readNumber("model.elements", errors, { integer: true }) },
     };
   }
 
@@ -99,7 +102,7 @@
   }
 
   function wantsJob(req) {
-    return chartPoints(req) > SYNC_POINT_LIMIT || chartPoints(req) * (req.model.elements || 0) > JOB_WORK_THRESHOLD;
+    return chartPoints(req) > SYNC_POINT_LIMIT || chartPoints(req) * (req.model.elements || 50) > JOB_WORK_THRESHOLD;
   }
 
   // ---------- errors next to fields ----------
@@ -308,7 +311,7 @@
     $("#download-png").disabled = false;
     const pts = chart.series.reduce((n, s) => n + s.points.length, 0);
     statusEl.dataset.series = String(chart.series.length);
-    setStatus("ready", `${chart.series.length} curves, ${pts} points, ${chart.elements} elements${via && via !== "direct" ? ` (${via})` : ""}.`);
+    setStatus("ready", `${chart.series.length} curves, ${pts} points, ${chart.converged ? "converged, safe side of the error" : `${chart.elements} elements`}${via && via !== "direct" ? ` (${via})` : ""}.`);
   }
 
   $("#log-time").addEventListener("change", () => {
@@ -511,7 +514,9 @@
       const a = r.body;
       const rows = [];
       if (a.max_rate_m_s != null) {
+        // Converged answers are already the safe side of the error bound.
         rows.push(["Largest safe rate", `${fmt(a.max_rate_m_s, 2)} m/s`]);
+        if (a.max_rate_error_m_s != null) rows.push([a.converged ? "Discretisation error (already subtracted)" : "Discretisation error of this mesh", `± ${fmt(a.max_rate_error_m_s, 3)} m/s`]);
         rows.push(["Time to reach H", `${fmt(a.time_to_target_s, 1)} s`]);
       } else {
         rows.push(["Largest safe rate", "none"]);

@@ -83,7 +83,7 @@ fn to_json(value: &impl Serialize) -> Result<Vec<u8>, ApiError> {
 }
 
 fn limit_qep_elements(system: &SystemInput, limits: &Limits, why: &str) -> Result<(), ApiError> {
-    let n = system.model.elements;
+    let n = system.model.mesh_elements();
     if n > limits.max_sync_qep_elements {
         return Err(ApiError::too_large(
             "model.elements",
@@ -99,7 +99,7 @@ fn limit_qep_elements(system: &SystemInput, limits: &Limits, why: &str) -> Resul
 /// Checks a chart against the synchronous limits.
 pub fn check_sync_chart(req: &ChartRequest, limits: &Limits) -> Result<(), ApiError> {
     let points = run::chart_points(req);
-    let work = points.saturating_mul(req.system.model.elements);
+    let work = points.saturating_mul(req.system.model.mesh_elements());
     if points > limits.max_sync_chart_points {
         return Err(ApiError::too_large(
             "rates_m_s.count",
@@ -114,7 +114,7 @@ pub fn check_sync_chart(req: &ChartRequest, limits: &Limits) -> Result<(), ApiEr
             "rates_m_s.count",
             format!(
                 "the chart has {points} points × {} elements = {work}; synchronous charts have at most {}",
-                req.system.model.elements, limits.max_sync_chart_work
+                req.system.model.mesh_elements(), limits.max_sync_chart_work
             ),
         ));
     }

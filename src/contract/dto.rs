@@ -37,23 +37,57 @@ pub struct ModelInput {
     /// Model kind.
     #[serde(default)]
     pub kind: ModelKind,
-    /// Number of finite elements (2..=2000).
-    #[serde(default = "default_elements")]
+    /// Number of uniform finite elements (2..=2000). Omitted: every
+    /// stability answer (t*, h*, safe rate, chart points) is converged to
+    /// `numerics.relative_tolerance` on meshes graded toward the roller and
+    /// given on the safe side of its error bound; the spectrum of
+    /// `/stability` and transient runs use 50 elements. Given: that mesh's
+    /// values, with their estimated error.
+    #[serde(default)]
     #[schema(example = 50, minimum = 2, maximum = 2000)]
-    pub elements: usize,
+    pub elements: Option<usize>,
 }
 
 impl Default for ModelInput {
     fn default() -> Self {
         Self {
             kind: ModelKind::LinearString,
-            elements: default_elements(),
+            elements: None,
         }
     }
 }
 
-fn default_elements() -> usize {
-    50
+/// Elements of the uniform mesh used for spectra and transient runs when
+/// `model.elements` is omitted.
+pub const DEFAULT_ELEMENTS: usize = 50;
+
+impl ModelInput {
+    /// The uniform mesh size: the one asked for, or [`DEFAULT_ELEMENTS`].
+    pub fn mesh_elements(&self) -> usize {
+        self.elements.unwrap_or(DEFAULT_ELEMENTS)
+    }
+}
+
+/// Accuracy of converged answers.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+pub struct NumericsInput {
+    /// Relative tolerance of converged answers (t*, h*, safe rate) when
+    /// `model.elements` is omitted.
+    #[serde(default = "default_relative_tolerance")]
+    #[schema(example = 1e-4, minimum = 1e-8, maximum = 1e-2)]
+    pub relative_tolerance: f64,
+}
+
+impl Default for NumericsInput {
+    fn default() -> Self {
+        Self {
+            relative_tolerance: default_relative_tolerance(),
+        }
+    }
+}
+
+fn default_relative_tolerance() -> f64 {
+    crate::numerics::string::converged::DEFAULT_RELATIVE_TOLERANCE
 }
 
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
@@ -79,6 +113,9 @@ pub struct SystemInput {
     pub gravity_m_s2: f64,
     #[serde(default)]
     pub model: ModelInput,
+    /// Accuracy of converged answers.
+    #[serde(default)]
+    pub numerics: NumericsInput,
 }
 
 fn default_initial_length() -> f64 {
@@ -337,6 +374,18 @@ pub struct CriticalResponse {
     /// Continuum estimate of h* (m): (F/ρA − v²)/g for constant rate; the
     /// root-tension estimate for constant acceleration; null when shortening.
     pub closed_form_elevation_m: Option<f64>,
+    /// Estimated discretisation error of `critical_time_s` (s); null when t*
+    /// is null. Converged answers give t* on the safe (early) side of it.
+    pub critical_time_error_s: Option<f64>,
+    /// Estimated discretisation error of `max_elevation_m` (m); null when h*
+    /// is null. Converged answers give h* on the safe (low) side of it.
+    pub max_elevation_error_m: Option<f64>,
+    /// Whether t* and h* are converged (model.elements omitted) rather than
+    /// one fixed mesh's values.
+    pub converged: bool,
+    /// Observed order of convergence in the first element's size (null
+    /// unless converged and measurable; linear elements give 1).
+    pub convergence_order_nondim: Option<f64>,
     /// `immediate`, `during` or `never`.
     pub onset: String,
     /// Plain-language account of the answer.
@@ -358,6 +407,12 @@ pub struct SafeRateResponse {
     pub max_rate_nondim: Option<f64>,
     /// Continuum estimate sqrt(F/ρA − g H) (m/s); null above the static limit.
     pub closed_form_rate_m_s: Option<f64>,
+    /// Estimated discretisation error of `max_rate_m_s` (m/s). Converged
+    /// answers give the rate on the safe (low) side of it: never above the
+    /// continuum limit.
+    pub max_rate_error_m_s: Option<f64>,
+    /// Whether the rate is converged (model.elements omitted).
+    pub converged: bool,
     /// Time to reach the target at the safe rate (s).
     pub time_to_target_s: Option<f64>,
     /// Why no rate is safe, when none is.
@@ -378,6 +433,10 @@ pub struct ChartPointOutput {
     pub max_elevation_m: f64,
     /// (F/ρA − v²)/g (m), clipped at 0.
     pub closed_form_elevation_m: f64,
+    /// Estimated discretisation error of `critical_time_s` (s).
+    pub critical_time_error_s: f64,
+    /// Estimated discretisation error of `max_elevation_m` (m).
+    pub max_elevation_error_m: f64,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
@@ -392,7 +451,12 @@ pub struct ChartSeriesOutput {
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
 pub struct ChartResponse {
     pub series: Vec<ChartSeriesOutput>,
+    /// Uniform elements, or (converged) those of the coarsest graded mesh
+    /// (each point refines from it as far as its tolerance needs).
     pub elements: usize,
+    /// Whether the points are converged (model.elements omitted); their
+    /// t* and h* are then on the safe side of the error bound.
+    pub converged: bool,
 }
 
 /// The one error body of the CLI and the API.

@@ -9,6 +9,7 @@ use crate::numerics::params::{
 use crate::numerics::profile::Profile;
 use crate::numerics::qep::QepError;
 use crate::numerics::string::StringModel;
+use crate::numerics::string::converged::{self, ConvergedConfig, ConvergedSafeRate};
 use crate::numerics::string::critical::{
     self, ImmediateCause, Onset, SafeRate, SearchConfig, SearchMethod,
 };
@@ -88,8 +89,22 @@ impl SystemInput {
     pub fn model(&self) -> Result<StringModel, InvalidInput> {
         let system = self.system()?;
         match self.model.kind {
-            ModelKind::LinearString => StringModel::new(system, self.model.elements),
+            ModelKind::LinearString => StringModel::new(system, self.model.mesh_elements()),
         }
+    }
+
+    /// Converged (elements omitted) or that uniform mesh.
+    pub fn discretisation(&self) -> Result<chart::Discretisation, InvalidInput> {
+        let tolerance = converged::validate_tolerance(
+            "numerics.relative_tolerance",
+            self.numerics.relative_tolerance,
+        )?;
+        Ok(match self.model.elements {
+            Some(n) => chart::Discretisation::Elements(n),
+            None => chart::Discretisation::Converged {
+                relative_tolerance: tolerance,
+            },
+        })
     }
 }
 
@@ -211,13 +226,71 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
             .into());
         }
     }
-    let result = critical::critical_time(
-        &model,
-        &profile,
-        SearchConfig {
-            confirm_with_qep: req.params.confirm_with_qep,
-        },
-    )?;
+    let discretisation = req.system.discretisation()?;
+    let answer = match discretisation {
+        chart::Discretisation::Converged { relative_tolerance } => {
+            let c = converged::critical_time(
+                &sys,
+                &profile,
+                ConvergedConfig {
+                    relative_tolerance,
+                    confirm_with_qep: req.params.confirm_with_qep,
+                },
+            )?;
+            let t_err = c.time_s.map(|t| t.error_estimate);
+            CriticalAnswer {
+                onset: c.onset,
+                method: c.method,
+                confirmed: c.confirmed(),
+                time_error_s: t_err,
+                length_error_m: c.length_m.map(|l| l.error_estimate),
+                order: c.time_s.map(|t| t.order).filter(|o| o.is_finite()),
+                elements: c.elements,
+                converged: true,
+                probes: c.probes,
+            }
+        }
+        chart::Discretisation::Elements(_) => {
+            let result = critical::critical_time(
+                &model,
+                &profile,
+                SearchConfig {
+                    confirm_with_qep: req.params.confirm_with_qep,
+                },
+            )?;
+            let c = converged::critical_time(
+                &sys,
+                &profile,
+                ConvergedConfig {
+                    relative_tolerance: converged::DEFAULT_RELATIVE_TOLERANCE,
+                    confirm_with_qep: false,
+                },
+            )?;
+            let (time_error_s, length_error_m) = match (result.onset, c.time_s, c.length_m) {
+                (Onset::During { time_s, length_m }, Some(t), Some(l)) => (
+                    converged::mesh_error_estimate(time_s, &t),
+                    converged::mesh_error_estimate(length_m, &l),
+                ),
+                // the mesh is stable for a while where the continuum is not
+                (Onset::During { time_s, length_m }, _, _) => {
+                    (time_s, length_m - sys.initial_length_m)
+                }
+                _ => (0.0, 0.0),
+            };
+            CriticalAnswer {
+                onset: result.onset,
+                method: result.method,
+                confirmed: result.confirmed(),
+                time_error_s: Some(time_error_s),
+                length_error_m: Some(length_error_m),
+                order: None,
+                elements: model.elements(),
+                converged: false,
+                probes: result.probes,
+            }
+        }
+    };
+    let result = &answer;
     let closed_form = match req.params.profile {
         ProfileInput::ConstantRate { rate_m_s, .. } if rate_m_s > 0.0 => {
             Some(sys.closed_form_elevation_m(rate_m_s).max(0.0))
@@ -267,16 +340,24 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
         SearchMethod::DivergenceConfirmedByQep => "divergence_confirmed_by_qep",
         SearchMethod::QepScan => "qep_scan",
     };
-    let t = result.time_s();
+    let t = match result.onset {
+        Onset::Immediate(_) => Some(0.0),
+        Onset::During { time_s, .. } => Some(time_s),
+        Onset::Never { .. } => None,
+    };
     Ok(CriticalResponse {
         critical_time_s: t,
         critical_time_nondim: t.map(|t| t / sys.time_scale_s()),
         max_elevation_m,
         closed_form_elevation_m: closed_form,
+        critical_time_error_s: t.map(|_| result.time_error_s.unwrap_or(0.0)),
+        max_elevation_error_m: max_elevation_m.map(|_| result.length_error_m.unwrap_or(0.0)),
+        converged: result.converged,
+        convergence_order_nondim: result.order,
         onset: onset.into(),
         explanation,
         method: method.into(),
-        confirmed_by_qep: result.confirmed(),
+        confirmed_by_qep: result.confirmed,
         qep_probes: result
             .probes
             .iter()
@@ -289,33 +370,82 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
             })
             .collect(),
         groups: groups(&sys),
-        elements: model.elements(),
+        elements: result.elements,
     })
+}
+
+/// A critical-time answer, converged or on one mesh, ready to print.
+struct CriticalAnswer {
+    onset: Onset,
+    method: SearchMethod,
+    confirmed: bool,
+    time_error_s: Option<f64>,
+    length_error_m: Option<f64>,
+    order: Option<f64>,
+    elements: usize,
+    converged: bool,
+    probes: Vec<critical::QepProbe>,
 }
 
 pub fn safe_rate(req: &SafeRateRequest) -> Result<SafeRateResponse, RequestError> {
     let model = req.system.model()?;
     let sys = model.system;
     let target = require_positive("target_elevation_m", req.params.target_elevation_m)?;
-    let answer = critical::safe_rate(&model, target)?;
     let closed = sys.net_buoyancy_n / sys.mass_per_length_kg_m - sys.gravity_m_s2 * target;
     let closed_form_rate_m_s = (closed > 0.0).then(|| closed.sqrt());
-    let (max_rate_m_s, max_rate_nondim, reason) = match answer {
-        SafeRate::Rate {
-            rate_m_s,
-            rate_nondim,
-        } => (Some(rate_m_s), Some(rate_nondim), None),
-        SafeRate::NoSafeRate { reason } => (None, None, Some(reason)),
+    let discretisation = req.system.discretisation()?;
+    let tolerance = match discretisation {
+        chart::Discretisation::Converged { relative_tolerance } => relative_tolerance,
+        chart::Discretisation::Elements(_) => converged::DEFAULT_RELATIVE_TOLERANCE,
     };
+    let conv = converged::safe_rate(&sys, target, tolerance)?;
+    let (max_rate_m_s, max_rate_nondim, max_rate_error_m_s, reason, elements) =
+        match (discretisation, conv) {
+            (
+                chart::Discretisation::Converged { .. },
+                ConvergedSafeRate::Rate {
+                    rate_m_s,
+                    rate_nondim,
+                    estimate,
+                },
+            ) => (
+                Some(rate_m_s),
+                Some(rate_nondim),
+                Some(estimate.error_estimate),
+                None,
+                estimate.elements,
+            ),
+            (chart::Discretisation::Converged { .. }, ConvergedSafeRate::NoSafeRate { reason }) => {
+                (None, None, None, Some(reason), converged::graded_operators(0).dim())
+            }
+            (chart::Discretisation::Elements(n), conv) => match critical::safe_rate(&model, target)? {
+                SafeRate::Rate {
+                    rate_m_s,
+                    rate_nondim,
+                } => {
+                    let error = match conv {
+                        ConvergedSafeRate::Rate { estimate, .. } => {
+                            converged::mesh_error_estimate(rate_m_s, &estimate)
+                        }
+                        // the mesh finds a rate where the continuum has none
+                        ConvergedSafeRate::NoSafeRate { .. } => rate_m_s,
+                    };
+                    (Some(rate_m_s), Some(rate_nondim), Some(error), None, n)
+                }
+                SafeRate::NoSafeRate { reason } => (None, None, None, Some(reason), n),
+            },
+        };
     Ok(SafeRateResponse {
         max_rate_m_s,
         max_rate_nondim,
         closed_form_rate_m_s,
+        max_rate_error_m_s,
+        converged: req.system.model.elements.is_none(),
         time_to_target_s: max_rate_m_s.map(|v| (target - sys.initial_length_m) / v),
         reason,
         target_elevation_m: target,
         groups: groups(&sys),
-        elements: model.elements(),
+        elements,
     })
 }
 
@@ -356,9 +486,10 @@ pub fn chart(
         req.params.net_buoyancies_n.clone()
     };
     let report = |done: usize, total: usize| progress.report(done, total);
-    let series = chart::deployment_chart(
+    let discretisation = req.system.discretisation()?;
+    let series = chart::deployment_chart_with(
         &sys,
-        model.elements(),
+        discretisation,
         &rates,
         &buoyancies,
         parallelism,
@@ -381,12 +512,24 @@ pub fn chart(
                         critical_time_s: p.critical_time_s,
                         max_elevation_m: p.max_elevation_m,
                         closed_form_elevation_m: p.closed_form_elevation_m,
+                        critical_time_error_s: p.critical_time_error_s,
+                        max_elevation_error_m: p.max_elevation_error_m,
                     })
                     .collect(),
             })
             .collect(),
-        elements: model.elements(),
+        elements: chart_elements(discretisation),
+        converged: req.system.model.elements.is_none(),
     })
+}
+
+/// Elements a chart reports: the uniform mesh, or the finest graded mesh
+/// a converged point may use.
+pub fn chart_elements(discretisation: chart::Discretisation) -> usize {
+    match discretisation {
+        chart::Discretisation::Elements(n) => n,
+        chart::Discretisation::Converged { .. } => converged::graded_operators(0).dim(),
+    }
 }
 
 impl RequestError {

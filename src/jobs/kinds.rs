@@ -135,9 +135,9 @@ impl JobKind for ChartRequest {
         let grid = &self.params.rates_m_s;
         chart::rate_grid(grid.min, grid.max, grid.count.min(2))?;
         chart::rate_grid(grid.min, grid.max, grid.count).map(drop)?;
-        chart::deployment_chart(
+        chart::deployment_chart_with(
             &model.system,
-            model.elements(),
+            self.system.discretisation()?,
             &[],
             &self.buoyancies(&model.system),
             Parallelism::Serial,
@@ -165,9 +165,9 @@ impl JobKind for ChartRequest {
             }
             let before = c * chunk_rates * buoyancies.len();
             let report = |done: usize, _: usize| progress.report(before + done, total);
-            let part = chart::deployment_chart(
+            let part = chart::deployment_chart_with(
                 &sys,
-                model.elements(),
+                self.system.discretisation()?,
                 chunk,
                 &buoyancies,
                 Parallelism::Rayon,
@@ -188,6 +188,8 @@ impl JobKind for ChartRequest {
                         critical_time_s: p.critical_time_s,
                         max_elevation_m: p.max_elevation_m,
                         closed_form_elevation_m: p.closed_form_elevation_m,
+                        critical_time_error_s: p.critical_time_error_s,
+                        max_elevation_error_m: p.max_elevation_error_m,
                     }));
             }
         }
@@ -196,7 +198,8 @@ impl JobKind for ChartRequest {
         }
         to_json(&ChartResponse {
             series,
-            elements: model.elements(),
+            elements: run::chart_elements(self.system.discretisation()?),
+            converged: self.system.model.elements.is_none(),
         })
     }
 }

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use crate::numerics::params::{AerostatSystem, InvalidInput};
 use crate::numerics::string::StringModel;
+use crate::numerics::string::converged;
 use crate::numerics::string::critical::{Onset, constant_rate_lengthening};
 use crate::numerics::string::operators::StringOperators;
 
@@ -33,7 +34,22 @@ pub struct ChartPoint {
     pub max_elevation_m: f64,
     /// `(F/ρA − v²)/g` (m), clipped at zero.
     pub closed_form_elevation_m: f64,
+    /// Estimated discretisation error of `critical_time_s` (s).
+    pub critical_time_error_s: f64,
+    /// Estimated discretisation error of `max_elevation_m` (m).
+    pub max_elevation_error_m: f64,
     pub onset: Onset,
+}
+
+/// How the points are discretised.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Discretisation {
+    /// Converged to this relative tolerance; `t*` and `h*` on the safe
+    /// side of their error bound (see [`converged`]).
+    Converged { relative_tolerance: f64 },
+    /// This many uniform elements: that mesh's values, with their error
+    /// against the converged answer.
+    Elements(usize),
 }
 
 /// One series: a net buoyancy and its points in rate order.
@@ -78,7 +94,35 @@ pub fn deployment_chart(
     parallelism: Parallelism,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<ChartSeries>, InvalidInput> {
-    crate::numerics::string::validate_elements("model.elements", elements)?;
+    deployment_chart_with(
+        base,
+        Discretisation::Elements(elements),
+        rates_m_s,
+        net_buoyancies_n,
+        parallelism,
+        progress,
+    )
+}
+
+/// [`deployment_chart`] with the discretisation chosen: converged, or a
+/// fixed uniform mesh.
+pub fn deployment_chart_with(
+    base: &AerostatSystem,
+    discretisation: Discretisation,
+    rates_m_s: &[f64],
+    net_buoyancies_n: &[f64],
+    parallelism: Parallelism,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Vec<ChartSeries>, InvalidInput> {
+    let elements = match discretisation {
+        Discretisation::Elements(n) => {
+            crate::numerics::string::validate_elements("model.elements", n)?
+        }
+        Discretisation::Converged { relative_tolerance } => {
+            converged::validate_tolerance("numerics.relative_tolerance", relative_tolerance)?;
+            crate::numerics::string::MIN_ELEMENTS
+        }
+    };
     if net_buoyancies_n.is_empty() {
         return Err(InvalidInput::new(
             "net_buoyancies_n",
@@ -107,8 +151,15 @@ pub fn deployment_chart(
     let done = AtomicUsize::new(0);
     let point = |index: usize| -> ChartPoint {
         let (s, r) = (index / rates_m_s.len(), index % rates_m_s.len());
-        let model = StringModel::with_operators(systems[s], operators.clone());
-        let p = chart_point(&model, rates_m_s[r]);
+        let p = match discretisation {
+            Discretisation::Elements(_) => {
+                let model = StringModel::with_operators(systems[s], operators.clone());
+                chart_point_with_error(&model, rates_m_s[r])
+            }
+            Discretisation::Converged { relative_tolerance } => {
+                converged_chart_point(&systems[s], rates_m_s[r], relative_tolerance)
+            }
+        };
         progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
         p
     };
@@ -140,6 +191,52 @@ pub fn chart_point(model: &StringModel, rate_m_s: f64) -> ChartPoint {
         critical_time_s,
         max_elevation_m,
         closed_form_elevation_m: sys.closed_form_elevation_m(rate_m_s).max(0.0),
+        critical_time_error_s: 0.0,
+        max_elevation_error_m: 0.0,
         onset: result.onset,
+    }
+}
+
+/// [`chart_point`] with the error of that mesh's `t*` and `h*` against the
+/// converged answer ([`converged::mesh_error_estimate`]).
+pub fn chart_point_with_error(model: &StringModel, rate_m_s: f64) -> ChartPoint {
+    let mut p = chart_point(model, rate_m_s);
+    let c = converged::constant_rate(
+        &model.system,
+        rate_m_s,
+        None,
+        converged::DEFAULT_RELATIVE_TOLERANCE,
+    );
+    if let (Onset::During { .. }, Some(t), Some(h)) = (p.onset, c.time_s, c.length_m) {
+        p.critical_time_error_s = converged::mesh_error_estimate(p.critical_time_s, &t);
+        p.max_elevation_error_m = converged::mesh_error_estimate(p.max_elevation_m, &h);
+    } else if let Onset::During { .. } = p.onset {
+        // the mesh is stable for a while where the continuum is not
+        p.critical_time_error_s = p.critical_time_s;
+        p.max_elevation_error_m = p.max_elevation_m - model.system.initial_length_m;
+    }
+    p
+}
+
+/// One converged chart point: `t*` and `h*` on the safe side of the bound.
+pub fn converged_chart_point(
+    sys: &AerostatSystem,
+    rate_m_s: f64,
+    relative_tolerance: f64,
+) -> ChartPoint {
+    let c = converged::constant_rate(sys, rate_m_s, None, relative_tolerance);
+    let (critical_time_s, max_elevation_m) = match c.onset {
+        Onset::Immediate(_) => (0.0, sys.initial_length_m),
+        Onset::During { time_s, length_m } => (time_s, length_m),
+        Onset::Never { .. } => (f64::INFINITY, f64::INFINITY),
+    };
+    ChartPoint {
+        rate_m_s,
+        critical_time_s,
+        max_elevation_m,
+        closed_form_elevation_m: sys.closed_form_elevation_m(rate_m_s).max(0.0),
+        critical_time_error_s: c.time_error_s(),
+        max_elevation_error_m: c.length_error_m(),
+        onset: c.onset,
     }
 }

@@ -17,10 +17,11 @@ import { checker, launch, target, watchConsole } from "./harness.mjs";
 
 const { url, artifacts } = target("chart_page.mjs");
 
-// The value the thesis chart gives for F = 1000 N, ρA = 0.078 kg/m, m = 10 kg,
-// L0 = 1 m, v = 10 m/s, 50 elements.
-const EXPECTED_H_M = 1310;
-const TOLERANCE = 0.01;
+// F = 1000 N, ρA = 0.078 kg/m, m = 10 kg, L0 = 1 m, v = 10 m/s: the page asks
+// for converged answers, so h* is the continuum (F/ρA − v²)/g = 1296.69 m
+// (the 50-element mesh gave 1310, 1 % high).
+const EXPECTED_H_M = 1296.69;
+const TOLERANCE = 0.001;
 
 const { failures, check } = checker();
 

@@ -164,7 +164,7 @@ pub fn critical_time(
 /// `μ*`: the supremum of `μ ≥ 0` with `base_diag/base_off − μ·(step)`
 /// positive definite, by bisection on the pivot count; `None` if not
 /// positive definite at `μ = 0`.
-fn pencil_limit(
+pub(crate) fn pencil_limit(
     n: usize,
     base: impl Fn(usize) -> f64 + Copy,
     base_off: impl Fn(usize) -> f64 + Copy,
@@ -250,7 +250,7 @@ pub fn constant_rate_lengthening(
     }
 }
 
-fn probe(
+pub(crate) fn probe(
     model: &StringModel,
     profile: &Profile,
     time_s: f64,
@@ -292,7 +292,7 @@ fn probes_around(
 
 /// Where a general search may stop: the profile's end, or once the cable
 /// is far beyond the static lift limit (surely unstable by then).
-fn search_horizon_s(model: &StringModel, profile: &Profile) -> f64 {
+pub(crate) fn search_horizon_s(model: &StringModel, profile: &Profile) -> f64 {
     let sys = &model.system;
     let far = sys.initial_length_m + 4.0 * sys.static_lift_limit_m();
     let reach = profile.time_to_length_s(far);
@@ -305,7 +305,7 @@ fn search_horizon_s(model: &StringModel, profile: &Profile) -> f64 {
 }
 
 /// Cheap divergence indicator: shortening, or `K` has a negative pivot.
-fn looks_unstable(model: &StringModel, k: Kinematics) -> bool {
+pub(crate) fn looks_unstable(model: &StringModel, k: Kinematics) -> bool {
     if k.rate_m_s < 0.0 {
         return true;
     }
@@ -318,7 +318,7 @@ fn looks_unstable(model: &StringModel, k: Kinematics) -> bool {
 
 /// Shortening profiles that stop near zero length would make `l → 0`;
 /// keep the search away from it.
-fn clamp_to_positive_length(model: &StringModel, profile: &Profile, horizon_s: f64) -> f64 {
+pub(crate) fn clamp_to_positive_length(model: &StringModel, profile: &Profile, horizon_s: f64) -> f64 {
     let min_length = 1e-3 * model.system.initial_length_m;
     if profile.kinematics(horizon_s).length_m >= min_length {
         return horizon_s;
@@ -336,7 +336,7 @@ fn clamp_to_positive_length(model: &StringModel, profile: &Profile, horizon_s: f
 }
 
 /// First time the indicator turns unstable within `[0, horizon]`.
-fn first_crossing(horizon_s: f64, samples: usize, unstable: impl Fn(f64) -> bool) -> Option<f64> {
+pub(crate) fn first_crossing(horizon_s: f64, samples: usize, unstable: impl Fn(f64) -> bool) -> Option<f64> {
     if unstable(0.0) {
         return Some(0.0);
     }
@@ -405,7 +405,7 @@ fn general_profile(model: &StringModel, profile: &Profile) -> Result<CriticalTim
     })
 }
 
-fn onset_at(
+pub(crate) fn onset_at(
     model: &StringModel,
     profile: &Profile,
     candidate: Option<f64>,

@@ -2,6 +2,7 @@
 //! operators, matrices at a state, the stability spectrum, and the
 //! critical-time and safe-rate searches built on them.
 
+pub mod converged;
 pub mod critical;
 pub mod operators;
 pub mod transient;

@@ -13,13 +13,13 @@
 //! All integrands are polynomials of degree ≤ 2 on an element; the 3-point
 //! Gauss rule integrates them exactly (consistent mass).
 
-use crate::numerics::mesh::UniformMesh;
+use crate::numerics::mesh::Mesh;
 use crate::numerics::tridiag::Tridiagonal;
 
 /// The five constant operators for one mesh.
 #[derive(Clone, Debug)]
 pub struct StringOperators {
-    pub mesh: UniformMesh,
+    pub mesh: Mesh,
     pub mass: Tridiagonal,
     pub conv: Tridiagonal,
     pub stiff_0: Tridiagonal,
@@ -56,11 +56,17 @@ pub struct SecondOrderSystem {
 }
 
 impl StringOperators {
+    /// Operators on a uniform mesh of `elements` elements.
     pub fn new(elements: usize) -> Self {
-        let mesh = UniformMesh::new(elements);
+        Self::on_mesh(Mesh::uniform(elements))
+    }
+
+    /// Operators on any mesh (e.g. graded toward the roller).
+    pub fn on_mesh(mesh: Mesh) -> Self {
+        let elements = mesh.elements();
         let n = elements; // unknowns: nodes 1..=n
         let mut ops = Self {
-            mesh,
+            mesh: mesh.clone(),
             mass: Tridiagonal::zeros(n),
             conv: Tridiagonal::zeros(n),
             stiff_0: Tridiagonal::zeros(n),
@@ -91,7 +97,7 @@ impl StringOperators {
 
     /// Number of unknowns (nodes 1..=n).
     pub fn dim(&self) -> usize {
-        self.mesh.elements
+        self.mesh.elements()
     }
 
     pub fn assemble(&self, c: &MatrixCoefficients) -> SecondOrderSystem {
