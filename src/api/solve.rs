@@ -316,13 +316,13 @@ solve_path!(
     parse = |body| contract::bands::parse_bands(body),
     |req, limits| {
         let points = contract::bands::evaluations(&req);
-        let work = points.saturating_mul(req.system.model.elements);
+        let work = points.saturating_mul(req.system.model.mesh_elements());
         if points > MAX_SYNC_BAND_EVALUATIONS || work > MAX_SYNC_BAND_WORK {
             return Err(ApiError::too_large(
                 "uncertainty.samples",
                 format!(
                     "{points} chart points (samples × rates) on {} elements take too long to answer synchronously (at most {MAX_SYNC_BAND_EVALUATIONS} points and {MAX_SYNC_BAND_WORK} points × elements): submit a job with \"kind\": \"bands\"",
-                    req.system.model.elements
+                    req.system.model.mesh_elements()
                 ),
             ));
         }

@@ -192,6 +192,13 @@ pub struct BandPointOutput {
     /// Samples unstable at once (rate at or above their wave speed, or
     /// the start already beyond the limit): `h* = L0`, `t* = 0`.
     pub immediate_samples: usize,
+    /// Largest discretisation error estimate of `h*` among the samples
+    /// (m): converged answers are on the safe side of it. Null with
+    /// `model.elements` (a fixed mesh's values are not error-estimated per
+    /// sample: omit `model.elements` for converged bands).
+    pub max_elevation_error_m: Option<f64>,
+    /// Largest discretisation error estimate of `t*` among the samples (s).
+    pub critical_time_error_s: Option<f64>,
     /// With `target_elevation_m`: the probability that it is unsafe.
     pub probability_unsafe: Option<UnsafeProbabilityOutput>,
 }
@@ -228,6 +235,8 @@ pub struct BandsResponse {
     /// `monte_carlo`: independent draws, sample `i` from its own
     /// counter-based stream of `(seed, i)`.
     pub method: String,
-    /// Elements of the mesh of each chart point.
+    /// Uniform elements, or (converged) those of the coarsest graded mesh.
     pub elements: usize,
+    /// Whether every chart point is converged (`model.elements` omitted).
+    pub converged: bool,
 }

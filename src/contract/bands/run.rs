@@ -21,7 +21,7 @@ use serde_json::{Map, Value};
 use crate::contract::bands::dto::*;
 use crate::contract::dto::SystemInput;
 use crate::contract::{Progress, RequestError, parse_value};
-use crate::numerics::chart::{self, Parallelism};
+use crate::numerics::chart::{self, Discretisation, Parallelism};
 use crate::numerics::params::{AerostatSystem, InvalidInput, require_positive};
 use crate::numerics::string::StringModel;
 use crate::numerics::string::critical::Onset;
@@ -170,7 +170,7 @@ pub struct Prepared {
     ensemble: Ensemble,
     rates: Vec<f64>,
     target: Option<f64>,
-    elements: usize,
+    discretisation: Discretisation,
 }
 
 /// Chart points of the request: samples × rates (for admission limits).
@@ -195,6 +195,7 @@ fn distribution(input: &UncertainInput) -> Distribution {
 /// Every check that needs no solve.
 pub fn prepare(req: &BandsRequest) -> Result<Prepared, RequestError> {
     let model = req.system.model()?;
+    let discretisation = req.system.discretisation()?;
     let nominal = model.system;
     let base = RawSystem::of(&req.system);
     let p = &req.params;
@@ -312,33 +313,61 @@ pub fn prepare(req: &BandsRequest) -> Result<Prepared, RequestError> {
         ensemble,
         rates,
         target,
-        elements: model.elements(),
+        discretisation,
     })
 }
 
-/// `h*`, `t*` of one chart point, and whether it is unstable at once.
+/// `h*`, `t*` of one chart point, their discretisation errors (converged
+/// points), and whether it is unstable at once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct PointValue {
     elevation_m: f64,
     time_s: f64,
+    elevation_error_m: f64,
+    time_error_s: f64,
     immediate: bool,
 }
 
-/// The chart of one system at the request's rates, as `/charts` computes it.
+/// The chart of one system at the request's rates, as `/charts` computes
+/// it: converged (graded meshes, safe side of the error bound) when
+/// `model.elements` is omitted, else that uniform mesh.
 struct ChartEvaluator {
-    operators: Arc<StringOperators>,
+    discretisation: Discretisation,
+    operators: Option<Arc<StringOperators>>,
 }
 
 impl ChartEvaluator {
+    fn new(discretisation: Discretisation) -> Self {
+        let operators = match discretisation {
+            Discretisation::Elements(n) => Some(Arc::new(StringOperators::new(n))),
+            Discretisation::Converged { .. } => None,
+        };
+        Self {
+            discretisation,
+            operators,
+        }
+    }
+
     fn chart(&self, sys: AerostatSystem, rates: &[f64]) -> Vec<PointValue> {
-        let model = StringModel::with_operators(sys, self.operators.clone());
+        let model = self
+            .operators
+            .as_ref()
+            .map(|ops| StringModel::with_operators(sys, ops.clone()));
         rates
             .iter()
             .map(|&v| {
-                let p = chart::chart_point(&model, v);
+                let p = match (&model, self.discretisation) {
+                    (Some(m), _) => chart::chart_point(m, v),
+                    (None, Discretisation::Converged { relative_tolerance }) => {
+                        chart::converged_chart_point(&sys, v, relative_tolerance)
+                    }
+                    (None, Discretisation::Elements(_)) => unreachable!("operators are built"),
+                };
                 PointValue {
                     elevation_m: p.max_elevation_m,
                     time_s: p.critical_time_s,
+                    elevation_error_m: p.max_elevation_error_m,
+                    time_error_s: p.critical_time_error_s,
                     immediate: matches!(p.onset, Onset::Immediate(_)),
                 }
             })
@@ -357,9 +386,8 @@ pub fn bands(
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
-    let evaluator = ChartEvaluator {
-        operators: Arc::new(StringOperators::new(prep.elements)),
-    };
+    let evaluator = ChartEvaluator::new(prep.discretisation);
+    let converged = matches!(prep.discretisation, Discretisation::Converged { .. });
     let nominal = evaluator.chart(prep.nominal, &prep.rates);
     // Ok(points) or Err(index of the first input whose draw is out of range)
     let results: Vec<Result<Vec<PointValue>, usize>> = prep
@@ -423,6 +451,10 @@ pub fn bands(
                 nominal_max_elevation_m: nominal[j].elevation_m,
                 nominal_critical_time_s: nominal[j].time_s,
                 immediate_samples: valid.iter().filter(|s| s[j].immediate).count(),
+                max_elevation_error_m: converged
+                    .then(|| valid.iter().map(|s| s[j].elevation_error_m).fold(0.0, f64::max)),
+                critical_time_error_s: converged
+                    .then(|| valid.iter().map(|s| s[j].time_error_s).fold(0.0, f64::max)),
                 probability_unsafe: unsafe_samples.map(|k| {
                     let p = uncertainty::percentiles::probability(k, n, uncertainty::CONFIDENCE);
                     UnsafeProbabilityOutput {
@@ -456,7 +488,8 @@ pub fn bands(
         target_elevation_m: prep.target,
         confidence_level_nondim: uncertainty::CONFIDENCE,
         method: "monte_carlo".into(),
-        elements: prep.elements,
+        elements: crate::contract::run::chart_elements(prep.discretisation),
+        converged,
     })
 }
 
@@ -651,7 +684,7 @@ mod tests {
         );
         assert_eq!(
             field_of(body(json!({"rates_m_s": {"min": 1.0, "max": 2.0, "cnt": 3}}))),
-            "rates_m_s"
+            "rates_m_s.cnt"
         );
         assert_eq!(field_of(body(json!({"rates_m_s": "fast"}))), "rates_m_s");
         assert_eq!(field_of(body(json!({"target_elevation_m": 0.0}))), "target_elevation_m");
@@ -667,14 +700,14 @@ mod tests {
     /// Rare invalid draws are counted and left out, not silently used.
     #[test]
     fn out_of_range_draws_are_counted_and_left_out() {
-        // P(m < 0) for N(10, 4.3) ≈ 1.0e-2 (just under the limit)
+        // P(m < 0) for N(10, 4.2) = Φ(−2.381) ≈ 8.6e-3 (just under the limit)
         let b = body(json!({"uncertainty": {"samples": 4000, "seed": 1, "inputs": [
-            {"field": "aerostat.mass_kg", "distribution": "normal", "mean": 10.0, "std_dev": 4.3}]}}));
+            {"field": "aerostat.mass_kg", "distribution": "normal", "mean": 10.0, "std_dev": 4.2}]}}));
         let resp = bands(&parse_bands(&b).unwrap(), Parallelism::Rayon, &NoProgress).unwrap();
         let rejected = &resp.rejected_samples[0];
         assert_eq!(rejected.field, "aerostat.mass_kg");
-        // expected 40 ± 6.3
-        assert!((15..=65).contains(&rejected.count), "{}", rejected.count);
+        // expected 34.5 ± 5.9
+        assert!((12..=60).contains(&rejected.count), "{}", rejected.count);
         assert_eq!(resp.valid_samples + rejected.count, 4000);
     }
 }

@@ -139,17 +139,29 @@ pub fn quantiles(
         .collect()
 }
 
-/// Mean and sample standard deviation, summed in the given order.
+/// Mean and sample standard deviation, summed in the given order about
+/// the first value (shifted data: exact when every value is the same, and
+/// no cancellation when the spread is small against the mean).
 pub fn mean_std(values: &[f64]) -> (f64, f64) {
     let n = values.len();
     if n == 0 {
         return (f64::NAN, f64::NAN);
     }
-    let mean = values.iter().sum::<f64>() / n as f64;
+    let shift = values[0];
+    if !shift.is_finite() {
+        let mean = values.iter().sum::<f64>() / n as f64;
+        return (mean, f64::NAN);
+    }
+    let d_mean = values.iter().map(|x| x - shift).sum::<f64>() / n as f64;
+    let mean = shift + d_mean;
     if n == 1 {
         return (mean, 0.0);
     }
-    let var = values.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+    let var = values
+        .iter()
+        .map(|x| (x - shift - d_mean).powi(2))
+        .sum::<f64>()
+        / (n - 1) as f64;
     (mean, var.sqrt())
 }
 
@@ -193,8 +205,8 @@ pub fn probability(events: usize, draws: usize, confidence: f64) -> Probability 
         draws,
         value: p,
         standard_error: (p * (1.0 - p) / n).sqrt(),
-        low: (centre - half).max(0.0),
-        high: (centre + half).min(1.0),
+        low: if events == 0 { 0.0 } else { (centre - half).max(0.0) },
+        high: if events == draws { 1.0 } else { (centre + half).min(1.0) },
     }
 }
 
@@ -269,6 +281,15 @@ mod tests {
         let asymptotic = 1.959964 * (level * (1.0 - level) / n as f64).sqrt() / density;
         let half = 0.5 * (q.high.unwrap() - q.low.unwrap());
         assert!((half / asymptotic - 1.0).abs() < 0.15, "half-width {half}, asymptotic {asymptotic}");
+    }
+
+    #[test]
+    fn mean_of_equal_values_is_exact() {
+        let x = [1304.2932925304171; 100];
+        assert_eq!(mean_std(&x), (1304.2932925304171, 0.0));
+        let (m, s) = mean_std(&[1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(m, 2.5);
+        assert!((s - (5.0f64 / 3.0).sqrt()).abs() < 1e-15);
     }
 
     #[test]

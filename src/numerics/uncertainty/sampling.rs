@@ -322,7 +322,8 @@ mod tests {
             let p = i as f64 / 200.0;
             let z = inverse_normal_cdf(p);
             assert!((normal_cdf(z) - p).abs() < 2e-7, "p = {p}");
-            assert_eq!(z, -inverse_normal_cdf(1.0 - p));
+            // 1 − p is exact here (p = i/200 has few bits); the two branches agree
+            assert!((z + inverse_normal_cdf(1.0 - p)).abs() <= 1e-15 * z.abs().max(1.0));
         }
     }
 
