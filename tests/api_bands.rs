@@ -113,7 +113,7 @@ async fn bad_input_is_a_422_naming_the_field() {
         (json!({"field": "cable.mass_per_length_kg_m", "distribution": "normal", "mean": 0.078, "std_dev": 0.001}),
          "uncertainty.inputs[0].field"),
         (json!({"field": "aerostat.net_buoyancy_n", "distribution": "triangular", "mean": 1.0}),
-         "uncertainty.inputs[0]"),
+         "uncertainty.inputs[0].distribution"),
         (json!({"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 600.0}),
          "uncertainty.inputs[0]"),
     ];
@@ -133,7 +133,7 @@ async fn bad_input_is_a_422_naming_the_field() {
     b["uncertainty"]["method"] = json!("sobol");
     let (status, text) = send(&app, "POST", "/api/v1/bands", Some(&b)).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
-    assert_eq!(error(&text).1.as_deref(), Some("uncertainty"), "{text}");
+    assert_eq!(error(&text).1.as_deref(), Some("uncertainty.method"), "{text}");
 }
 
 #[tokio::test]
