@@ -62,6 +62,9 @@ enum Command {
     Envelope(InputArg),
     /// The fastest safe deployment (or retrieval) schedule, with the haul-down deadline.
     Plan(InputArg),
+    /// Uncertainty bands of a deployment chart: 5/50/95 % of h* and t*
+    /// per rate under uncertain inputs (seeded Monte Carlo).
+    Bands(InputArg),
 }
 
 /// A progress bar on standard error for `total` units of `what`.
@@ -191,6 +194,12 @@ fn main() -> ExitCode {
         return serve(cli.serve);
     };
     match &command {
+        Command::Bands(arg) => answer_with(arg, contract::bands::parse_bands, |req| {
+            let bar = progress_bar(req.params.uncertainty.samples as u64, "samples");
+            let out = contract::bands::bands(req, Parallelism::Rayon, &bar);
+            bar.0.finish_and_clear();
+            out
+        }),
         Command::Serve(args) => serve(args.clone()),
         Command::Stability(arg) => answer_with(
             arg,

@@ -79,6 +79,12 @@ fn every_route_is_documented_with_its_statuses() {
         ),
         (
             "post",
+            "/api/v1/bands",
+            "compute_bands",
+            &["200", "400", "413", "415", "422", "500", "503", "504"],
+        ),
+        (
+            "post",
             "/api/v1/jobs",
             "create_job",
             &["200", "202", "400", "401", "413", "415", "422", "429", "500"],
@@ -148,6 +154,10 @@ fn numeric_fields_name_their_unit() {
     // Counts, ids and fractions; RateGrid's bounds are described in m/s by its parent `rates_m_s`.
     const UNITLESS: &[&str] = &[
         "elements", "modes", "count", "id", "attempts", "progress", "min", "max",
+        // Percentile bands and distributions carry their parent's unit
+        // (`max_elevation_m.p05`, the `field` an uncertain input names).
+        "p05", "p50", "p95", "p05_error", "p50_error", "p95_error", "p05_low", "p05_high",
+        "p50_low", "p50_high", "p95_low", "p95_high", "mean", "std_dev", "low", "high", "seed",
     ];
     // Dimensionless by name: ratios (E*, γ̃ as the issues name them), step
     // and sample counts, Newton iteration counts, relative tolerances.

@@ -135,6 +135,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
         .route("/api/v1/equilibrium", post(tether::compute_equilibrium))
         .route("/api/v1/envelope", post(tether::compute_envelope))
         .route("/api/v1/plan", post(solve::compute_plan))
+        .route("/api/v1/bands", post(solve::compute_bands))
         .route("/api/v1/jobs", post(jobs::create_job).get(jobs::list_jobs))
         .route(
             "/api/v1/jobs/{id}",

@@ -36,6 +36,7 @@ use crate::jobs::store::JobStatus;
         crate::api::tether::compute_equilibrium,
         crate::api::tether::compute_envelope,
         solve::compute_plan,
+        solve::compute_bands,
         jobs::create_job,
         jobs::list_jobs,
         jobs::get_job,
@@ -48,6 +49,7 @@ use crate::jobs::store::JobStatus;
         BatchOutcome, BatchItemOutcome, StabilityResponse, CriticalResponse, SafeRateResponse, ChartResponse,
         Health,
         crate::contract::ge_critical::GeCriticalResponse, crate::contract::ge_critical::GeStabilityResponse,
+        Health, crate::contract::bands::BandsResponse,
     )),
     modifiers(&BearerTokens),
     tags(

@@ -409,3 +409,36 @@ solve_path!(
     parse = |body| contract::plan::parse_plan(body),
     |req, limits| to_json(&contract::plan::plan(&req, &Deadline::after(limits))?)
 );
+
+/// Chart points (samples × rates) a synchronous bands request may have.
+pub const MAX_SYNC_BAND_EVALUATIONS: usize = 200_000;
+/// Synchronous bands work on a fixed mesh: points × elements.
+pub const MAX_SYNC_BAND_WORK: usize = 20_000_000;
+
+solve_path!(
+    /// Uncertainty bands of a deployment chart (SPEC §8): 5/50/95 % points
+    /// of h* and t* at each rate under uncertain inputs, each with its
+    /// sampling error, and the probability that a target elevation is
+    /// unsafe.
+    ///
+    /// Seeded Monte Carlo: sample i draws from its own stream of
+    /// (seed, i), so the answer is identical at any thread count.
+    /// Synchronously at most 200 000 chart points (samples × rates); up
+    /// to 2 000 000 as a job with `"kind": "bands"`.
+    compute_bands, "/api/v1/bands", crate::contract::bands::BandsRequest, crate::contract::bands::BandsResponse,
+    parse = |body| contract::bands::parse_bands(body),
+    |req, limits| {
+        let points = contract::bands::evaluations(&req);
+        let work = points.saturating_mul(req.system.model.mesh_elements());
+        if points > MAX_SYNC_BAND_EVALUATIONS || work > MAX_SYNC_BAND_WORK {
+            return Err(ApiError::too_large(
+                "uncertainty.samples",
+                format!(
+                    "{points} chart points (samples × rates) on {} elements take too long to answer synchronously (at most {MAX_SYNC_BAND_EVALUATIONS} points and {MAX_SYNC_BAND_WORK} points × elements): submit a job with \"kind\": \"bands\"",
+                    req.system.model.mesh_elements()
+                ),
+            ));
+        }
+        to_json(&contract::bands::bands(&req, Parallelism::Rayon, &Deadline::after(limits))?)
+    }
+);

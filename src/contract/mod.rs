@@ -3,6 +3,7 @@
 //! conversion to the numerical core, and one function per request kind
 //! ([`run`]). Everything here is synchronous and CPU-bound.
 
+pub mod bands;
 pub mod dto;
 pub mod envelope;
 pub mod equilibrium;

@@ -447,6 +447,23 @@ impl JobKind for AnyCriticalRequest {
     }
 }
 
+impl JobKind for crate::contract::bands::BandsRequest {
+    const NAME: &'static str = "bands";
+    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
+        crate::contract::bands::parse_bands(body)
+    }
+    fn validate(&self) -> Result<(), RequestError> {
+        crate::contract::bands::prepare(self).map(drop)
+    }
+    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
+        to_json(&crate::contract::bands::bands(
+            self,
+            Parallelism::Rayon,
+            progress,
+        )?)
+    }
+}
+
 fn prefixed(e: RequestError, prefix: &str) -> RequestError {
     match e {
         RequestError::Invalid(InvalidInput { field, reason }) => {
@@ -518,6 +535,8 @@ job_kinds!(
     Equilibrium(crate::contract::equilibrium::dto::EquilibriumRequest),
     /// `POST /api/v1/envelope`, up to 250 000 points (with progress).
     Envelope(crate::contract::envelope::dto::EnvelopeRequest),
+    /// `POST /api/v1/bands`, up to 2 000 000 chart points (samples × rates).
+    Bands(crate::contract::bands::BandsRequest),
 );
 
 impl JobItem {
@@ -795,6 +814,8 @@ mod tests {
                 "aero": {"radius_m": 0.5}, "wind_amplitude_m_s": 1.0,
                 "frequencies_rad_s": {"min": 1.0, "max": 2.0, "count": 2}})
             }
+            "bands" => json!({"rates_m_s": [10.0], "uncertainty": {"samples": 4, "inputs": [
+                {"field": "aerostat.net_buoyancy_n", "distribution": "uniform", "low": 900.0, "high": 1100.0}]}}),
             other => panic!("a new kind needs a valid request here: {other}"),
         };
         v.as_object_mut()

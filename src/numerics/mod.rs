@@ -16,3 +16,4 @@ pub mod reduced;
 pub mod string;
 pub mod tether;
 pub mod tridiag;
+pub mod uncertainty;

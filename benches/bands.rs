@@ -1,0 +1,65 @@
+//! Uncertainty bands (issue 14): 1000 samples × a 100-rate chart
+//! (1–100 m/s), converged points (model.elements omitted), two normal
+//! inputs (lift, mass per length), on rayon over all cores. Target ≤ 3 s on
+//! 2 cores. Timed runs outside criterion's loop (median of 3 reported),
+//! plus a short criterion group for a 100-sample ensemble.
+
+use std::time::Instant;
+
+use criterion::Criterion;
+use serde_json::json;
+use tetherplan::contract::bands::{self, BandsRequest};
+use tetherplan::contract::run::NoProgress;
+use tetherplan::numerics::chart::Parallelism;
+
+fn request(samples: usize, count: usize) -> BandsRequest {
+    let body = json!({
+        "cable": {"mass_per_length_kg_m": 0.078},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+        "rates_m_s": {"min": 1.0, "max": 100.0, "count": count},
+        "target_elevation_m": 1200.0,
+        "uncertainty": {"samples": samples, "seed": 1, "inputs": [
+            {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 50.0},
+            {"field": "cable.mass_per_length_kg_m", "distribution": "normal", "mean": 0.078, "std_dev": 0.002}
+        ]}
+    });
+    bands::parse_bands(&serde_json::to_vec(&body).unwrap()).unwrap()
+}
+
+fn timed_runs() {
+    let req = request(1000, 100);
+    let mut times: Vec<f64> = (0..3)
+        .map(|_| {
+            let start = Instant::now();
+            let resp = bands::bands(&req, Parallelism::Rayon, &NoProgress).unwrap();
+            assert_eq!(resp.points.len(), 100);
+            assert!(resp.converged);
+            start.elapsed().as_secs_f64()
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    println!(
+        "bands/1000_samples_x_100_rates_converged: median {:.3} s (runs {:?}) on {} rayon threads",
+        times[1],
+        times.iter().map(|t| format!("{t:.3}")).collect::<Vec<_>>(),
+        rayon::current_num_threads()
+    );
+}
+
+fn small(c: &mut Criterion) {
+    let req = request(100, 100);
+    let mut group = c.benchmark_group("bands");
+    group.sample_size(10);
+    group.bench_function("100_samples_x_100_rates_converged", |b| {
+        b.iter(|| bands::bands(&req, Parallelism::Rayon, &NoProgress).unwrap())
+    });
+    group.finish();
+}
+
+fn main() {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let mut c = Criterion::default().configure_from_args();
+    small(&mut c);
+    timed_runs();
+    c.final_summary();
+}

@@ -1,0 +1,20 @@
+//! `POST /api/v1/bands` (SPEC §8, issue 14): the deployment chart of one
+//! system under uncertain inputs — 5/50/95 % bands of `h*` and `t*` at
+//! each rate, each percentile with its sampling error, and the probability
+//! that a target elevation is unsafe.
+//!
+//! * [`dto`]: request and response bodies.
+//! * [`run`]: parsing (system part and parameters separately, unknown
+//!   fields refused everywhere), the uncertain-field paths
+//!   (`aerostat.net_buoyancy_n`, …) resolved to a direct numeric setter
+//!   (no JSON round trip per sample), the ensemble on rayon
+//!   ([`crate::numerics::uncertainty`]) and the summaries.
+//!
+//! The sampling layer is request-agnostic: a plan or envelope band needs
+//! only its own field table and per-sample evaluation.
+
+pub mod dto;
+pub mod run;
+
+pub use dto::{BandsRequest, BandsResponse};
+pub use run::{bands, evaluations, parse_bands, prepare};

@@ -1,0 +1,713 @@
+//! Parses, validates and runs a bands request.
+//!
+//! Each sample copies the request's system numbers, overwrites the
+//! uncertain fields with the sample's draws, and evaluates every rate of
+//! the chart exactly as `POST /api/v1/charts` does for that system (same
+//! mesh, same critical-length search), so a zero-width distribution gives
+//! the chart's own numbers bit for bit.
+//!
+//! Out-of-range draws: a distribution that puts more than
+//! [`MAX_OUT_OF_RANGE`] of its mass outside its field's physical range
+//! (e.g. a normal net buoyancy reaching 0) is refused up front (422 naming
+//! `uncertainty.inputs[i]`): that is a mis-specified input, not an answer.
+//! Below that, the rare invalid draws are counted per field
+//! (`rejected_samples`) and left out; percentiles and probabilities are
+//! over the valid samples (conditional on a physical draw).
+
+use std::sync::Arc;
+
+use serde_json::{Map, Value};
+
+use crate::contract::bands::dto::*;
+use crate::contract::dto::SystemInput;
+use crate::contract::{Progress, RequestError, parse_value};
+use crate::numerics::chart::{self, Discretisation, Parallelism};
+use crate::numerics::params::{AerostatSystem, InvalidInput, require_positive};
+use crate::numerics::string::StringModel;
+use crate::numerics::string::critical::Onset;
+use crate::numerics::string::operators::StringOperators;
+use crate::numerics::uncertainty::{self, Distribution, Ensemble, Summariser};
+
+/// Most rates of one banded chart.
+pub const MAX_BAND_RATES: usize = 1000;
+/// Most chart points (samples × rates) of one bands request (a job).
+pub const MAX_BAND_EVALUATIONS: usize = 2_000_000;
+/// Largest fraction of a distribution allowed outside its field's range.
+pub const MAX_OUT_OF_RANGE: f64 = 0.01;
+/// Largest seed (2^53 − 1: exact in every JSON reader).
+pub const MAX_SEED: u64 = (1 << 53) - 1;
+
+/// The keys of the parameters; every other top-level key belongs to the
+/// system.
+const PARAM_KEYS: [&str; 3] = ["rates_m_s", "uncertainty", "target_elevation_m"];
+
+/// A numeric field of the system that may be uncertain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SystemField {
+    NetBuoyancy,
+    AerostatMass,
+    MassPerLength,
+    Density,
+    Area,
+    InitialLength,
+    Gravity,
+}
+
+impl SystemField {
+    pub const ALL: [Self; 7] = [
+        Self::NetBuoyancy,
+        Self::AerostatMass,
+        Self::MassPerLength,
+        Self::Density,
+        Self::Area,
+        Self::InitialLength,
+        Self::Gravity,
+    ];
+
+    /// The request path.
+    pub fn path(self) -> &'static str {
+        match self {
+            Self::NetBuoyancy => "aerostat.net_buoyancy_n",
+            Self::AerostatMass => "aerostat.mass_kg",
+            Self::MassPerLength => "cable.mass_per_length_kg_m",
+            Self::Density => "cable.density_kg_m3",
+            Self::Area => "cable.area_m2",
+            Self::InitialLength => "initial_length_m",
+            Self::Gravity => "gravity_m_s2",
+        }
+    }
+
+    pub fn from_path(path: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|f| f.path() == path)
+    }
+
+    /// Is zero allowed (`≥ 0`) or not (`> 0`)?
+    fn zero_allowed(self) -> bool {
+        matches!(self, Self::AerostatMass)
+    }
+
+    fn in_range(self, v: f64) -> bool {
+        v.is_finite() && if self.zero_allowed() { v >= 0.0 } else { v > 0.0 }
+    }
+
+    fn range_words(self) -> &'static str {
+        if self.zero_allowed() {
+            "must not be negative"
+        } else {
+            "must be greater than zero"
+        }
+    }
+}
+
+/// The system's numbers as the request gives them.
+#[derive(Clone, Copy, Debug)]
+struct RawSystem {
+    mass_per_length: Option<f64>,
+    density: Option<f64>,
+    area: Option<f64>,
+    net_buoyancy: f64,
+    mass: f64,
+    initial_length: f64,
+    gravity: f64,
+}
+
+impl RawSystem {
+    fn of(s: &SystemInput) -> Self {
+        Self {
+            mass_per_length: s.cable.mass_per_length_kg_m,
+            density: s.cable.density_kg_m3,
+            area: s.cable.area_m2,
+            net_buoyancy: s.aerostat.net_buoyancy_n,
+            mass: s.aerostat.mass_kg,
+            initial_length: s.initial_length_m,
+            gravity: s.gravity_m_s2,
+        }
+    }
+
+    fn has(&self, f: SystemField) -> bool {
+        match f {
+            SystemField::MassPerLength => self.mass_per_length.is_some(),
+            SystemField::Density => self.density.is_some(),
+            SystemField::Area => self.area.is_some(),
+            _ => true,
+        }
+    }
+
+    fn set(&mut self, f: SystemField, v: f64) {
+        match f {
+            SystemField::NetBuoyancy => self.net_buoyancy = v,
+            SystemField::AerostatMass => self.mass = v,
+            SystemField::MassPerLength => self.mass_per_length = Some(v),
+            SystemField::Density => self.density = Some(v),
+            SystemField::Area => self.area = Some(v),
+            SystemField::InitialLength => self.initial_length = v,
+            SystemField::Gravity => self.gravity = v,
+        }
+    }
+
+    /// The validated system (the same arithmetic as `SystemInput::system`).
+    fn system(&self) -> Result<AerostatSystem, InvalidInput> {
+        let rho_a = match (self.mass_per_length, self.density, self.area) {
+            (Some(m), _, _) => m,
+            (None, Some(rho), Some(a)) => rho * a,
+            _ => f64::NAN,
+        };
+        AerostatSystem::new(
+            rho_a,
+            self.net_buoyancy,
+            self.mass,
+            self.initial_length,
+            self.gravity,
+        )
+    }
+}
+
+/// A validated bands request, ready to run.
+pub struct Prepared {
+    base: RawSystem,
+    nominal: AerostatSystem,
+    fields: Vec<SystemField>,
+    ensemble: Ensemble,
+    rates: Vec<f64>,
+    target: Option<f64>,
+    discretisation: Discretisation,
+}
+
+/// Chart points of the request: samples × rates (for admission limits).
+pub fn evaluations(req: &BandsRequest) -> usize {
+    let rates = match &req.params.rates_m_s {
+        RatesInput::List(v) => v.len(),
+        RatesInput::Grid(g) => g.count,
+    };
+    rates.saturating_mul(req.params.uncertainty.samples)
+}
+
+fn distribution(input: &UncertainInput) -> Distribution {
+    match *input {
+        UncertainInput::Normal { mean, std_dev, .. } => Distribution::Normal { mean, std_dev },
+        UncertainInput::Uniform { low, high, .. } => Distribution::Uniform { low, high },
+        UncertainInput::Lognormal { mean, std_dev, .. } => {
+            Distribution::Lognormal { mean, std_dev }
+        }
+    }
+}
+
+/// Every check that needs no solve.
+pub fn prepare(req: &BandsRequest) -> Result<Prepared, RequestError> {
+    let model = req.system.model()?;
+    let discretisation = req.system.discretisation()?;
+    let nominal = model.system;
+    let base = RawSystem::of(&req.system);
+    let p = &req.params;
+    let rates = match &p.rates_m_s {
+        RatesInput::List(list) => {
+            if list.is_empty() || list.len() > MAX_BAND_RATES {
+                return Err(InvalidInput::new(
+                    "rates_m_s",
+                    format!("must list 1 to {MAX_BAND_RATES} rates, got {}", list.len()),
+                )
+                .into());
+            }
+            for (i, &v) in list.iter().enumerate() {
+                require_positive(&format!("rates_m_s[{i}]"), v)?;
+            }
+            list.clone()
+        }
+        RatesInput::Grid(g) => {
+            if g.count == 0 || g.count > MAX_BAND_RATES {
+                return Err(InvalidInput::new(
+                    "rates_m_s.count",
+                    format!("must be between 1 and {MAX_BAND_RATES}, got {}", g.count),
+                )
+                .into());
+            }
+            chart::rate_grid(g.min, g.max, g.count)?
+        }
+    };
+    let target = p
+        .target_elevation_m
+        .map(|t| require_positive("target_elevation_m", t))
+        .transpose()?;
+    let u = &p.uncertainty;
+    if u.seed > MAX_SEED {
+        return Err(InvalidInput::new(
+            "uncertainty.seed",
+            format!("must be at most {MAX_SEED} (2^53 − 1), got {}", u.seed),
+        )
+        .into());
+    }
+    let ensemble = Ensemble::new(
+        "uncertainty",
+        u.samples,
+        u.seed,
+        u.inputs.iter().map(distribution).collect(),
+    )?;
+    let total = u.samples.saturating_mul(rates.len());
+    if total > MAX_BAND_EVALUATIONS {
+        return Err(InvalidInput::new(
+            "uncertainty.samples",
+            format!(
+                "{} samples × {} rates = {total} chart points; at most {MAX_BAND_EVALUATIONS} are allowed",
+                u.samples,
+                rates.len()
+            ),
+        )
+        .into());
+    }
+    let mut fields: Vec<SystemField> = Vec::with_capacity(u.inputs.len());
+    for (i, input) in u.inputs.iter().enumerate() {
+        let at = format!("uncertainty.inputs[{i}]");
+        let path = input.field();
+        let Some(f) = SystemField::from_path(path) else {
+            let known: Vec<&str> = SystemField::ALL.iter().map(|f| f.path()).collect();
+            return Err(InvalidInput::new(
+                format!("{at}.field"),
+                format!(
+                    "`{path}` is not a numeric field of the system that can be uncertain: one of {}",
+                    known.join(", ")
+                ),
+            )
+            .into());
+        };
+        if !base.has(f) {
+            return Err(InvalidInput::new(
+                format!("{at}.field"),
+                format!(
+                    "`{path}` is not given in this request (the cable is given as {}): make one of those uncertain",
+                    if base.mass_per_length.is_some() {
+                        "cable.mass_per_length_kg_m"
+                    } else {
+                        "cable.density_kg_m3 and cable.area_m2"
+                    }
+                ),
+            )
+            .into());
+        }
+        if let Some(j) = fields.iter().position(|&g| g == f) {
+            return Err(InvalidInput::new(
+                format!("{at}.field"),
+                format!("`{path}` is already uncertain in uncertainty.inputs[{j}]"),
+            )
+            .into());
+        }
+        let dist = ensemble.inputs[i];
+        let outside = dist.cdf(0.0);
+        if outside > MAX_OUT_OF_RANGE {
+            return Err(InvalidInput::new(
+                at,
+                format!(
+                    "puts {:.2} % of its draws outside the range of {path} ({}); at most {} % may fall outside: narrow it, or use a lognormal",
+                    100.0 * outside,
+                    f.range_words(),
+                    100.0 * MAX_OUT_OF_RANGE
+                ),
+            )
+            .into());
+        }
+        fields.push(f);
+    }
+    Ok(Prepared {
+        base,
+        nominal,
+        fields,
+        ensemble,
+        rates,
+        target,
+        discretisation,
+    })
+}
+
+/// `h*`, `t*` of one chart point, their discretisation errors (converged
+/// points), and whether it is unstable at once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PointValue {
+    elevation_m: f64,
+    time_s: f64,
+    elevation_error_m: f64,
+    time_error_s: f64,
+    immediate: bool,
+}
+
+/// The chart of one system at the request's rates, as `/charts` computes
+/// it: converged (graded meshes, safe side of the error bound) when
+/// `model.elements` is omitted, else that uniform mesh.
+struct ChartEvaluator {
+    discretisation: Discretisation,
+    operators: Option<Arc<StringOperators>>,
+}
+
+impl ChartEvaluator {
+    fn new(discretisation: Discretisation) -> Self {
+        let operators = match discretisation {
+            Discretisation::Elements(n) => Some(Arc::new(StringOperators::new(n))),
+            Discretisation::Converged { .. } => None,
+        };
+        Self {
+            discretisation,
+            operators,
+        }
+    }
+
+    fn chart(&self, sys: AerostatSystem, rates: &[f64]) -> Vec<PointValue> {
+        let model = self
+            .operators
+            .as_ref()
+            .map(|ops| StringModel::with_operators(sys, ops.clone()));
+        rates
+            .iter()
+            .map(|&v| {
+                let p = match (&model, self.discretisation) {
+                    (Some(m), _) => chart::chart_point(m, v),
+                    (None, Discretisation::Converged { relative_tolerance }) => {
+                        chart::converged_chart_point(&sys, v, relative_tolerance)
+                    }
+                    (None, Discretisation::Elements(_)) => unreachable!("operators are built"),
+                };
+                PointValue {
+                    elevation_m: p.max_elevation_m,
+                    time_s: p.critical_time_s,
+                    elevation_error_m: p.max_elevation_error_m,
+                    time_error_s: p.critical_time_error_s,
+                    immediate: matches!(p.onset, Onset::Immediate(_)),
+                }
+            })
+            .collect()
+    }
+}
+
+/// The banded chart. `progress` counts samples; cancellation is checked
+/// before every sample.
+pub fn bands(
+    req: &BandsRequest,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<BandsResponse, RequestError> {
+    let prep = prepare(req)?;
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    let evaluator = ChartEvaluator::new(prep.discretisation);
+    let converged = matches!(prep.discretisation, Discretisation::Converged { .. });
+    let nominal = evaluator.chart(prep.nominal, &prep.rates);
+    // Ok(points) or Err(index of the first input whose draw is out of range)
+    let results: Vec<Result<Vec<PointValue>, usize>> = prep
+        .ensemble
+        .run(
+            parallelism,
+            &|done, total| progress.report(done, total),
+            &|| progress.cancelled(),
+            |values| {
+                let mut raw = prep.base;
+                for (k, (&f, &v)) in prep.fields.iter().zip(values).enumerate() {
+                    if !f.in_range(v) {
+                        return Err(k);
+                    }
+                    raw.set(f, v);
+                }
+                let sys = raw
+                    .system()
+                    .expect("the base system is valid and every draw is in range");
+                Ok(evaluator.chart(sys, &prep.rates))
+            },
+        )
+        .ok_or(RequestError::Cancelled)?;
+    let valid: Vec<&Vec<PointValue>> = results.iter().filter_map(|r| r.as_ref().ok()).collect();
+    let mut rejected = vec![0usize; prep.fields.len()];
+    for r in &results {
+        if let Err(k) = r {
+            rejected[*k] += 1;
+        }
+    }
+    let n = valid.len();
+    if n == 0 {
+        return Err(InvalidInput::new(
+            "uncertainty.inputs",
+            "every sample drew a value outside its field's physical range",
+        )
+        .into());
+    }
+    let summariser = Summariser::new(n);
+    let mut column = vec![0.0; n];
+    let points = prep
+        .rates
+        .iter()
+        .enumerate()
+        .map(|(j, &rate)| {
+            for (c, s) in column.iter_mut().zip(&valid) {
+                *c = s[j].elevation_m;
+            }
+            let unsafe_samples = prep
+                .target
+                .map(|t| column.iter().filter(|&&h| h < t).count());
+            let elevation = percentile_band(summariser.band(&mut column));
+            for (c, s) in column.iter_mut().zip(&valid) {
+                *c = s[j].time_s;
+            }
+            let time = percentile_band(summariser.band(&mut column));
+            BandPointOutput {
+                rate_m_s: rate,
+                max_elevation_m: elevation,
+                critical_time_s: time,
+                nominal_max_elevation_m: nominal[j].elevation_m,
+                nominal_critical_time_s: nominal[j].time_s,
+                immediate_samples: valid.iter().filter(|s| s[j].immediate).count(),
+                max_elevation_error_m: converged
+                    .then(|| valid.iter().map(|s| s[j].elevation_error_m).fold(0.0, f64::max)),
+                critical_time_error_s: converged
+                    .then(|| valid.iter().map(|s| s[j].time_error_s).fold(0.0, f64::max)),
+                probability_unsafe: unsafe_samples.map(|k| {
+                    let p = uncertainty::percentiles::probability(k, n, uncertainty::CONFIDENCE);
+                    UnsafeProbabilityOutput {
+                        probability_nondim: p.value,
+                        standard_error_nondim: p.standard_error,
+                        low_nondim: p.low,
+                        high_nondim: p.high,
+                        unsafe_samples: k,
+                    }
+                }),
+            }
+        })
+        .collect();
+    Ok(BandsResponse {
+        points,
+        samples: prep.ensemble.samples,
+        valid_samples: n,
+        rejected_samples: prep
+            .fields
+            .iter()
+            .zip(&rejected)
+            .filter(|(_, c)| **c > 0)
+            .map(|(f, &count)| RejectedSamplesOutput {
+                field: f.path().into(),
+                count,
+                reason: format!("{} {}", f.path(), f.range_words()),
+            })
+            .collect(),
+        seed: prep.ensemble.seed,
+        inputs: req.params.uncertainty.inputs.clone(),
+        target_elevation_m: prep.target,
+        confidence_level_nondim: uncertainty::CONFIDENCE,
+        method: "monte_carlo".into(),
+        elements: crate::contract::run::chart_elements(prep.discretisation),
+        converged,
+    })
+}
+
+fn percentile_band(b: uncertainty::Band) -> PercentileBand {
+    let [q05, q50, q95] = b.quantiles;
+    PercentileBand {
+        p05: q05.value,
+        p50: q50.value,
+        p95: q95.value,
+        p05_error: q05.error(),
+        p50_error: q50.error(),
+        p95_error: q95.error(),
+        p05_low: q05.low,
+        p05_high: q05.high,
+        p50_low: q50.low,
+        p50_high: q50.high,
+        p95_low: q95.low,
+        p95_high: q95.high,
+        mean: b.mean,
+        std_dev: b.std_dev,
+    }
+}
+
+/// Parses a bands body: the system part and the parameters separately (so
+/// every error names its field), unknown fields refused in both.
+pub fn parse_bands(body: &[u8]) -> Result<BandsRequest, RequestError> {
+    let value: Value =
+        serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
+    let Value::Object(obj) = value else {
+        return Err(InvalidInput::new("body", "must be a JSON object").into());
+    };
+    let (mut system_part, mut params_part) = (Map::new(), Map::new());
+    for (k, v) in obj {
+        if PARAM_KEYS.contains(&k.as_str()) {
+            params_part.insert(k, v);
+        } else {
+            system_part.insert(k, v);
+        }
+    }
+    let system_value = Value::Object(system_part);
+    let system: SystemInput = parse_value(&system_value)?;
+    let known = serde_json::to_value(&system).expect("the system serialises");
+    reject_unknown(&system_value, &known, "")?;
+    match params_part.get("rates_m_s") {
+        Some(Value::Array(_)) => {
+            parse_value::<Vec<f64>>(&params_part["rates_m_s"]).map_err(|e| under("rates_m_s", e))?;
+        }
+        Some(Value::Object(_)) => {
+            parse_value::<BandsRateGrid>(&params_part["rates_m_s"])
+                .map_err(|e| under("rates_m_s", e))?;
+        }
+        Some(_) => {
+            return Err(InvalidInput::new(
+                "rates_m_s",
+                "must be a list of rates (m/s) or a grid {min, max, count}",
+            )
+            .into());
+        }
+        None => {}
+    }
+    let params: BandsParams = parse_value(&Value::Object(params_part))?;
+    Ok(BandsRequest { system, params })
+}
+
+/// Prefixes the field of an error from a sub-parse.
+fn under(prefix: &str, e: RequestError) -> RequestError {
+    match e {
+        RequestError::Invalid(InvalidInput { field, reason }) => {
+            let field = if field == "body" {
+                prefix.to_string()
+            } else if field.starts_with('[') {
+                format!("{prefix}{field}")
+            } else {
+                format!("{prefix}.{field}")
+            };
+            RequestError::Invalid(InvalidInput { field, reason })
+        }
+        other => other,
+    }
+}
+
+/// Refuses keys of `given` that the parsed value `known` does not have
+/// (serde ignores them in the system part, which has no
+/// `deny_unknown_fields` because other requests flatten it).
+fn reject_unknown(given: &Value, known: &Value, prefix: &str) -> Result<(), InvalidInput> {
+    if let (Value::Object(g), Value::Object(k)) = (given, known) {
+        for (key, v) in g {
+            let path = if prefix.is_empty() {
+                key.clone()
+            } else {
+                format!("{prefix}.{key}")
+            };
+            match k.get(key) {
+                None => {
+                    return Err(InvalidInput::new(
+                        path,
+                        format!(
+                            "unknown field `{key}`{}",
+                            if prefix.is_empty() {
+                                format!(
+                                    ": a bands request has the system fields ({}) and {}",
+                                    k.keys().map(String::as_str).collect::<Vec<_>>().join(", "),
+                                    PARAM_KEYS.join(", ")
+                                )
+                            } else {
+                                format!(
+                                    ": expected one of {}",
+                                    k.keys().map(String::as_str).collect::<Vec<_>>().join(", ")
+                                )
+                            }
+                        ),
+                    ));
+                }
+                Some(kv) => reject_unknown(v, kv, &path)?,
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contract::run::NoProgress;
+    use serde_json::json;
+
+    fn body(extra: Value) -> Vec<u8> {
+        let mut v = json!({
+            "cable": {"mass_per_length_kg_m": 0.078},
+            "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+            "rates_m_s": [5.0, 10.0],
+            "uncertainty": {"samples": 200, "seed": 3, "inputs": [
+                {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 50.0}
+            ]}
+        });
+        for (k, x) in extra.as_object().unwrap() {
+            v[k] = x.clone();
+        }
+        serde_json::to_vec(&v).unwrap()
+    }
+
+    fn field_of(b: Vec<u8>) -> String {
+        let err = parse_bands(&b)
+            .and_then(|r| prepare(&r).map(drop))
+            .expect_err("invalid");
+        err.body().error.field.unwrap()
+    }
+
+    #[test]
+    fn errors_name_their_field() {
+        assert_eq!(
+            field_of(body(json!({"uncertainty": {"inputs": [
+                {"field": "aerostat.lift_n", "distribution": "normal", "mean": 1.0, "std_dev": 0.1}]}}))),
+            "uncertainty.inputs[0].field"
+        );
+        assert_eq!(
+            field_of(body(json!({"uncertainty": {"inputs": [
+                {"field": "model.elements", "distribution": "normal", "mean": 1.0, "std_dev": 0.1}]}}))),
+            "uncertainty.inputs[0].field"
+        );
+        assert_eq!(
+            field_of(body(json!({"uncertainty": {"inputs": [
+                {"field": "cable.density_kg_m3", "distribution": "normal", "mean": 1.0, "std_dev": 0.1}]}}))),
+            "uncertainty.inputs[0].field"
+        );
+        assert_eq!(
+            field_of(body(json!({"uncertainty": {"inputs": [
+                {"field": "aerostat.mass_kg", "distribution": "uniform", "low": 9.0, "high": 11.0},
+                {"field": "aerostat.mass_kg", "distribution": "uniform", "low": 9.0, "high": 11.0}]}}))),
+            "uncertainty.inputs[1].field"
+        );
+        assert_eq!(
+            field_of(body(json!({"uncertainty": {"inputs": [
+                {"field": "aerostat.mass_kg", "distribution": "normal", "mean": 10.0}]}}))),
+            "uncertainty.inputs[0].std_dev"
+        );
+        assert_eq!(
+            field_of(body(json!({"uncertainty": {"inputs": [
+                {"field": "aerostat.mass_kg", "distribution": "normal", "mean": 10.0, "std_dev": 1.0, "skew": 1}]}}))),
+            "uncertainty.inputs[0]"
+        );
+        // 2.3 % of a N(10, 5) mass is negative: refused
+        assert_eq!(
+            field_of(body(json!({"uncertainty": {"inputs": [
+                {"field": "aerostat.mass_kg", "distribution": "normal", "mean": 10.0, "std_dev": 5.0}]}}))),
+            "uncertainty.inputs[0]"
+        );
+        assert_eq!(field_of(body(json!({"rates_m_s": [5.0, -1.0]}))), "rates_m_s[1]");
+        assert_eq!(
+            field_of(body(json!({"rates_m_s": {"min": 1.0, "max": 2.0, "count": 0}}))),
+            "rates_m_s.count"
+        );
+        assert_eq!(
+            field_of(body(json!({"rates_m_s": {"min": 1.0, "max": 2.0, "cnt": 3}}))),
+            "rates_m_s.cnt"
+        );
+        assert_eq!(field_of(body(json!({"rates_m_s": "fast"}))), "rates_m_s");
+        assert_eq!(field_of(body(json!({"target_elevation_m": 0.0}))), "target_elevation_m");
+        assert_eq!(field_of(body(json!({"wind_m_s": 3.0}))), "wind_m_s");
+        assert_eq!(field_of(body(json!({"aerostat": {"net_buoyancy_n": 1.0, "lift": 2}}))), "aerostat.lift");
+        assert_eq!(
+            field_of(body(json!({"uncertainty": {"samples": 0, "inputs": [
+                {"field": "aerostat.mass_kg", "distribution": "uniform", "low": 9.0, "high": 11.0}]}}))),
+            "uncertainty.samples"
+        );
+    }
+
+    /// Rare invalid draws are counted and left out, not silently used.
+    #[test]
+    fn out_of_range_draws_are_counted_and_left_out() {
+        // P(m < 0) for N(10, 4.2) = Φ(−2.381) ≈ 8.6e-3 (just under the limit)
+        let b = body(json!({"uncertainty": {"samples": 4000, "seed": 1, "inputs": [
+            {"field": "aerostat.mass_kg", "distribution": "normal", "mean": 10.0, "std_dev": 4.2}]}}));
+        let resp = bands(&parse_bands(&b).unwrap(), Parallelism::Rayon, &NoProgress).unwrap();
+        let rejected = &resp.rejected_samples[0];
+        assert_eq!(rejected.field, "aerostat.mass_kg");
+        // expected 34.5 ± 5.9
+        assert!((12..=60).contains(&rejected.count), "{}", rejected.count);
+        assert_eq!(resp.valid_samples + rejected.count, 4000);
+    }
+}

@@ -1,0 +1,171 @@
+//! `POST /api/v1/bands` and the `bands` job kind (issue 14): the route's
+//! answer is the contract's, the OpenAPI example succeeds as is, bad input
+//! is a 422 naming the field, large ensembles point to jobs, and a job runs
+//! to the same answer with progress.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use axum::Router;
+use axum::body::Body;
+use axum::http::{Request, StatusCode, header};
+use http_body_util::BodyExt;
+use serde_json::{Value, json};
+use tetherplan::api::{self, AppState};
+use tetherplan::config::Limits;
+use tetherplan::contract::bands;
+use tetherplan::contract::dto::ErrorBody;
+use tetherplan::contract::run::NoProgress;
+use tetherplan::jobs::store::{JobStatus, JobStore};
+use tetherplan::jobs::{JobQueue, try_execute_next};
+use tetherplan::numerics::chart::Parallelism;
+use tower::ServiceExt;
+
+fn app() -> (Router, Arc<JobQueue>) {
+    let queue = Arc::new(JobQueue::new(
+        JobStore::open_in_memory().unwrap(),
+        2,
+        Limits::default(),
+    ));
+    (
+        api::router(AppState::new(queue.clone()), Path::new("static")),
+        queue,
+    )
+}
+
+async fn send(app: &Router, method: &str, uri: &str, body: Option<&Value>) -> (StatusCode, String) {
+    let mut req = Request::builder().method(method).uri(uri);
+    let body = match body {
+        Some(b) => {
+            req = req.header(header::CONTENT_TYPE, "application/json");
+            Body::from(serde_json::to_vec(b).unwrap())
+        }
+        None => Body::empty(),
+    };
+    let resp = app.clone().oneshot(req.body(body).unwrap()).await.unwrap();
+    let status = resp.status();
+    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
+    (status, String::from_utf8_lossy(&bytes).into_owned())
+}
+
+fn body(samples: usize) -> Value {
+    json!({
+        "cable": {"density_kg_m3": 7800.0, "area_m2": 1e-5},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+        "rates_m_s": {"min": 5.0, "max": 40.0, "count": 8},
+        "target_elevation_m": 1200.0,
+        "uncertainty": {"samples": samples, "seed": 99, "inputs": [
+            {"field": "aerostat.net_buoyancy_n", "distribution": "lognormal", "mean": 1000.0, "std_dev": 40.0},
+            {"field": "cable.area_m2", "distribution": "uniform", "low": 0.97e-5, "high": 1.03e-5}
+        ]}
+    })
+}
+
+fn direct(v: &Value) -> String {
+    let req = bands::parse_bands(&serde_json::to_vec(v).unwrap()).unwrap();
+    serde_json::to_string(&bands::bands(&req, Parallelism::Rayon, &NoProgress).unwrap()).unwrap()
+}
+
+fn error(text: &str) -> (String, Option<String>) {
+    let e: ErrorBody = serde_json::from_str(text).unwrap_or_else(|_| panic!("{text}"));
+    (e.error.code, e.error.field)
+}
+
+#[tokio::test]
+async fn the_route_answers_like_the_contract() {
+    let (app, _) = app();
+    let b = body(300);
+    let (status, text) = send(&app, "POST", "/api/v1/bands", Some(&b)).await;
+    assert_eq!(status, StatusCode::OK, "{text}");
+    assert_eq!(text, direct(&b));
+    let v: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["points"].as_array().unwrap().len(), 8);
+    assert_eq!(v["seed"], 99);
+    assert_eq!(v["inputs"], b["uncertainty"]["inputs"]);
+    assert_eq!(v["converged"], true);
+    let p = &v["points"][3];
+    assert!(p["max_elevation_m"]["p05"].as_f64() < p["max_elevation_m"]["p95"].as_f64());
+    assert!(p["probability_unsafe"]["probability_nondim"].is_number());
+}
+
+/// The request example of the OpenAPI document succeeds as is.
+#[tokio::test]
+async fn the_openapi_example_succeeds() {
+    let doc: Value = serde_json::from_str(&api::openapi::openapi_json()).unwrap();
+    let schema = &doc["components"]["schemas"]["BandsRequest"];
+    let example = if schema["example"].is_object() {
+        schema["example"].clone()
+    } else {
+        schema["examples"][0].clone()
+    };
+    assert!(example.is_object(), "no example in {schema}");
+    let (app, _) = app();
+    let (status, text) = send(&app, "POST", "/api/v1/bands", Some(&example)).await;
+    assert_eq!(status, StatusCode::OK, "{text}");
+}
+
+#[tokio::test]
+async fn bad_input_is_a_422_naming_the_field() {
+    let (app, _) = app();
+    let cases = [
+        (json!({"field": "aerostat.buoyancy", "distribution": "normal", "mean": 1.0, "std_dev": 1.0}),
+         "uncertainty.inputs[0].field"),
+        (json!({"field": "cable.mass_per_length_kg_m", "distribution": "normal", "mean": 0.078, "std_dev": 0.001}),
+         "uncertainty.inputs[0].field"),
+        (json!({"field": "aerostat.net_buoyancy_n", "distribution": "triangular", "mean": 1.0}),
+         "uncertainty.inputs[0].distribution"),
+        (json!({"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 600.0}),
+         "uncertainty.inputs[0]"),
+    ];
+    for (input, field) in cases {
+        let mut b = body(10);
+        b["uncertainty"]["inputs"] = json!([input]);
+        let (status, text) = send(&app, "POST", "/api/v1/bands", Some(&b)).await;
+        assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{text}");
+        assert_eq!(error(&text), ("invalid_input".into(), Some(field.into())), "{text}");
+    }
+    let mut b = body(10);
+    b["extra_m"] = json!(1.0);
+    let (status, text) = send(&app, "POST", "/api/v1/bands", Some(&b)).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(error(&text).1.as_deref(), Some("extra_m"));
+    let mut b = body(10);
+    b["uncertainty"]["method"] = json!("sobol");
+    let (status, text) = send(&app, "POST", "/api/v1/bands", Some(&b)).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(error(&text).1.as_deref(), Some("uncertainty.method"), "{text}");
+}
+
+#[tokio::test]
+async fn large_ensembles_point_to_jobs() {
+    let (app, _) = app();
+    let mut b = body(100_000);
+    b["rates_m_s"]["count"] = json!(3);
+    let (status, text) = send(&app, "POST", "/api/v1/bands", Some(&b)).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(error(&text), ("too_large".into(), Some("uncertainty.samples".into())));
+    assert!(text.contains("\\\"kind\\\": \\\"bands\\\""), "{text}");
+}
+
+#[tokio::test]
+async fn a_bands_job_runs_to_the_synchronous_answer_with_progress() {
+    let (app, queue) = app();
+    let b = body(400);
+    let (status, text) = send(&app, "POST", "/api/v1/jobs", Some(&json!({"kind": "bands", "request": b}))).await;
+    assert_eq!(status, StatusCode::ACCEPTED, "{text}");
+    let id = serde_json::from_str::<Value>(&text).unwrap()["id"].as_i64().unwrap();
+    let ran = try_execute_next(&queue).unwrap().unwrap();
+    assert_eq!((ran.id, ran.status), (id, JobStatus::Done));
+    let (_, text) = send(&app, "GET", &format!("/api/v1/jobs/{id}"), None).await;
+    let v: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["kind"], "bands");
+    assert_eq!(v["progress"], 1.0);
+    let answer: Value = serde_json::from_str(&direct(&b)).unwrap();
+    assert_eq!(v["result"], answer);
+    // invalid input is refused at submission
+    let mut bad = body(10);
+    bad["uncertainty"]["seed"] = json!(1u64 << 60);
+    let (status, text) = send(&app, "POST", "/api/v1/jobs", Some(&json!({"kind": "bands", "request": bad}))).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(error(&text).1.as_deref(), Some("request.uncertainty.seed"));
+}
