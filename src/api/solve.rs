@@ -181,13 +181,13 @@ pub fn check_sync_chart(req: &ChartRequest, limits: &Limits) -> Result<(), ApiEr
 
 /// Progress that gives up once the solve timeout has passed or the caller
 /// has gone away, so an abandoned request stops using the CPU.
-struct Deadline {
+pub(crate) struct Deadline {
     end: std::time::Instant,
     abandoned: Arc<AtomicBool>,
 }
 
 impl Deadline {
-    fn after(ctx: &SolveCtx) -> Self {
+    pub(crate) fn after(ctx: &SolveCtx) -> Self {
         Self {
             end: ctx.end,
             abandoned: ctx.abandoned.clone(),

@@ -7,12 +7,11 @@ use axum::response::Response;
 
 use crate::api::AppState;
 use crate::api::error::{ApiError, JsonBody};
-use crate::config::Limits;
+use crate::api::solve::{Deadline, SolveCtx};
 use crate::contract::dto::ErrorBody;
 use crate::contract::envelope::dto::{EnvelopeRequest, EnvelopeResponse};
 use crate::contract::envelope::{self, MAX_SYNC_ENVELOPE_POINTS};
 use crate::contract::equilibrium::dto::{EquilibriumRequest, EquilibriumResponse};
-use crate::contract::run::NoProgress;
 use crate::contract::{self, equilibrium};
 use crate::numerics::chart::Parallelism;
 
@@ -47,7 +46,7 @@ pub async fn compute_equilibrium(
     State(app): State<AppState>,
     JsonBody(body): JsonBody,
 ) -> Result<Response, ApiError> {
-    app.solve(move |_: &Limits| {
+    app.solve(move |_: &SolveCtx| {
         let req: EquilibriumRequest = contract::parse_plain(&body)?;
         to_json(&equilibrium::equilibrium(&req)?)
     })
@@ -82,7 +81,7 @@ pub async fn compute_envelope(
     State(app): State<AppState>,
     JsonBody(body): JsonBody,
 ) -> Result<Response, ApiError> {
-    app.solve(move |_: &Limits| {
+    app.solve(move |ctx: &SolveCtx| {
         let req: EnvelopeRequest = contract::parse_plain(&body)?;
         req.validate()?;
         let points = req.points();
@@ -94,7 +93,7 @@ pub async fn compute_envelope(
                 ),
             ));
         }
-        to_json(&envelope::envelope(&req, Parallelism::Rayon, &NoProgress)?)
+        to_json(&envelope::envelope(&req, Parallelism::Rayon, &Deadline::after(ctx))?)
     })
     .await
 }

@@ -23,10 +23,18 @@ pub const PER_EIGENVALUE: u64 = 6 * PER_NUMBER + 120;
 pub const CHART_BASE: u64 = 512;
 /// One chart series without its points.
 pub const PER_CHART_SERIES: u64 = 256;
-/// One chart point: 4 numbers and their keys (75 bytes).
-pub const PER_CHART_POINT: u64 = 4 * PER_NUMBER + 80;
-/// One GE chart point: 9 numbers or nulls, the onset and their keys.
-pub const PER_GE_CHART_POINT: u64 = 9 * PER_NUMBER + 260;
+/// One chart point: 6 numbers and their keys.
+pub const PER_CHART_POINT: u64 = 6 * PER_NUMBER + 160;
+/// One GE chart point: 12 numbers or nulls, the onset, the closed-form
+/// note and their keys.
+pub const PER_GE_CHART_POINT: u64 = 12 * PER_NUMBER + 900;
+/// One rate of an uncertainty band: percentiles, their errors, the
+/// exceedance probability and their keys.
+pub const PER_BAND_POINT: u64 = 40 * PER_NUMBER + 1000;
+/// One envelope grid point: about 16 values, the binding limit and keys.
+pub const PER_ENVELOPE_POINT: u64 = 16 * PER_NUMBER + 600;
+/// One sample of a tether shape: 4 numbers and their keys.
+pub const PER_SHAPE_SAMPLE: u64 = 4 * PER_NUMBER + 60;
 /// A transient answer without its samples.
 pub const SIMULATE_BASE: u64 = 4 << 10;
 /// One sample of a linear-string run: 13 columns (9 of the run, 4 of the reduced model).

@@ -424,6 +424,15 @@ impl JobKind for AnyStabilityRequest {
             Self::GeometricallyExact(r) => to_json(&ge_critical::ge_stability(r)?),
         }
     }
+    fn estimate(&self) -> Estimate {
+        match self {
+            Self::LinearString(r) => r.estimate(),
+            Self::GeometricallyExact(r) => E::new(
+                "modes",
+                est::STABILITY_BASE + r.modes as u64 * est::PER_EIGENVALUE,
+            ),
+        }
+    }
 }
 
 impl JobKind for AnyCriticalRequest {
@@ -445,6 +454,12 @@ impl JobKind for AnyCriticalRequest {
             Self::GeometricallyExact(r) => to_json(&ge_critical::ge_critical(r, progress)?),
         }
     }
+    fn estimate(&self) -> Estimate {
+        match self {
+            Self::LinearString(r) => r.estimate(),
+            Self::GeometricallyExact(_) => E::new("profile", est::SMALL_ANSWER),
+        }
+    }
 }
 
 impl JobKind for crate::contract::bands::BandsRequest {
@@ -461,6 +476,14 @@ impl JobKind for crate::contract::bands::BandsRequest {
             Parallelism::Rayon,
             progress,
         )?)
+    }
+    fn estimate(&self) -> Estimate {
+        let samples = self.params.uncertainty.samples.max(1);
+        let rates = (crate::contract::bands::evaluations(self) / samples) as u64;
+        E::new(
+            "rates_m_s",
+            est::CHART_BASE + rates.saturating_mul(est::PER_BAND_POINT),
+        )
     }
 }
 

@@ -6,6 +6,7 @@ use serde_json::Value;
 use crate::contract::envelope::dto::EnvelopeRequest;
 use crate::contract::equilibrium::dto::EquilibriumRequest;
 use crate::contract::{self, Progress, RequestError, envelope, equilibrium};
+use crate::jobs::estimate::{self as est, Estimate, Estimate as E};
 use crate::jobs::kinds::JobKind;
 use crate::numerics::chart::Parallelism;
 
@@ -24,6 +25,12 @@ impl JobKind for EquilibriumRequest {
     fn run(&self, _: &dyn Progress) -> Result<String, RequestError> {
         to_json(&equilibrium::equilibrium(self)?)
     }
+    fn estimate(&self) -> Estimate {
+        E::new(
+            "shape_samples",
+            est::SIMULATE_BASE + self.shape_samples as u64 * est::PER_SHAPE_SAMPLE,
+        )
+    }
 }
 
 impl JobKind for EnvelopeRequest {
@@ -36,6 +43,15 @@ impl JobKind for EnvelopeRequest {
     }
     fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
         to_json(&envelope::envelope(self, Parallelism::Rayon, progress)?)
+    }
+    fn estimate(&self) -> Estimate {
+        let rows = (self.wind_speeds_m_s.count + self.tether_lengths_m.count) as u64;
+        E::new(
+            "wind_speeds_m_s.count",
+            est::SIMULATE_BASE
+                + (self.points() as u64).saturating_mul(est::PER_ENVELOPE_POINT)
+                + rows * 8 * est::PER_NUMBER,
+        )
     }
 }
 

@@ -65,6 +65,7 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
         initial_length_m: req.initial_length_m,
         gravity_m_s2: req.gravity_m_s2,
         model: req.model.clone(),
+        numerics: Default::default(),
     };
     let model = system_input.model()?;
     let winch = Winch::new(req.winch.max_rate_m_s, req.winch.max_acceleration_m_s2)?;

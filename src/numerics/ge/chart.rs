@@ -399,6 +399,7 @@ pub fn chart_point(
         perturbation,
         aero,
         config,
+        start,
         cancel,
         &|_| {},
     )
@@ -415,6 +416,7 @@ pub fn chart_point_observed(
     perturbation: Option<TipPerturbation>,
     aero: Option<Aerodynamics>,
     config: &CriticalConfig,
+    start: StartState,
     cancel: &(dyn Fn() -> bool + Sync),
     march: &(dyn Fn(f64) + Sync),
 ) -> Result<GeChartPoint, InvalidInput> {
