@@ -132,7 +132,8 @@ fn numeric_fields_name_their_unit() {
         "elements", "modes", "count", "id", "attempts", "progress", "min", "max",
     ];
     // Dimensionless by name: ratios (E*, γ̃ as the issues name them), step
-    // and sample counts, Newton iteration counts, relative tolerances.
+    // and sample counts, Newton iteration counts, relative tolerances,
+    // step cuts (halvings of a time step).
     const DIMENSIONLESS_SUFFIXES: &[&str] = &[
         "_ratio",
         "steps",
@@ -145,6 +146,7 @@ fn numeric_fields_name_their_unit() {
         "iterations_max",
         "iterations_total",
         "_solves",
+        "_cuts",
     ];
     let doc = doc();
     let mut offenders = vec![];
