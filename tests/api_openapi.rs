@@ -160,7 +160,8 @@ fn numeric_fields_name_their_unit() {
         "p50_low", "p50_high", "p95_low", "p95_high", "mean", "std_dev", "low", "high", "seed",
     ];
     // Dimensionless by name: ratios (E*, γ̃ as the issues name them), step
-    // and sample counts, Newton iteration counts, relative tolerances.
+    // and sample counts, Newton iteration counts, relative tolerances,
+    // step cuts (halvings of a time step).
     const DIMENSIONLESS_SUFFIXES: &[&str] = &[
         "_ratio",
         "steps",
@@ -173,6 +174,7 @@ fn numeric_fields_name_their_unit() {
         "iterations_max",
         "iterations_total",
         "_solves",
+        "_cuts",
     ];
     let doc = doc();
     let mut offenders = vec![];
