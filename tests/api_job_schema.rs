@@ -38,12 +38,21 @@ fn with(mut base: Value, extra: Value) -> Value {
 fn requests() -> Vec<(&'static str, Value)> {
     let scale = (0.078f64 / 1000.0).sqrt();
     vec![
-        ("stability", with(string(20), json!({"state": {"length_m": 10.0}, "modes": 3}))),
+        (
+            "stability",
+            with(string(20), json!({"state": {"length_m": 10.0}, "modes": 3})),
+        ),
         (
             "critical",
-            with(string(50), json!({"profile": {"kind": "constant_rate", "rate_m_s": 10.0}})),
+            with(
+                string(50),
+                json!({"profile": {"kind": "constant_rate", "rate_m_s": 10.0}}),
+            ),
         ),
-        ("safe_rate", with(string(50), json!({"target_elevation_m": 100.0}))),
+        (
+            "safe_rate",
+            with(string(50), json!({"target_elevation_m": 100.0})),
+        ),
         (
             "chart",
             with(
@@ -119,7 +128,10 @@ fn assert_valid(v: &jsonschema::Validator, what: &str, instance: &Value) {
         .take(5)
         .map(|e| format!("{} at {}", e, e.instance_path()))
         .collect();
-    assert!(errors.is_empty(), "{what} does not match the schema: {errors:#?}");
+    assert!(
+        errors.is_empty(),
+        "{what} does not match the schema: {errors:#?}"
+    );
 }
 
 fn app() -> (Router, Arc<JobQueue>) {
@@ -193,7 +205,13 @@ async fn every_finished_job_matches_the_published_job_view() {
         assert_valid(&job_view, &format!("the finished {kind} job {id}"), &v);
     }
     // Every item of the batch answered.
-    let (_, v) = call(&app, "GET", &format!("/api/v1/jobs/{}", ids.last().unwrap().1), None).await;
+    let (_, v) = call(
+        &app,
+        "GET",
+        &format!("/api/v1/jobs/{}", ids.last().unwrap().1),
+        None,
+    )
+    .await;
     for item in v["result"]["items"].as_array().unwrap() {
         assert!(item["result"].is_object(), "{item}");
     }
@@ -224,7 +242,10 @@ fn creating_a_job_links_to_getting_and_deleting_it() {
     let doc = serde_json::to_value(openapi()).unwrap();
     for status in ["200", "202"] {
         let links = &doc["paths"]["/api/v1/jobs"]["post"]["responses"][status]["links"];
-        assert_eq!(links["GetJob"]["operationId"], "get_job", "{status}: {links}");
+        assert_eq!(
+            links["GetJob"]["operationId"], "get_job",
+            "{status}: {links}"
+        );
         assert_eq!(links["DeleteJob"]["operationId"], "delete_job");
         assert_eq!(links["GetJob"]["parameters"]["id"], "$response.body#/id");
     }

@@ -15,9 +15,7 @@ use serde_json::{Value, json};
 use tetherplan::api::auth::Tokens;
 use tetherplan::api::{self, AppState};
 use tetherplan::config::Limits;
-use tetherplan::jobs::store::{
-    ClaimPolicy, InsertError, JobBackend, JobStatus, JobStore, NewJob,
-};
+use tetherplan::jobs::store::{ClaimPolicy, InsertError, JobBackend, JobStatus, JobStore, NewJob};
 use tetherplan::jobs::{JobQueue, Submitter, try_execute_next};
 use tower::ServiceExt;
 
@@ -64,10 +62,16 @@ impl Answer {
         serde_json::from_str(&self.text).unwrap_or_else(|e| panic!("not JSON ({e}): {}", self.text))
     }
     fn code(&self) -> String {
-        self.json()["error"]["code"].as_str().unwrap_or("").to_string()
+        self.json()["error"]["code"]
+            .as_str()
+            .unwrap_or("")
+            .to_string()
     }
     fn field(&self) -> String {
-        self.json()["error"]["field"].as_str().unwrap_or("").to_string()
+        self.json()["error"]["field"]
+            .as_str()
+            .unwrap_or("")
+            .to_string()
     }
 }
 
@@ -119,7 +123,12 @@ async fn a_batch_of_a_thousand_million_point_charts_is_refused_at_submission() {
     let started = std::time::Instant::now();
     let a = send(&app, "POST", "/api/v1/jobs", &[], Some(&batch)).await;
     assert_eq!(a.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", a.text);
-    assert_eq!(a.field(), "request[0].request.rates_m_s.count", "{}", a.text);
+    assert_eq!(
+        a.field(),
+        "request[0].request.rates_m_s.count",
+        "{}",
+        a.text
+    );
     assert!(a.text.contains("MB"), "{}", a.text);
     assert!(started.elapsed() < Duration::from_secs(10));
     // One such chart alone is refused as well…
@@ -168,7 +177,10 @@ async fn a_finished_job_serves_its_stored_answer_verbatim() {
     let (app, queue) = app_with(Limits::default(), &[]);
     let a = send(&app, "POST", "/api/v1/jobs", &[], Some(&chart_job(300, 20))).await;
     let id = a.json()["id"].as_i64().unwrap();
-    assert_eq!(try_execute_next(&queue).unwrap().unwrap().status, JobStatus::Done);
+    assert_eq!(
+        try_execute_next(&queue).unwrap().unwrap().status,
+        JobStatus::Done
+    );
     let stored = queue.store.get(id).unwrap().unwrap().result.unwrap();
     let a = send(&app, "GET", &format!("/api/v1/jobs/{id}"), &[], None).await;
     assert_eq!(a.status, StatusCode::OK);
@@ -178,7 +190,10 @@ async fn a_finished_job_serves_its_stored_answer_verbatim() {
     assert_eq!(&a.text[at + prefix.len()..a.text.len() - 1], stored);
     let v = a.json();
     assert_eq!(v["status"], "done");
-    assert_eq!(v["result"]["series"][0]["points"].as_array().unwrap().len(), 300);
+    assert_eq!(
+        v["result"]["series"][0]["points"].as_array().unwrap().len(),
+        300
+    );
 }
 
 /// A job that runs past the run-time limit fails with the reason.
@@ -190,7 +205,14 @@ async fn a_job_past_its_run_time_limit_fails_with_the_reason() {
     };
     let (app, queue) = app_with(limits, &[]);
     // Several seconds of work at 1000 elements.
-    let a = send(&app, "POST", "/api/v1/jobs", &[], Some(&chart_job(5000, 1000))).await;
+    let a = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        &[],
+        Some(&chart_job(5000, 1000)),
+    )
+    .await;
     let id = a.json()["id"].as_i64().unwrap();
     let started = std::time::Instant::now();
     let q = queue.clone();
@@ -198,10 +220,21 @@ async fn a_job_past_its_run_time_limit_fails_with_the_reason() {
         .await
         .unwrap();
     assert_eq!(ran.status, JobStatus::Failed);
-    assert!(started.elapsed() < Duration::from_secs(5), "{:?}", started.elapsed());
-    let v = send(&app, "GET", &format!("/api/v1/jobs/{id}"), &[], None).await.json();
+    assert!(
+        started.elapsed() < Duration::from_secs(5),
+        "{:?}",
+        started.elapsed()
+    );
+    let v = send(&app, "GET", &format!("/api/v1/jobs/{id}"), &[], None)
+        .await
+        .json();
     assert_eq!(v["error"]["error"]["code"], "run_time_exceeded", "{v}");
-    assert!(v["error"]["error"]["message"].as_str().unwrap().contains("0.3 s"));
+    assert!(
+        v["error"]["error"]["message"]
+            .as_str()
+            .unwrap()
+            .contains("0.3 s")
+    );
 }
 
 // ---------------------------------------------------------------- tokens
@@ -226,31 +259,71 @@ async fn with_tokens_every_api_route_needs_one_and_jobs_belong_to_their_token() 
             ("GET", "/api/v1/jobs", None),
             ("GET", "/api/v1/jobs/1", None),
             ("DELETE", "/api/v1/jobs/1", None),
-            ("POST", "/api/v1/critical", Some(critical_job(10.0)["request"].clone())),
+            (
+                "POST",
+                "/api/v1/critical",
+                Some(critical_job(10.0)["request"].clone()),
+            ),
             ("GET", "/api/v1/nowhere", None),
         ] {
             let a = send(&app, method, uri, &headers, body.as_ref()).await;
-            assert_eq!(a.status, StatusCode::UNAUTHORIZED, "{method} {uri} {headers:?}");
+            assert_eq!(
+                a.status,
+                StatusCode::UNAUTHORIZED,
+                "{method} {uri} {headers:?}"
+            );
             assert_eq!(a.code(), "unauthorized");
             let challenge = a.headers[header::WWW_AUTHENTICATE].to_str().unwrap();
-            assert!(challenge.starts_with("Bearer realm=\"tetherplan\""), "{challenge}");
+            assert!(
+                challenge.starts_with("Bearer realm=\"tetherplan\""),
+                "{challenge}"
+            );
         }
     }
     // Outside /api nothing is asked.
-    assert_eq!(send(&app, "GET", "/healthz", &[], None).await.status, StatusCode::OK);
-    assert_eq!(send(&app, "GET", "/openapi.json", &[], None).await.status, StatusCode::OK);
+    assert_eq!(
+        send(&app, "GET", "/healthz", &[], None).await.status,
+        StatusCode::OK
+    );
+    assert_eq!(
+        send(&app, "GET", "/openapi.json", &[], None).await.status,
+        StatusCode::OK
+    );
     // A synchronous route with a token answers.
-    let a = send(&app, "POST", "/api/v1/critical", &alice, Some(&critical_job(10.0)["request"])).await;
+    let a = send(
+        &app,
+        "POST",
+        "/api/v1/critical",
+        &alice,
+        Some(&critical_job(10.0)["request"]),
+    )
+    .await;
     assert_eq!(a.status, StatusCode::OK, "{}", a.text);
 
     // Alice's job is hers: Bob gets 404 and does not see it listed or cancel it.
-    let a = send(&app, "POST", "/api/v1/jobs", &alice, Some(&critical_job(10.0))).await;
+    let a = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        &alice,
+        Some(&critical_job(10.0)),
+    )
+    .await;
     assert_eq!(a.status, StatusCode::ACCEPTED, "{}", a.text);
     let id = a.json()["id"].as_i64().unwrap();
     let uri = format!("/api/v1/jobs/{id}");
-    assert_eq!(send(&app, "GET", &uri, &alice, None).await.status, StatusCode::OK);
-    assert_eq!(send(&app, "GET", &uri, &bob, None).await.status, StatusCode::NOT_FOUND);
-    assert_eq!(send(&app, "DELETE", &uri, &bob, None).await.status, StatusCode::NOT_FOUND);
+    assert_eq!(
+        send(&app, "GET", &uri, &alice, None).await.status,
+        StatusCode::OK
+    );
+    assert_eq!(
+        send(&app, "GET", &uri, &bob, None).await.status,
+        StatusCode::NOT_FOUND
+    );
+    assert_eq!(
+        send(&app, "DELETE", &uri, &bob, None).await.status,
+        StatusCode::NOT_FOUND
+    );
     let listed = send(&app, "GET", "/api/v1/jobs", &bob, None).await.json();
     assert!(listed["jobs"].as_array().unwrap().is_empty(), "{listed}");
     let listed = send(&app, "GET", "/api/v1/jobs", &alice, None).await.json();
@@ -287,10 +360,24 @@ async fn each_token_has_a_queue_quota() {
     let b_h = bearer("beta-token");
     let bob = [("authorization", b_h.as_str())];
     for rate in [1.0, 2.0] {
-        let a = send(&app, "POST", "/api/v1/jobs", &alice, Some(&critical_job(rate))).await;
+        let a = send(
+            &app,
+            "POST",
+            "/api/v1/jobs",
+            &alice,
+            Some(&critical_job(rate)),
+        )
+        .await;
         assert_eq!(a.status, StatusCode::ACCEPTED);
     }
-    let a = send(&app, "POST", "/api/v1/jobs", &alice, Some(&critical_job(3.0))).await;
+    let a = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        &alice,
+        Some(&critical_job(3.0)),
+    )
+    .await;
     assert_eq!(a.status, StatusCode::TOO_MANY_REQUESTS, "{}", a.text);
     assert_eq!(a.code(), "quota_full");
     assert!(a.headers.contains_key(header::RETRY_AFTER));
@@ -305,34 +392,96 @@ async fn each_token_has_a_queue_quota() {
 async fn an_idempotency_key_returns_the_first_job() {
     let (app, queue) = app_with(Limits::default(), &["alpha-token", "beta-token"]);
     let a_h = bearer("alpha-token");
-    let alice = [("authorization", a_h.as_str()), ("idempotency-key", "order-17")];
+    let alice = [
+        ("authorization", a_h.as_str()),
+        ("idempotency-key", "order-17"),
+    ];
     let b_h = bearer("beta-token");
-    let bob = [("authorization", b_h.as_str()), ("idempotency-key", "order-17")];
-    let first = send(&app, "POST", "/api/v1/jobs", &alice, Some(&critical_job(10.0))).await;
+    let bob = [
+        ("authorization", b_h.as_str()),
+        ("idempotency-key", "order-17"),
+    ];
+    let first = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        &alice,
+        Some(&critical_job(10.0)),
+    )
+    .await;
     assert_eq!(first.status, StatusCode::ACCEPTED);
     let id = first.json()["id"].as_i64().unwrap();
     // The lost-202 retry: same key, same body → the same job, 200.
-    let again = send(&app, "POST", "/api/v1/jobs", &alice, Some(&critical_job(10.0))).await;
+    let again = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        &alice,
+        Some(&critical_job(10.0)),
+    )
+    .await;
     assert_eq!(again.status, StatusCode::OK, "{}", again.text);
     assert_eq!(again.json()["id"], id);
-    assert_eq!(again.headers[header::LOCATION], format!("/api/v1/jobs/{id}"));
+    assert_eq!(
+        again.headers[header::LOCATION],
+        format!("/api/v1/jobs/{id}")
+    );
     // After it ran, a retry still returns it, with its status.
     try_execute_next(&queue).unwrap();
-    let again = send(&app, "POST", "/api/v1/jobs", &alice, Some(&critical_job(10.0))).await;
-    assert_eq!((again.status, again.json()["status"].clone()), (StatusCode::OK, json!("done")));
+    let again = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        &alice,
+        Some(&critical_job(10.0)),
+    )
+    .await;
+    assert_eq!(
+        (again.status, again.json()["status"].clone()),
+        (StatusCode::OK, json!("done"))
+    );
     // Same key, another body: 422 naming the header.
-    let other = send(&app, "POST", "/api/v1/jobs", &alice, Some(&critical_job(11.0))).await;
-    assert_eq!(other.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", other.text);
+    let other = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        &alice,
+        Some(&critical_job(11.0)),
+    )
+    .await;
+    assert_eq!(
+        other.status,
+        StatusCode::UNPROCESSABLE_ENTITY,
+        "{}",
+        other.text
+    );
     assert_eq!(other.code(), "idempotency_key_reused");
     assert_eq!(other.field(), "Idempotency-Key");
     assert!(other.text.contains(&format!("job {id}")), "{}", other.text);
     // Keys are per token: Bob's "order-17" is another job.
-    let b = send(&app, "POST", "/api/v1/jobs", &bob, Some(&critical_job(11.0))).await;
+    let b = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        &bob,
+        Some(&critical_job(11.0)),
+    )
+    .await;
     assert_eq!(b.status, StatusCode::ACCEPTED);
     assert_ne!(b.json()["id"], id);
     // A bad key is refused.
-    let bad = [("authorization", a_h.as_str()), ("idempotency-key", "with space")];
-    let a = send(&app, "POST", "/api/v1/jobs", &bad, Some(&critical_job(10.0))).await;
+    let bad = [
+        ("authorization", a_h.as_str()),
+        ("idempotency-key", "with space"),
+    ];
+    let a = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        &bad,
+        Some(&critical_job(10.0)),
+    )
+    .await;
     assert_eq!(a.status, StatusCode::UNPROCESSABLE_ENTITY);
     assert_eq!(queue.store.list(None, 10).unwrap().len(), 2);
 }
@@ -438,7 +587,12 @@ fn the_queue_fails_an_exhausted_job_with_a_reason() {
     assert_eq!(rec.status, JobStatus::Failed);
     let error: Value = serde_json::from_str(&rec.error.unwrap()).unwrap();
     assert_eq!(error["error"]["code"], "attempts_exhausted");
-    assert!(error["error"]["message"].as_str().unwrap().contains("started 2 times"));
+    assert!(
+        error["error"]["message"]
+            .as_str()
+            .unwrap()
+            .contains("started 2 times")
+    );
 }
 
 /// A restarted process on the same host takes over its dead predecessor's
@@ -472,7 +626,10 @@ fn the_store_keeps_one_job_per_key() {
     };
     let first = store.insert(&job("h1")).unwrap();
     let again = store.insert(&job("h1")).unwrap();
-    assert!(matches!(again, tetherplan::jobs::store::Inserted::Existing { .. }));
+    assert!(matches!(
+        again,
+        tetherplan::jobs::store::Inserted::Existing { .. }
+    ));
     assert!(matches!(
         store.insert(&job("h2")),
         Err(InsertError::KeyReused { .. })

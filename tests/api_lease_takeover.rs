@@ -50,7 +50,9 @@ impl Server {
     }
 
     fn request(&self, method: &str, path: &str, body: Option<&Value>) -> (u16, Value) {
-        let body = body.map(|b| serde_json::to_vec(b).unwrap()).unwrap_or_default();
+        let body = body
+            .map(|b| serde_json::to_vec(b).unwrap())
+            .unwrap_or_default();
         let mut s = TcpStream::connect(self.addr).unwrap();
         s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
         let head = format!(
@@ -66,7 +68,10 @@ impl Server {
         let head = String::from_utf8_lossy(&raw[..split]).to_string();
         let status = head.split(' ').nth(1).unwrap().parse().unwrap();
         let mut body = raw[split + 4..].to_vec();
-        if head.to_ascii_lowercase().contains("transfer-encoding: chunked") {
+        if head
+            .to_ascii_lowercase()
+            .contains("transfer-encoding: chunked")
+        {
             body = dechunk(&body);
         }
         (status, serde_json::from_slice(&body).unwrap_or(Value::Null))
@@ -134,10 +139,11 @@ fn a_killed_servers_job_is_taken_over_after_its_lease_and_run_once() {
     // Wait until one of them runs it with progress.
     let start = Instant::now();
     let holder = loop {
-        let (_, v) = servers[1]
-            .as_ref()
-            .unwrap()
-            .request("GET", &format!("/api/v1/jobs/{id}"), None);
+        let (_, v) =
+            servers[1]
+                .as_ref()
+                .unwrap()
+                .request("GET", &format!("/api/v1/jobs/{id}"), None);
         let (status, attempts, owner) = row(&db, id);
         if status == "running" && v["progress"].as_f64().unwrap_or(0.0) > 0.0 {
             assert_eq!(attempts, 1);
@@ -172,7 +178,10 @@ fn a_killed_servers_job_is_taken_over_after_its_lease_and_run_once() {
     };
     let survivor_server = servers[survivor].as_ref().unwrap();
     assert_eq!(pid_of(&taken.1), survivor_server.child.id());
-    eprintln!("lease takeover {:.2} s after SIGKILL (lease 2 s)", taken.0.as_secs_f64());
+    eprintln!(
+        "lease takeover {:.2} s after SIGKILL (lease 2 s)",
+        taken.0.as_secs_f64()
+    );
     assert!(
         taken.0 >= Duration::from_millis(600),
         "taken over before the lease could have expired: {:?}",

@@ -4,9 +4,7 @@
 
 use utoipa::Modify;
 use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityRequirement, SecurityScheme};
-use utoipa::openapi::{
-    ContentBuilder, HeaderBuilder, OpenApi, Ref, ResponseBuilder, schema::Type,
-};
+use utoipa::openapi::{ContentBuilder, HeaderBuilder, OpenApi, Ref, ResponseBuilder, schema::Type};
 
 /// Name of the security scheme.
 pub const SCHEME: &str = "bearer";
@@ -36,7 +34,9 @@ impl Modify for BearerTokens {
             .header(
                 "WWW-Authenticate",
                 HeaderBuilder::new()
-                    .schema(Some(utoipa::openapi::schema::ObjectBuilder::new().schema_type(Type::String)))
+                    .schema(Some(
+                        utoipa::openapi::schema::ObjectBuilder::new().schema_type(Type::String),
+                    ))
                     .description(Some("`Bearer realm=\"tetherplan\"`"))
                     .build(),
             )

@@ -79,7 +79,10 @@ impl JobKind for StabilityRequest {
         to_json(&run::stability(self)?)
     }
     fn estimate(&self) -> Estimate {
-        E::new("modes", est::STABILITY_BASE + self.params.modes as u64 * est::PER_EIGENVALUE)
+        E::bytes(
+            "modes",
+            est::STABILITY_BASE as f64 + self.params.modes as f64 * est::PER_EIGENVALUE as f64,
+        )
     }
 }
 
@@ -219,11 +222,13 @@ impl JobKind for ChartRequest {
         })
     }
     fn estimate(&self) -> Estimate {
-        let series = self.params.net_buoyancies_n.len().max(1) as u64;
-        let points = series.saturating_mul(self.params.rates_m_s.count as u64);
-        E::new(
+        let series = self.params.net_buoyancies_n.len().max(1) as f64;
+        let points = series * self.params.rates_m_s.count as f64;
+        E::bytes(
             "rates_m_s.count",
-            est::CHART_BASE + series * est::PER_CHART_SERIES + points * est::PER_CHART_POINT,
+            (est::CHART_BASE as f64)
+                + series * est::PER_CHART_SERIES as f64
+                + points * est::PER_CHART_POINT as f64,
         )
     }
 }
@@ -285,32 +290,32 @@ impl JobKind for AnySimulateRequest {
     fn estimate(&self) -> Estimate {
         match self {
             Self::LinearString(r) => {
-                let samples = r.params.samples as u64;
-                let tracks = r.params.eigenvalues.as_ref().map_or(0, |e| {
-                    let every = e.interval_s.max(1e-9);
-                    let solves = (r.params.duration_s / every).ceil().clamp(0.0, 1e12) as u64 + 1;
-                    solves.saturating_mul(
-                        est::PER_EIGEN_TRACK + e.count as u64 * est::PER_EIGENVALUE,
-                    )
+                let samples = r.params.samples as f64;
+                let tracks = r.params.eigenvalues.as_ref().map_or(0.0, |e| {
+                    let solves = (r.params.duration_s / e.interval_s).ceil() + 1.0;
+                    solves
+                        * (est::PER_EIGEN_TRACK as f64 + e.count as f64 * est::PER_EIGENVALUE as f64)
                 });
-                E::new(
+                E::bytes(
                     "samples",
-                    est::SIMULATE_BASE + samples * est::PER_SIMULATE_SAMPLE + tracks,
+                    est::SIMULATE_BASE as f64 + samples * est::PER_SIMULATE_SAMPLE as f64 + tracks,
                 )
             }
             Self::GeometricallyExact(r) => {
-                let steps = (r.duration_s / r.time_step_s).ceil().clamp(0.0, 1e15);
-                let samples = (steps / r.output_every_steps.max(1) as f64).ceil() as u64 + 1;
+                let steps = (r.duration_s / r.time_step_s).ceil();
+                let samples = (steps / r.output_every_steps.max(1) as f64).ceil() + 1.0;
                 let spectra = if r.eigenvalues_every_steps > 0 {
-                    (steps / r.eigenvalues_every_steps as f64).ceil() as u64 + 1
+                    (steps / r.eigenvalues_every_steps as f64).ceil() + 1.0
                 } else {
-                    0
+                    0.0
                 };
-                E::new(
+                E::bytes(
                     "output_every_steps",
-                    est::SIMULATE_BASE
-                        + samples * est::PER_GE_SAMPLE
-                        + spectra * (est::PER_EIGEN_TRACK + r.modes as u64 * est::PER_EIGENVALUE),
+                    est::SIMULATE_BASE as f64
+                        + samples * est::PER_GE_SAMPLE as f64
+                        + spectra
+                            * (est::PER_EIGEN_TRACK as f64
+                                + r.modes as f64 * est::PER_EIGENVALUE as f64),
                 )
             }
         }
@@ -362,10 +367,11 @@ impl JobKind for AnyChartRequest {
         match self {
             Self::LinearString(r) => r.estimate(),
             Self::GeometricallyExact(r) => {
-                let points = ge_charts::prepare_chart(r).map_or(0, |c| c.point_count()) as u64;
-                E::new(
+                let points = ge_charts::prepare_chart(r).map_or(0, |c| c.point_count()) as f64;
+                E::bytes(
                     "rates_m_s",
-                    est::CHART_BASE + points * (est::PER_GE_CHART_POINT + est::PER_CHART_SERIES),
+                    est::CHART_BASE as f64
+                        + points * (est::PER_GE_CHART_POINT + est::PER_CHART_SERIES) as f64,
                 )
             }
         }
@@ -392,16 +398,17 @@ impl JobKind for AnyFrequencyResponseRequest {
     fn estimate(&self) -> Estimate {
         match self {
             Self::Wind(r) => {
-                let f = r.params.frequencies_rad_s.count as u64;
-                let n = r.params.samples as u64;
-                E::new(
+                let f = r.params.frequencies_rad_s.count as f64;
+                let n = r.params.samples as f64;
+                E::bytes(
                     "frequencies_rad_s.count",
-                    est::SIMULATE_BASE + f.saturating_mul(n + 4) * est::PER_NUMBER + n * est::PER_NUMBER,
+                    est::SIMULATE_BASE as f64 + (f * (n + 4.0) + n) * est::PER_NUMBER as f64,
                 )
             }
-            Self::Base(r) => E::new(
+            Self::Base(r) => E::bytes(
                 "frequencies_rad_s.count",
-                est::SIMULATE_BASE + r.frequencies_rad_s.count as u64 * est::PER_BASE_POINT,
+                est::SIMULATE_BASE as f64
+                    + r.frequencies_rad_s.count as f64 * est::PER_BASE_POINT as f64,
             ),
         }
     }
@@ -563,7 +570,18 @@ job_kinds!(
 );
 
 impl JobItem {
+    #[cfg(test)]
     fn parse(value: &Value, prefix: &str) -> Result<Self, RequestError> {
+        Self::parse_bounded(value, prefix, u64::MAX)
+    }
+
+    /// Parses, refuses an answer estimated above `max_result_bytes` (before
+    /// the costlier validation), then validates.
+    fn parse_bounded(
+        value: &Value,
+        prefix: &str,
+        max_result_bytes: u64,
+    ) -> Result<Self, RequestError> {
         let obj = value.as_object().ok_or_else(|| {
             InvalidInput::new(
                 prefix.to_string(),
@@ -600,6 +618,10 @@ impl JobItem {
             )
             .into())
         })?;
+        est::check(
+            &item.estimate().prefixed(&request_field),
+            max_result_bytes,
+        )?;
         item.validate_kind()
             .map_err(|e| prefixed(e, &request_field))?;
         Ok(item)
@@ -715,11 +737,7 @@ impl JobSubmission {
         let value: Value =
             serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
         if value.get("kind").and_then(Value::as_str) != Some("batch") {
-            let item = JobItem::parse(&value, "body")?;
-            est::check(
-                &item.estimate().prefixed("request"),
-                limits.max_job_result_bytes,
-            )?;
+            let item = JobItem::parse_bounded(&value, "body", limits.max_job_result_bytes)?;
             return Ok(Self::One(item));
         }
         if let Some(obj) = value.as_object() {
@@ -748,7 +766,9 @@ impl JobSubmission {
         let request = list
             .iter()
             .enumerate()
-            .map(|(i, v)| JobItem::parse(v, &format!("request[{i}]")))
+            .map(|(i, v)| {
+                JobItem::parse_bounded(v, &format!("request[{i}]"), limits.max_job_result_bytes)
+            })
             .collect::<Result<Vec<_>, _>>()?;
         est::check_batch(
             request.iter().map(JobItem::estimate),

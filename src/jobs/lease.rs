@@ -141,7 +141,10 @@ mod tests {
         // pid 1 is alive on every Unix host (init).
         assert!(!me.is_dead_local(&format!("{host}/1/00")));
         assert!(!me.is_dead_local("elsewhere/999999/00"), "another host");
-        assert!(me.is_dead_local(&format!("{host}/4194303/00")), "no such pid");
+        assert!(
+            me.is_dead_local(&format!("{host}/4194303/00")),
+            "no such pid"
+        );
         assert!(!me.is_dead_local("garbage"));
     }
 }

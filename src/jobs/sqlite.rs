@@ -15,8 +15,8 @@ use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
 
 use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
 use super::store::{
-    ClaimPolicy, ClaimedJob, InsertError, Inserted, JobBackend, JobRecord, JobStatus, KeyedJob, NewJob,
-    StoreError,
+    ClaimPolicy, ClaimedJob, InsertError, Inserted, JobBackend, JobRecord, JobStatus, KeyedJob,
+    NewJob, StoreError,
 };
 
 const SCHEMA_V1: &str = "
@@ -156,7 +156,12 @@ impl JobStore {
         })
     }
 
-    fn fenced(&self, sql_set: &str, lease: &Lease, extra: Option<&dyn rusqlite::ToSql>) -> Result<bool, StoreError> {
+    fn fenced(
+        &self,
+        sql_set: &str,
+        lease: &Lease,
+        extra: Option<&dyn rusqlite::ToSql>,
+    ) -> Result<bool, StoreError> {
         let sql = format!("UPDATE jobs SET {sql_set} WHERE {FENCE}");
         let n = match extra {
             Some(x) => self
@@ -412,20 +417,37 @@ impl JobBackend for JobStore {
         self.get_owned(id, owner)
     }
 
+    /// The answer is read with SQLite's incremental I/O straight into one
+    /// buffer of its size: a 100 MB answer costs 100 MB, not twice that
+    /// (SQLite's copy of the value and ours).
     fn get_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobRecord>, StoreError> {
         let sql = format!(
-            "SELECT {}, result, error FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
+            "SELECT {}, octet_length(result), error FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
             Self::COLUMNS
         );
-        Ok(self
-            .conn()
+        let conn = self.conn();
+        let found = conn
             .query_row(&sql, params![id, owner], |r| {
                 let mut rec = Self::record(r)?;
-                rec.result = r.get(9)?;
                 rec.error = r.get(10)?;
-                Ok(rec)
+                Ok((rec, r.get::<_, Option<i64>>(9)?))
             })
-            .optional()?)
+            .optional()?;
+        let Some((mut rec, result_bytes)) = found else {
+            return Ok(None);
+        };
+        if let Some(n) = result_bytes {
+            use std::io::Read;
+            let mut blob = conn.blob_open(rusqlite::MAIN_DB, "jobs", "result", id, true)?;
+            let mut buf = vec![0u8; n.max(0) as usize];
+            blob.read_exact(&mut buf)
+                .map_err(|e| StoreError(format!("reading the answer of job {id}: {e}")))?;
+            rec.result =
+                Some(String::from_utf8(buf).map_err(|e| {
+                    StoreError(format!("the answer of job {id} is not UTF-8: {e}"))
+                })?);
+        }
+        Ok(Some(rec))
     }
 
     fn list_owned(

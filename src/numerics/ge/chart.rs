@@ -2,7 +2,7 @@
 //! and `h* = L(t*)` against a grid of constant rates, one series per
 //! stiffness ratio `E*`, tip perturbation `F0`, net buoyancy and (with
 //! wind) amplitude `A0` of the perturbed flow (7.4). Every
-//! point is an independent [`critical_time`] search from `L0`; the points
+//! point is an independent [`critical_time`](super::critical::critical_time) search from `L0`; the points
 //! fan out on rayon when asked ([`Parallelism::Rayon`]) and the result is
 //! the same bit for bit as the serial sweep.
 
