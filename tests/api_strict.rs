@@ -372,7 +372,29 @@ fn typed(job_kind: &str, text: &str) -> Result<(), String> {
         "simulate" => serde_json::from_str::<AnySimulateResponse>(text).map(drop),
         _ => serde_json::from_str::<AnyFrequencyResponseResponse>(text).map(drop),
     };
-    r.map_err(|e| format!("{e}"))
+    r.map_err(|e| {
+        let mut nulls = vec![];
+        null_paths(
+            &serde_json::from_str(text).unwrap_or(Value::Null),
+            String::new(),
+            &mut nulls,
+        );
+        format!("{e}; nulls at {:?}", &nulls[..nulls.len().min(8)])
+    })
+}
+
+fn null_paths(v: &Value, at: String, out: &mut Vec<String>) {
+    match v {
+        Value::Null => out.push(at),
+        Value::Object(m) => m
+            .iter()
+            .for_each(|(k, x)| null_paths(x, format!("{at}.{k}"), out)),
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .for_each(|(i, x)| null_paths(x, format!("{at}[{i}]"), out)),
+        _ => {}
+    }
 }
 
 /// Every object path of a JSON value (key paths; array indices as numbers).
