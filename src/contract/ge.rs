@@ -311,6 +311,15 @@ pub struct GeGroups {
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
 pub struct GeSimulateResponse {
     pub outcome: GeOutcome,
+    /// First instant whose local-stability QEP (`spectra`, every
+    /// `eigenvalues_every_steps`) is unstable (s); null when every one was
+    /// stable or none was solved. The samples after it show growth past
+    /// onset. (The GE cable's deflection is bounded by its stretched
+    /// length, so a GE run needs no magnitude cap: it ends `completed` or
+    /// `newton_failed`.)
+    pub first_unstable_time_s: Option<f64>,
+    /// Why the run ended: `completed` or `newton_failed`.
+    pub stopped_reason: String,
     pub series: GeSeries,
     pub spectra: Vec<GeSpectrumOutput>,
     pub steps: usize,
@@ -643,7 +652,18 @@ pub fn simulate_ge(
                 .collect(),
         })
         .collect();
+    let first_unstable_time_s = result
+        .spectra
+        .iter()
+        .find(|s| !s.spectrum.is_stable())
+        .map(|s| s.time_s);
+    let stopped_reason = match outcome {
+        GeOutcome::Completed => "completed",
+        GeOutcome::NewtonFailed { .. } => "newton_failed",
+    };
     Ok(GeSimulateResponse {
+        first_unstable_time_s,
+        stopped_reason: stopped_reason.into(),
         outcome,
         series,
         spectra,
@@ -670,6 +690,8 @@ fn groups(p: &Prepared) -> GeGroups {
 
 fn failed_before_start(p: &Prepared, f: solver::NewtonFailure) -> GeSimulateResponse {
     GeSimulateResponse {
+        first_unstable_time_s: None,
+        stopped_reason: "newton_failed".into(),
         outcome: GeOutcome::NewtonFailed {
             step: 0,
             time_s: 0.0,

@@ -686,8 +686,9 @@ pub struct BaseResponsePointOutput {
     pub frequency_rad_s: f64,
     /// ω̄ = ω L0 √(I_ρ/EI).
     pub frequency_nondim: f64,
-    /// Amplitude gain (8.3) (dB).
-    pub gain_db: f64,
+    /// Amplitude gain (8.3) (dB); null when it has no finite value (the
+    /// run or the reference run failed before moving the tip).
+    pub gain_db: Option<f64>,
     /// max |u2(1,t) + r(t)| (m).
     pub max_tip_amplitude_m: f64,
     /// False if Newton failed before the end of the run.
@@ -854,7 +855,7 @@ pub fn ge_base_frequency_response(
     let out = |p: &base::ResponsePoint| BaseResponsePointOutput {
         frequency_rad_s: p.frequency_rad_s,
         frequency_nondim: p.frequency_rad_s * scale,
-        gain_db: p.gain_db,
+        gain_db: p.gain_db.is_finite().then_some(p.gain_db),
         max_tip_amplitude_m: p.max_tip_amplitude_m,
         completed: p.completed,
     };

@@ -101,16 +101,64 @@ pub fn parse_value<T: serde::de::DeserializeOwned>(
             .iter()
             .find_map(|p| message.strip_prefix(p))
             .and_then(|rest| rest.split('`').next());
+        let unknown = message.starts_with("unknown field `");
         let field = match named {
             // serde_path_to_error already ends the path with an unknown key
             // of a plain struct (not inside a tagged enum).
             Some(name) if path == name || path.ends_with(&format!(".{name}")) => path,
+            // inside a tagged enum the path stops at the enum: find the key below it
+            Some(name) if unknown => find_key(value, &path, name)
+                .unwrap_or_else(|| format!("{prefix}{name}")),
             Some(name) => format!("{prefix}{name}"),
             None if prefix.is_empty() => "body".to_string(),
             None => path,
         };
         RequestError::Invalid(InvalidInput::new(field, plain_words(&message)))
     })
+}
+
+/// The full path of the first object holding `key` at or below `path`
+/// (`profile.points[1]`) in `value`.
+fn find_key(value: &serde_json::Value, path: &str, key: &str) -> Option<String> {
+    let mut node = value;
+    if !(path.is_empty() || path == ".") {
+        for part in path.split('.') {
+            let (name, indices) = match part.find('[') {
+                Some(i) => (&part[..i], &part[i..]),
+                None => (part, ""),
+            };
+            if !name.is_empty() {
+                node = node.get(name)?;
+            }
+            for index in indices.split(['[', ']']).filter(|s| !s.is_empty()) {
+                node = node.get(index.parse::<usize>().ok()?)?;
+            }
+        }
+    }
+    fn search(v: &serde_json::Value, at: String, key: &str) -> Option<String> {
+        let join = |at: &str, k: &str| {
+            if at.is_empty() {
+                k.to_string()
+            } else {
+                format!("{at}.{k}")
+            }
+        };
+        match v {
+            serde_json::Value::Object(m) => {
+                if m.contains_key(key) {
+                    return Some(join(&at, key));
+                }
+                m.iter().find_map(|(k, x)| search(x, join(&at, k), key))
+            }
+            serde_json::Value::Array(a) => a
+                .iter()
+                .enumerate()
+                .find_map(|(i, x)| search(x, format!("{at}[{i}]"), key)),
+            _ => None,
+        }
+    }
+    let at = if path == "." { String::new() } else { path.to_string() };
+    search(node, at, key)
 }
 
 /// serde's messages in plain words: "must be a number, got string \"x\""

@@ -450,6 +450,8 @@ fn check_ge_wind(w: &GeWindInput) -> Checked {
 
 impl GeChartRequest {
     pub fn check_ranges(&self) -> Checked {
+        // a chart of elevation limits needs gravity (the closed forms divide by g)
+        GRAVITY_M_S2.check("gravity_m_s2", self.gravity_m_s2)?;
         check_ge_system(
             &self.cable,
             Some(&self.aerostat),

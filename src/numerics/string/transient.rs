@@ -752,11 +752,13 @@ fn run_planned(
         // Advance.
         let t_next = (step + 1) as f64 * dt_s;
         let v_pred = nm.predicted_velocity(dt, &state, n - 1);
-        (kin, s, force_n) = eval.evaluate(t_next, v_pred, &mut matrices, &mut load);
-        if kin.length_m < MIN_LENGTH_FRACTION * l0 {
+        let next = eval.evaluate(t_next, v_pred, &mut matrices, &mut load);
+        if next.0.length_m < MIN_LENGTH_FRACTION * l0 {
+            // stop at the last state with a length (its sample stays finite)
             outcome = RunOutcome::LengthCollapsed { time_s: t_next };
             break;
         }
+        (kin, s, force_n) = next;
         if let Err(e) = nm.step(
             dt,
             &matrices.mass,
