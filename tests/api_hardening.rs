@@ -73,7 +73,9 @@ impl Server {
 
     fn send(&self, method: &str, path: &str, host: &str, body: Option<&Value>) -> Reply {
         let mut s = self.connect();
-        let body = body.map(|b| serde_json::to_vec(b).unwrap()).unwrap_or_default();
+        let body = body
+            .map(|b| serde_json::to_vec(b).unwrap())
+            .unwrap_or_default();
         let mut head = format!(
             "{method} {path} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\nContent-Length: {}\r\n",
             body.len()
@@ -120,7 +122,14 @@ impl Reply {
             .unwrap_or_else(|| panic!("a complete response: {:?}", String::from_utf8_lossy(raw)));
         let head = String::from_utf8_lossy(&raw[..split]).into_owned();
         let mut lines = head.split("\r\n");
-        let status = lines.next().unwrap().split(' ').nth(1).unwrap().parse().unwrap();
+        let status = lines
+            .next()
+            .unwrap()
+            .split(' ')
+            .nth(1)
+            .unwrap()
+            .parse()
+            .unwrap();
         let headers = lines
             .filter_map(|l| l.split_once(':'))
             .map(|(k, v)| (k.trim().to_ascii_lowercase(), v.trim().to_string()))
@@ -157,7 +166,10 @@ fn with(mut base: Value, extra: Value) -> Value {
 }
 
 fn critical_body() -> Value {
-    with(system(50), json!({"profile": {"kind": "constant_rate", "rate_m_s": 10.0}}))
+    with(
+        system(50),
+        json!({"profile": {"kind": "constant_rate", "rate_m_s": 10.0}}),
+    )
 }
 
 /// The hang input: 250 bytes that kept a core busy for minutes.
@@ -232,7 +244,10 @@ fn time_until_critical_answers(server: &Server, limit: Duration) -> Duration {
             return start.elapsed();
         }
         assert_eq!(r.status, 503, "{}", r.body);
-        assert!(start.elapsed() < limit, "the solve slot was not freed within {limit:?}");
+        assert!(
+            start.elapsed() < limit,
+            "the solve slot was not freed within {limit:?}"
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
 }
@@ -241,7 +256,10 @@ fn time_until_critical_answers(server: &Server, limit: Duration) -> Duration {
 fn a_slow_solve_stops_at_its_timeout_and_frees_its_slot() {
     let server = Server::start(
         "slow-timeout",
-        &[("TETHERPLAN_SOLVE_TIMEOUT_S", "1"), ("TETHERPLAN_MAX_IN_FLIGHT", "1")],
+        &[
+            ("TETHERPLAN_SOLVE_TIMEOUT_S", "1"),
+            ("TETHERPLAN_MAX_IN_FLIGHT", "1"),
+        ],
     );
     let start = Instant::now();
     let r = server.post("/api/v1/simulate", &slow_body());
@@ -255,7 +273,10 @@ fn a_slow_solve_stops_at_its_timeout_and_frees_its_slot() {
 fn a_slow_solve_stops_when_its_caller_goes_away() {
     let server = Server::start(
         "slow-gone",
-        &[("TETHERPLAN_SOLVE_TIMEOUT_S", "120"), ("TETHERPLAN_MAX_IN_FLIGHT", "1")],
+        &[
+            ("TETHERPLAN_SOLVE_TIMEOUT_S", "120"),
+            ("TETHERPLAN_MAX_IN_FLIGHT", "1"),
+        ],
     );
     let mut s = server.connect();
     let body = serde_json::to_vec(&slow_body()).unwrap();
@@ -268,7 +289,10 @@ fn a_slow_solve_stops_when_its_caller_goes_away() {
     s.write_all(&body).unwrap();
     std::thread::sleep(Duration::from_millis(500));
     // the solve holds the only slot
-    assert_eq!(server.post("/api/v1/critical", &critical_body()).status, 503);
+    assert_eq!(
+        server.post("/api/v1/critical", &critical_body()).status,
+        503
+    );
     drop(s);
     let freed = time_until_critical_answers(&server, Duration::from_secs(3));
     eprintln!("slot freed {freed:?} after the caller hung up");
@@ -278,7 +302,8 @@ fn a_slow_solve_stops_when_its_caller_goes_away() {
 fn an_unfinished_request_head_is_dropped_within_the_header_timeout() {
     let server = Server::start("header", &[]);
     let mut s = server.connect();
-    s.write_all(b"GET /healthz HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ").unwrap();
+    s.write_all(b"GET /healthz HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ")
+        .unwrap();
     let start = Instant::now();
     let mut buf = [0u8; 256];
     // EOF (or a reset) once the server gives up on the head
@@ -292,7 +317,10 @@ fn an_unfinished_request_head_is_dropped_within_the_header_timeout() {
     let took = start.elapsed();
     eprintln!("unfinished head dropped after {took:?}");
     assert!(took < Duration::from_secs(10), "took {took:?}");
-    assert!(took >= Duration::from_secs(4), "took {took:?}: before the 5 s default");
+    assert!(
+        took >= Duration::from_secs(4),
+        "took {took:?}: before the 5 s default"
+    );
 }
 
 #[test]
@@ -310,11 +338,15 @@ fn fifteen_hundred_idle_connections_and_healthz_still_answers() {
     assert_eq!(r.status, 200, "{}", r.body);
     assert!(took < Duration::from_secs(2), "/healthz took {took:?}");
     // A synchronous solve answers too.
-    assert_eq!(server.post("/api/v1/critical", &critical_body()).status, 200);
+    assert_eq!(
+        server.post("/api/v1/critical", &critical_body()).status,
+        200
+    );
     // The oldest idle connections were closed (EOF), the newest are open.
     let mut closed = 0;
     for s in idle.iter_mut().take(100) {
-        s.set_read_timeout(Some(Duration::from_millis(200))).unwrap();
+        s.set_read_timeout(Some(Duration::from_millis(200)))
+            .unwrap();
         if matches!(s.read(&mut [0u8; 1]), Ok(0) | Err(_)) {
             closed += 1;
         }
@@ -337,15 +369,33 @@ fn default_cap_holds_fifteen_hundred_idle_connections() {
 #[test]
 fn security_headers_and_host_allow_list() {
     let server = Server::start("hosts", &[("TETHERPLAN_ALLOWED_HOSTS", "plan.example.org")]);
-    for path in ["/", "/healthz", "/openapi.json", "/api/v1/jobs/none", "/no-such-file"] {
+    for path in [
+        "/",
+        "/healthz",
+        "/openapi.json",
+        "/api/v1/jobs/none",
+        "/no-such-file",
+    ] {
         let r = server.get(path);
-        assert_eq!(r.header("x-content-type-options"), Some("nosniff"), "{path}");
+        assert_eq!(
+            r.header("x-content-type-options"),
+            Some("nosniff"),
+            "{path}"
+        );
         let csp = r.header("content-security-policy").unwrap_or("");
         assert!(csp.contains("default-src 'self'"), "{path}: {csp:?}");
     }
     let port = server.addr.port();
-    for host in [format!("localhost:{port}"), format!("127.0.0.1:{port}"), "plan.example.org".into()] {
-        assert_eq!(server.send("GET", "/healthz", &host, None).status, 200, "{host}");
+    for host in [
+        format!("localhost:{port}"),
+        format!("127.0.0.1:{port}"),
+        "plan.example.org".into(),
+    ] {
+        assert_eq!(
+            server.send("GET", "/healthz", &host, None).status,
+            200,
+            "{host}"
+        );
     }
     let r = server.send("GET", "/healthz", "rebind.attacker.example", None);
     assert_eq!(r.status, 421, "{}", r.body);
@@ -360,10 +410,18 @@ fn serve_from_a_temporary_directory_serves_the_built_in_page() {
     let r = server.get("/");
     assert_eq!(r.status, 200);
     assert!(r.header("content-type").unwrap().starts_with("text/html"));
-    assert!(r.body.contains("<script src=\"app.js\"></script>"), "{}", r.body);
+    assert!(
+        r.body.contains("<script src=\"app.js\"></script>"),
+        "{}",
+        r.body
+    );
     let js = server.get("/app.js");
     assert_eq!(js.status, 200);
-    assert!(js.header("content-type").unwrap().starts_with("text/javascript"));
+    assert!(
+        js.header("content-type")
+            .unwrap()
+            .starts_with("text/javascript")
+    );
     let on_disk = std::fs::read_to_string(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("static/app.js"),
     )
@@ -375,15 +433,17 @@ fn serve_from_a_temporary_directory_serves_the_built_in_page() {
 
 #[test]
 fn logs_that_are_not_a_terminal_carry_no_colour_codes() {
-    let mut server = Server::start_with(
-        "colour",
-        &[("RUST_LOG", "info")],
-        Stdio::piped(),
-    );
+    let mut server = Server::start_with("colour", &[("RUST_LOG", "info")], Stdio::piped());
     let _ = server.get("/healthz");
     let _ = server.child.kill();
     let mut log = String::new();
-    server.child.stderr.take().unwrap().read_to_string(&mut log).unwrap();
+    server
+        .child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut log)
+        .unwrap();
     assert!(log.contains("listening"), "{log}");
     assert!(!log.contains('\u{1b}'), "ANSI escape in {log:?}");
 }

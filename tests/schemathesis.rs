@@ -17,7 +17,8 @@ fn schemathesis() -> Option<PathBuf> {
     if let Ok(p) = std::env::var("TETHERPLAN_SCHEMATHESIS") {
         return Some(PathBuf::from(p));
     }
-    let venv = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/schemathesis-venv/bin/schemathesis");
+    let venv =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/schemathesis-venv/bin/schemathesis");
     venv.exists().then_some(venv)
 }
 
@@ -28,7 +29,9 @@ fn schemathesis_finds_no_server_error_and_no_schema_violation() {
             std::env::var_os("CI").is_none(),
             "CI is set but schemathesis is missing: run .ci/run (it creates target/schemathesis-venv)"
         );
-        eprintln!("skipped: no schemathesis (python3 -m venv target/schemathesis-venv && target/schemathesis-venv/bin/pip install schemathesis)");
+        eprintln!(
+            "skipped: no schemathesis (python3 -m venv target/schemathesis-venv && target/schemathesis-venv/bin/pip install schemathesis)"
+        );
         return;
     };
     let dir = std::env::temp_dir().join(format!("tetherplan-st-{}", std::process::id()));
@@ -99,7 +102,11 @@ fn schemathesis_finds_no_server_error_and_no_schema_violation() {
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    eprintln!("schemathesis took {:?}:\n{}", start.elapsed(), tail(&text, 60));
+    eprintln!(
+        "schemathesis took {:?}:\n{}",
+        start.elapsed(),
+        tail(&text, 60)
+    );
     let status = status.unwrap_or_else(|| panic!("schemathesis did not finish within {limit:?}"));
     assert!(status.success(), "schemathesis found failures:\n{text}");
 }

@@ -77,10 +77,19 @@ mod tests {
 
     #[test]
     fn the_page_and_its_scripts_are_embedded() {
-        for f in ["index.html", "app.js", "style.css", "vendor/uPlot.iife.min.js"] {
-            let file = STATIC.get_file(f).unwrap_or_else(|| panic!("{f} is embedded"));
+        for f in [
+            "index.html",
+            "app.js",
+            "style.css",
+            "vendor/uPlot.iife.min.js",
+        ] {
+            let file = STATIC
+                .get_file(f)
+                .unwrap_or_else(|| panic!("{f} is embedded"));
             let on_disk = std::fs::read(
-                std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("static").join(f),
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("static")
+                    .join(f),
             )
             .unwrap();
             assert_eq!(file.contents(), on_disk.as_slice(), "{f}");

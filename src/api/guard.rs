@@ -107,7 +107,10 @@ impl HostAllowList {
         if let Some(host) = request.headers().get(header::HOST) {
             let ok = host.to_str().map(|h| list.allows(h)).unwrap_or(false);
             if !ok {
-                let shown = String::from_utf8_lossy(host.as_bytes()).chars().take(100).collect::<String>();
+                let shown = String::from_utf8_lossy(host.as_bytes())
+                    .chars()
+                    .take(100)
+                    .collect::<String>();
                 return ApiError::new(
                     StatusCode::MISDIRECTED_REQUEST,
                     "host_not_allowed",
@@ -163,7 +166,13 @@ mod tests {
         ] {
             assert!(list.allows(ok), "{ok}");
         }
-        for bad in ["evil.example:8080", "10.1.2.4", "localhost.evil.example", "", "[::2]:80"] {
+        for bad in [
+            "evil.example:8080",
+            "10.1.2.4",
+            "localhost.evil.example",
+            "",
+            "[::2]:80",
+        ] {
             assert!(!list.allows(bad), "{bad}");
         }
     }
