@@ -556,18 +556,32 @@
     setTimeout(() => URL.revokeObjectURL(url), 1000);
   }
 
-  function chartCsv(chart) {
-    const lines = ["net_buoyancy_n,rate_m_s,critical_time_s,max_elevation_m,closed_form_elevation_m"];
+  // Every input of the request as `# input <path>,<value>` lines.
+  function inputLines(obj, prefix = "", out = []) {
+    for (const [k, v] of Object.entries(obj ?? {})) {
+      const key = prefix ? `${prefix}.${k}` : k;
+      if (v && typeof v === "object" && !Array.isArray(v)) inputLines(v, key, out);
+      else out.push(`# input ${key},${Array.isArray(v) ? v.join(" ") : v}`);
+    }
+    return out;
+  }
+
+  // Six significant digits: what the model resolves, not 16-digit floats.
+  const sig = (v) => (typeof v === "number" && Number.isFinite(v) ? Number(v.toPrecision(6)) : v);
+
+  function chartCsv(chart, request) {
+    const lines = ["# tetherplan deployment chart", ...inputLines(request), `# elements,${chart.elements}`,
+      "net_buoyancy_n,rate_m_s,critical_time_s,max_elevation_m,closed_form_elevation_m"];
     for (const s of chart.series) {
       for (const p of s.points) {
-        lines.push([s.net_buoyancy_n, p.rate_m_s, p.critical_time_s, p.max_elevation_m, p.closed_form_elevation_m].join(","));
+        lines.push([s.net_buoyancy_n, p.rate_m_s, p.critical_time_s, p.max_elevation_m, p.closed_form_elevation_m].map(sig).join(","));
       }
     }
     return lines.join("\n") + "\n";
   }
 
   $("#download-csv").addEventListener("click", () => {
-    if (state.chart) download(new Blob([chartCsv(state.chart)], { type: "text/csv" }), "deployment-chart.csv");
+    if (state.chart) download(new Blob([chartCsv(state.chart, state.request)], { type: "text/csv" }), "deployment-chart.csv");
   });
 
   // Splits `text` into lines no wider than `max` pixels in the context's font.
