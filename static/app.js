@@ -170,9 +170,13 @@
 
   // ---------- HTTP ----------
 
+  // True while a GE job runs after a finished string chart: that chart is
+  // the current answer and stays undimmed.
+  let geAfterString = false;
+
   function setStatus(kind, text) {
     // Plots of an earlier request are dimmed until a new answer replaces them.
-    if (kind === "ready") delete $("#results").dataset.stale;
+    if (kind === "ready" || geAfterString) delete $("#results").dataset.stale;
     else $("#results").dataset.stale = "";
     statusEl.dataset.state = kind;
     statusEl.textContent = text;
@@ -462,8 +466,11 @@
           setStatus("error", "Fix the highlighted GE fields.");
         } else {
           const points = geReq.rates_m_s.count * geReq.stiffness_ratios.length;
+          geAfterString = true;
           setStatus("busy", `Submitting a GE job for ${points} points…`);
-          const ge = await runChartJob(geReq, points);
+          const ge = await runChartJob(geReq, points).finally(() => {
+            geAfterString = false;
+          });
           if (ge.chart) {
             renderGe(ge.chart, outcome.chart);
             setStatus("ready", `String: ${curves(outcome.chart.series.length)}; GE: ${curves(ge.chart.series.length)}, ${points} points (${ge.via}).`);
