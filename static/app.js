@@ -173,9 +173,13 @@
 
   // ---------- HTTP ----------
 
+  // True while a GE job runs after a finished string chart: that chart is
+  // the current answer and stays undimmed.
+  let geAfterString = false;
+
   function setStatus(kind, text) {
     // Plots of an earlier request are dimmed until a new answer replaces them.
-    if (kind === "ready") delete $("#results").dataset.stale;
+    if (kind === "ready" || geAfterString) delete $("#results").dataset.stale;
     else $("#results").dataset.stale = "";
     statusEl.dataset.state = kind;
     statusEl.textContent = text;
@@ -465,8 +469,11 @@
           setStatus("error", "Fix the highlighted GE fields.");
         } else {
           const points = geReq.rates_m_s.count * geReq.stiffness_ratios.length;
+          geAfterString = true;
           setStatus("busy", `Submitting a GE job for ${points} points…`);
-          const ge = await runChartJob(geReq, points);
+          const ge = await runChartJob(geReq, points).finally(() => {
+            geAfterString = false;
+          });
           if (ge.chart) {
             renderGe(ge.chart, outcome.chart);
             setStatus("ready", `String: ${curves(outcome.chart.series.length)}; GE: ${curves(ge.chart.series.length)}, ${points} points (${ge.via}).`);
@@ -561,18 +568,32 @@
     setTimeout(() => URL.revokeObjectURL(url), 1000);
   }
 
-  function chartCsv(chart) {
-    const lines = ["net_buoyancy_n,rate_m_s,critical_time_s,max_elevation_m,closed_form_elevation_m"];
+  // Every input of the request as `# input <path>,<value>` lines.
+  function inputLines(obj, prefix = "", out = []) {
+    for (const [k, v] of Object.entries(obj ?? {})) {
+      const key = prefix ? `${prefix}.${k}` : k;
+      if (v && typeof v === "object" && !Array.isArray(v)) inputLines(v, key, out);
+      else out.push(`# input ${key},${Array.isArray(v) ? v.join(" ") : v}`);
+    }
+    return out;
+  }
+
+  // Six significant digits: what the model resolves, not 16-digit floats.
+  const sig = (v) => (typeof v === "number" && Number.isFinite(v) ? Number(v.toPrecision(6)) : v);
+
+  function chartCsv(chart, request) {
+    const lines = ["# tetherplan deployment chart", ...inputLines(request), `# elements,${chart.elements}`,
+      "net_buoyancy_n,rate_m_s,critical_time_s,max_elevation_m,closed_form_elevation_m"];
     for (const s of chart.series) {
       for (const p of s.points) {
-        lines.push([s.net_buoyancy_n, p.rate_m_s, p.critical_time_s, p.max_elevation_m, p.closed_form_elevation_m].join(","));
+        lines.push([s.net_buoyancy_n, p.rate_m_s, p.critical_time_s, p.max_elevation_m, p.closed_form_elevation_m].map(sig).join(","));
       }
     }
     return lines.join("\n") + "\n";
   }
 
   $("#download-csv").addEventListener("click", () => {
-    if (state.chart) download(new Blob([chartCsv(state.chart)], { type: "text/csv" }), "deployment-chart.csv");
+    if (state.chart) download(new Blob([chartCsv(state.chart, state.request)], { type: "text/csv" }), "deployment-chart.csv");
   });
 
   // Splits `text` into lines no wider than `max` pixels in the context's font.

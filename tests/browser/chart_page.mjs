@@ -91,7 +91,12 @@ try {
     const [download] = await Promise.all([page.waitForEvent("download"), page.click("#download-csv")]);
     const csvPath = path.join(artifacts, "chart_page.csv");
     await download.saveAs(csvPath);
-    const csv = readFileSync(csvPath, "utf8").trim().split("\n");
+    const all = readFileSync(csvPath, "utf8").trim().split("\n");
+    const comments = all.filter((l) => l.startsWith("#"));
+    check(comments.some((l) => l.startsWith("# input cable.mass_per_length_kg_m,0.078")) && comments.some((l) => l.startsWith("# input rates_m_s.count,100")),
+      "CSV records the inputs");
+    const csv = all.filter((l) => !l.startsWith("#"));
+    check(!csv.some((l) => /\d\.\d{7,}/.test(l)), "CSV numbers have at most six significant digits");
     check(csv[0] === "net_buoyancy_n,rate_m_s,critical_time_s,max_elevation_m,closed_form_elevation_m", "CSV header");
     check(csv.length === 1 + 300, `CSV has ${csv.length - 1} rows (3 × 100 points)`);
     const [png] = await Promise.all([page.waitForEvent("download"), page.click("#download-png")]);

@@ -474,6 +474,16 @@ fn compress(knots: Vec<Knot>) -> Vec<Knot> {
 /// ceiling `v ≤ √((1 − r)F/ρA − gL)` (acceleration terms and margin
 /// dropped) and the winch limits. Exact for that problem on the grid.
 /// `None` when the static ceiling is negative somewhere on the path.
+///
+/// Derivation check: with `C(L) = (1 − r)F/ρA − gL` and braking at
+/// `a_max` to rest at `L_T`, `C(L) − 2a_max(L_T − L) = C(L_T) + (g −
+/// 2a_max)(L_T − L) > 0` when `a_max < g/2`, and the ramps meet at
+/// `u = a_max(L_T − L₀) < C` there too: the static ceiling never binds and
+/// the bound is the winch trapezoid. Thesis data to 1200 m at 40 m/s and
+/// 2 m/s²: 20 s up (400 m), 399 m at 40 m/s (9.975 s), 20 s down: 49.975 s
+/// (the SPEC's 50.0 s). The plan equals it because the acceleration terms
+/// do not bind either: at the end of the ramp (401 m, 40 m/s, +2 m/s²)
+/// `T_eff = 950 − 20 − 0.078·11.81·401 − 0.078·1600 = 436 N > 0`.
 pub fn static_ceiling_bound_s(p: &PlanProblem) -> Option<f64> {
     let g = Grid::new(p, 0.0);
     let n = g.segments();
