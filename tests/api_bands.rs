@@ -169,3 +169,32 @@ async fn a_bands_job_runs_to_the_synchronous_answer_with_progress() {
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
     assert_eq!(error(&text).1.as_deref(), Some("request.uncertainty.seed"));
 }
+
+/// `tetherplan bands` reads the same JSON from stdin and prints the same
+/// answer; bad input exits 2 with the error body.
+#[test]
+fn the_cli_prints_the_same_answer() {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let run = |b: &Value| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_tetherplan"))
+            .arg("bands")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child.stdin.take().unwrap().write_all(&serde_json::to_vec(b).unwrap()).unwrap();
+        let out = child.wait_with_output().unwrap();
+        (out.status.code().unwrap(), serde_json::from_slice::<Value>(&out.stdout).unwrap())
+    };
+    let b = body(200);
+    let (code, v) = run(&b);
+    assert_eq!(code, 0);
+    assert_eq!(v, serde_json::from_str::<Value>(&direct(&b)).unwrap());
+    let mut bad = body(200);
+    bad["uncertainty"]["inputs"][0]["field"] = json!("aerostat.colour");
+    let (code, v) = run(&bad);
+    assert_eq!(code, 2);
+    assert_eq!(v["error"]["field"], "uncertainty.inputs[0].field");
+}
