@@ -183,3 +183,8 @@ fn chart_page_in_headless_chromium() {
 fn transient_page_in_headless_chromium() {
     run_page_script("transient_page.mjs");
 }
+
+#[test]
+fn bands_page_in_headless_chromium() {
+    run_page_script("bands_page.mjs");
+}
