@@ -108,21 +108,33 @@ async fn the_openapi_example_succeeds() {
 async fn bad_input_is_a_422_naming_the_field() {
     let (app, _) = app();
     let cases = [
-        (json!({"field": "aerostat.buoyancy", "distribution": "normal", "mean": 1.0, "std_dev": 1.0}),
-         "uncertainty.inputs[0].field"),
-        (json!({"field": "cable.mass_per_length_kg_m", "distribution": "normal", "mean": 0.078, "std_dev": 0.001}),
-         "uncertainty.inputs[0].field"),
-        (json!({"field": "aerostat.net_buoyancy_n", "distribution": "triangular", "mean": 1.0}),
-         "uncertainty.inputs[0].distribution"),
-        (json!({"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 600.0}),
-         "uncertainty.inputs[0]"),
+        (
+            json!({"field": "aerostat.buoyancy", "distribution": "normal", "mean": 1.0, "std_dev": 1.0}),
+            "uncertainty.inputs[0].field",
+        ),
+        (
+            json!({"field": "cable.mass_per_length_kg_m", "distribution": "normal", "mean": 0.078, "std_dev": 0.001}),
+            "uncertainty.inputs[0].field",
+        ),
+        (
+            json!({"field": "aerostat.net_buoyancy_n", "distribution": "triangular", "mean": 1.0}),
+            "uncertainty.inputs[0].distribution",
+        ),
+        (
+            json!({"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 600.0}),
+            "uncertainty.inputs[0]",
+        ),
     ];
     for (input, field) in cases {
         let mut b = body(10);
         b["uncertainty"]["inputs"] = json!([input]);
         let (status, text) = send(&app, "POST", "/api/v1/bands", Some(&b)).await;
         assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{text}");
-        assert_eq!(error(&text), ("invalid_input".into(), Some(field.into())), "{text}");
+        assert_eq!(
+            error(&text),
+            ("invalid_input".into(), Some(field.into())),
+            "{text}"
+        );
     }
     let mut b = body(10);
     b["extra_m"] = json!(1.0);
@@ -133,7 +145,11 @@ async fn bad_input_is_a_422_naming_the_field() {
     b["uncertainty"]["method"] = json!("sobol");
     let (status, text) = send(&app, "POST", "/api/v1/bands", Some(&b)).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
-    assert_eq!(error(&text).1.as_deref(), Some("uncertainty.method"), "{text}");
+    assert_eq!(
+        error(&text).1.as_deref(),
+        Some("uncertainty.method"),
+        "{text}"
+    );
 }
 
 #[tokio::test]
@@ -143,7 +159,10 @@ async fn large_ensembles_point_to_jobs() {
     b["rates_m_s"]["count"] = json!(3);
     let (status, text) = send(&app, "POST", "/api/v1/bands", Some(&b)).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
-    assert_eq!(error(&text), ("too_large".into(), Some("uncertainty.samples".into())));
+    assert_eq!(
+        error(&text),
+        ("too_large".into(), Some("uncertainty.samples".into()))
+    );
     assert!(text.contains("\\\"kind\\\": \\\"bands\\\""), "{text}");
 }
 
@@ -151,9 +170,17 @@ async fn large_ensembles_point_to_jobs() {
 async fn a_bands_job_runs_to_the_synchronous_answer_with_progress() {
     let (app, queue) = app();
     let b = body(400);
-    let (status, text) = send(&app, "POST", "/api/v1/jobs", Some(&json!({"kind": "bands", "request": b}))).await;
+    let (status, text) = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        Some(&json!({"kind": "bands", "request": b})),
+    )
+    .await;
     assert_eq!(status, StatusCode::ACCEPTED, "{text}");
-    let id = serde_json::from_str::<Value>(&text).unwrap()["id"].as_i64().unwrap();
+    let id = serde_json::from_str::<Value>(&text).unwrap()["id"]
+        .as_i64()
+        .unwrap();
     let ran = try_execute_next(&queue).unwrap().unwrap();
     assert_eq!((ran.id, ran.status), (id, JobStatus::Done));
     let (_, text) = send(&app, "GET", &format!("/api/v1/jobs/{id}"), None).await;
@@ -165,7 +192,50 @@ async fn a_bands_job_runs_to_the_synchronous_answer_with_progress() {
     // invalid input is refused at submission
     let mut bad = body(10);
     bad["uncertainty"]["seed"] = json!(1u64 << 60);
-    let (status, text) = send(&app, "POST", "/api/v1/jobs", Some(&json!({"kind": "bands", "request": bad}))).await;
+    let (status, text) = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        Some(&json!({"kind": "bands", "request": bad})),
+    )
+    .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
     assert_eq!(error(&text).1.as_deref(), Some("request.uncertainty.seed"));
+}
+
+/// `tetherplan bands` reads the same JSON from stdin and prints the same
+/// answer; bad input exits 2 with the error body.
+#[test]
+fn the_cli_prints_the_same_answer() {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let run = |b: &Value| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_tetherplan"))
+            .arg("bands")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(&serde_json::to_vec(b).unwrap())
+            .unwrap();
+        let out = child.wait_with_output().unwrap();
+        (
+            out.status.code().unwrap(),
+            serde_json::from_slice::<Value>(&out.stdout).unwrap(),
+        )
+    };
+    let b = body(200);
+    let (code, v) = run(&b);
+    assert_eq!(code, 0);
+    assert_eq!(v, serde_json::from_str::<Value>(&direct(&b)).unwrap());
+    let mut bad = body(200);
+    bad["uncertainty"]["inputs"][0]["field"] = json!("aerostat.colour");
+    let (code, v) = run(&bad);
+    assert_eq!(code, 2);
+    assert_eq!(v["error"]["field"], "uncertainty.inputs[0].field");
 }

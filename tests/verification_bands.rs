@@ -134,7 +134,11 @@ fn probability_unsafe_matches_an_independent_monte_carlo() {
         let se = (p.standard_error_nondim.powi(2) + p_ref * (1.0 - p_ref) / 200_000.0).sqrt();
         println!(
             "rate {} m/s: P(h* < 1200 m) = {:.4} ± {:.4} (Wilson {:.4}–{:.4}), independent {p_ref:.4}",
-            point.rate_m_s, p.probability_nondim, p.standard_error_nondim, p.low_nondim, p.high_nondim
+            point.rate_m_s,
+            p.probability_nondim,
+            p.standard_error_nondim,
+            p.low_nondim,
+            p.high_nondim
         );
         assert!(
             (p.probability_nondim - p_ref).abs() <= 4.0 * se + 1e-3,
@@ -158,14 +162,19 @@ fn probability_unsafe_matches_an_independent_monte_carlo() {
 /// the stated sampling errors.
 #[test]
 fn same_seed_same_json_at_any_thread_count_other_seed_within_error() {
-    let req = request(json!({"uncertainty": {"samples": 1000, "seed": 11, "inputs": [
-        {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 50.0},
-        {"field": "cable.mass_per_length_kg_m", "distribution": "normal", "mean": 0.078, "std_dev": 0.002}
-    ]}}));
+    let req = request(
+        json!({"uncertainty": {"samples": 1000, "seed": 11, "inputs": [
+            {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 50.0},
+            {"field": "cable.mass_per_length_kg_m", "distribution": "normal", "mean": 0.078, "std_dev": 0.002}
+        ]}}),
+    );
     let texts: Vec<String> = [1, 2]
         .into_iter()
         .map(|threads| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
             pool.install(|| serde_json::to_string(&run(&req)).unwrap())
         })
         .collect();
@@ -179,7 +188,10 @@ fn same_seed_same_json_at_any_thread_count_other_seed_within_error() {
     assert_eq!(b.seed, 12);
     let mut differ = 0;
     for (pa, pb) in a.points.iter().zip(&b.points) {
-        for (x, y) in [(&pa.max_elevation_m, &pb.max_elevation_m), (&pa.critical_time_s, &pb.critical_time_s)] {
+        for (x, y) in [
+            (&pa.max_elevation_m, &pb.max_elevation_m),
+            (&pa.critical_time_s, &pb.critical_time_s),
+        ] {
             for (va, ea, vb, eb) in [
                 (x.p05, x.p05_error, y.p05, y.p05_error),
                 (x.p50, x.p50_error, y.p50, y.p50_error),
@@ -235,7 +247,10 @@ fn zero_width_distributions_reproduce_the_chart_exactly() {
                 assert_eq!(e, Some(0.0));
             }
         }
-        assert_eq!(b.nominal_max_elevation_m.to_bits(), c.max_elevation_m.to_bits());
+        assert_eq!(
+            b.nominal_max_elevation_m.to_bits(),
+            c.max_elevation_m.to_bits()
+        );
     }
 }
 
@@ -248,7 +263,11 @@ fn rates_near_the_wave_speed_count_immediate_samples() {
         "uncertainty": {"samples": 500, "seed": 1, "inputs": [
             {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 50.0}]}})));
     let near = &resp.points[0];
-    assert!(near.immediate_samples > 100 && near.immediate_samples < 400, "{}", near.immediate_samples);
+    assert!(
+        near.immediate_samples > 100 && near.immediate_samples < 400,
+        "{}",
+        near.immediate_samples
+    );
     assert_eq!(near.max_elevation_m.p05, 1.0);
     let far = &resp.points[1];
     assert_eq!(far.immediate_samples, 500);

@@ -111,11 +111,7 @@ pub enum UncertainInput {
         std_dev: f64,
     },
     /// Uniform on `[low, high]`.
-    Uniform {
-        field: String,
-        low: f64,
-        high: f64,
-    },
+    Uniform { field: String, low: f64, high: f64 },
     /// Lognormal given by the **mean and standard deviation of the
     /// variable itself** (not of its logarithm): always positive.
     Lognormal {
@@ -130,7 +126,9 @@ pub enum UncertainInput {
 impl UncertainInput {
     pub fn field(&self) -> &str {
         match self {
-            Self::Normal { field, .. } | Self::Uniform { field, .. } | Self::Lognormal { field, .. } => field,
+            Self::Normal { field, .. }
+            | Self::Uniform { field, .. }
+            | Self::Lognormal { field, .. } => field,
         }
     }
 }

@@ -87,7 +87,12 @@ impl SystemField {
     }
 
     fn in_range(self, v: f64) -> bool {
-        v.is_finite() && if self.zero_allowed() { v >= 0.0 } else { v > 0.0 }
+        v.is_finite()
+            && if self.zero_allowed() {
+                v >= 0.0
+            } else {
+                v > 0.0
+            }
     }
 
     fn range_words(self) -> &'static str {
@@ -451,8 +456,12 @@ pub fn bands(
                 nominal_max_elevation_m: nominal[j].elevation_m,
                 nominal_critical_time_s: nominal[j].time_s,
                 immediate_samples: valid.iter().filter(|s| s[j].immediate).count(),
-                max_elevation_error_m: converged
-                    .then(|| valid.iter().map(|s| s[j].elevation_error_m).fold(0.0, f64::max)),
+                max_elevation_error_m: converged.then(|| {
+                    valid
+                        .iter()
+                        .map(|s| s[j].elevation_error_m)
+                        .fold(0.0, f64::max)
+                }),
                 critical_time_error_s: converged
                     .then(|| valid.iter().map(|s| s[j].time_error_s).fold(0.0, f64::max)),
                 probability_unsafe: unsafe_samples.map(|k| {
@@ -535,7 +544,8 @@ pub fn parse_bands(body: &[u8]) -> Result<BandsRequest, RequestError> {
     reject_unknown(&system_value, &known, "")?;
     match params_part.get("rates_m_s") {
         Some(Value::Array(_)) => {
-            parse_value::<Vec<f64>>(&params_part["rates_m_s"]).map_err(|e| under("rates_m_s", e))?;
+            parse_value::<Vec<f64>>(&params_part["rates_m_s"])
+                .map_err(|e| under("rates_m_s", e))?;
         }
         Some(Value::Object(_)) => {
             parse_value::<BandsRateGrid>(&params_part["rates_m_s"])
@@ -677,19 +687,34 @@ mod tests {
                 {"field": "aerostat.mass_kg", "distribution": "normal", "mean": 10.0, "std_dev": 5.0}]}}))),
             "uncertainty.inputs[0]"
         );
-        assert_eq!(field_of(body(json!({"rates_m_s": [5.0, -1.0]}))), "rates_m_s[1]");
         assert_eq!(
-            field_of(body(json!({"rates_m_s": {"min": 1.0, "max": 2.0, "count": 0}}))),
+            field_of(body(json!({"rates_m_s": [5.0, -1.0]}))),
+            "rates_m_s[1]"
+        );
+        assert_eq!(
+            field_of(body(
+                json!({"rates_m_s": {"min": 1.0, "max": 2.0, "count": 0}})
+            )),
             "rates_m_s.count"
         );
         assert_eq!(
-            field_of(body(json!({"rates_m_s": {"min": 1.0, "max": 2.0, "cnt": 3}}))),
+            field_of(body(
+                json!({"rates_m_s": {"min": 1.0, "max": 2.0, "cnt": 3}})
+            )),
             "rates_m_s.cnt"
         );
         assert_eq!(field_of(body(json!({"rates_m_s": "fast"}))), "rates_m_s");
-        assert_eq!(field_of(body(json!({"target_elevation_m": 0.0}))), "target_elevation_m");
+        assert_eq!(
+            field_of(body(json!({"target_elevation_m": 0.0}))),
+            "target_elevation_m"
+        );
         assert_eq!(field_of(body(json!({"wind_m_s": 3.0}))), "wind_m_s");
-        assert_eq!(field_of(body(json!({"aerostat": {"net_buoyancy_n": 1.0, "lift": 2}}))), "aerostat.lift");
+        assert_eq!(
+            field_of(body(
+                json!({"aerostat": {"net_buoyancy_n": 1.0, "lift": 2}})
+            )),
+            "aerostat.lift"
+        );
         assert_eq!(
             field_of(body(json!({"uncertainty": {"samples": 0, "inputs": [
                 {"field": "aerostat.mass_kg", "distribution": "uniform", "low": 9.0, "high": 11.0}]}}))),
@@ -701,8 +726,10 @@ mod tests {
     #[test]
     fn out_of_range_draws_are_counted_and_left_out() {
         // P(m < 0) for N(10, 4.2) = Φ(−2.381) ≈ 8.6e-3 (just under the limit)
-        let b = body(json!({"uncertainty": {"samples": 4000, "seed": 1, "inputs": [
-            {"field": "aerostat.mass_kg", "distribution": "normal", "mean": 10.0, "std_dev": 4.2}]}}));
+        let b = body(
+            json!({"uncertainty": {"samples": 4000, "seed": 1, "inputs": [
+            {"field": "aerostat.mass_kg", "distribution": "normal", "mean": 10.0, "std_dev": 4.2}]}}),
+        );
         let resp = bands(&parse_bands(&b).unwrap(), Parallelism::Rayon, &NoProgress).unwrap();
         let rejected = &resp.rejected_samples[0];
         assert_eq!(rejected.field, "aerostat.mass_kg");

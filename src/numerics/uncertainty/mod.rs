@@ -63,7 +63,10 @@ impl Ensemble {
         if inputs.is_empty() || inputs.len() > MAX_INPUTS {
             return Err(InvalidInput::new(
                 format!("{prefix}.inputs"),
-                format!("must list 1 to {MAX_INPUTS} uncertain inputs, got {}", inputs.len()),
+                format!(
+                    "must list 1 to {MAX_INPUTS} uncertain inputs, got {}",
+                    inputs.len()
+                ),
             ));
         }
         for (i, d) in inputs.iter().enumerate() {
@@ -162,8 +165,14 @@ mod tests {
             3000,
             42,
             vec![
-                Distribution::Normal { mean: 1.0, std_dev: 0.1 },
-                Distribution::Uniform { low: 2.0, high: 3.0 },
+                Distribution::Normal {
+                    mean: 1.0,
+                    std_dev: 0.1,
+                },
+                Distribution::Uniform {
+                    low: 2.0,
+                    high: 3.0,
+                },
             ],
         )
         .unwrap()
@@ -173,9 +182,14 @@ mod tests {
     fn serial_and_parallel_runs_agree_bit_for_bit() {
         let e = ensemble();
         let f = |v: &[f64]| (v[0] * v[1]).sin();
-        let serial = e.run(Parallelism::Serial, &|_, _| {}, &|| false, f).unwrap();
+        let serial = e
+            .run(Parallelism::Serial, &|_, _| {}, &|| false, f)
+            .unwrap();
         for threads in [1, 2, 3] {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
             let par = pool
                 .install(|| e.run(Parallelism::Rayon, &|_, _| {}, &|| false, f))
                 .unwrap();
@@ -188,16 +202,44 @@ mod tests {
 
     #[test]
     fn cancelled_runs_give_nothing() {
-        assert!(ensemble().run(Parallelism::Rayon, &|_, _| {}, &|| true, |v| v[0]).is_none());
+        assert!(
+            ensemble()
+                .run(Parallelism::Rayon, &|_, _| {}, &|| true, |v| v[0])
+                .is_none()
+        );
     }
 
     #[test]
     fn bad_ensembles_name_the_field() {
-        let e = Ensemble::new("u", 0, 1, vec![Distribution::Uniform { low: 0.0, high: 1.0 }]);
+        let e = Ensemble::new(
+            "u",
+            0,
+            1,
+            vec![Distribution::Uniform {
+                low: 0.0,
+                high: 1.0,
+            }],
+        );
         assert_eq!(e.unwrap_err().field, "u.samples");
-        let e = Ensemble::new("u", 10, 1, vec![Distribution::Normal { mean: 1.0, std_dev: -1.0 }]);
+        let e = Ensemble::new(
+            "u",
+            10,
+            1,
+            vec![Distribution::Normal {
+                mean: 1.0,
+                std_dev: -1.0,
+            }],
+        );
         assert_eq!(e.unwrap_err().field, "u.inputs[0].std_dev");
-        let e = Ensemble::new("u", 10, 1, vec![Distribution::Uniform { low: 1.0, high: 0.0 }]);
+        let e = Ensemble::new(
+            "u",
+            10,
+            1,
+            vec![Distribution::Uniform {
+                low: 1.0,
+                high: 0.0,
+            }],
+        );
         assert_eq!(e.unwrap_err().field, "u.inputs[0].high");
     }
 
@@ -206,11 +248,16 @@ mod tests {
     #[test]
     fn band_of_a_normal_input_covers_its_true_percentiles() {
         let e = ensemble();
-        let mut xs = e.run(Parallelism::Serial, &|_, _| {}, &|| false, |v| v[0]).unwrap();
+        let mut xs = e
+            .run(Parallelism::Serial, &|_, _| {}, &|| false, |v| v[0])
+            .unwrap();
         let band = Summariser::new(xs.len()).band(&mut xs);
         for q in band.quantiles {
             let truth = 1.0 + 0.1 * sampling::inverse_normal_cdf(q.level);
-            assert!(q.low.unwrap() <= truth && truth <= q.high.unwrap(), "{q:?} vs {truth}");
+            assert!(
+                q.low.unwrap() <= truth && truth <= q.high.unwrap(),
+                "{q:?} vs {truth}"
+            );
             assert!(q.error().unwrap() < 0.02);
         }
         assert!((band.mean - 1.0).abs() < 4.0 * 0.1 / (3000f64).sqrt());

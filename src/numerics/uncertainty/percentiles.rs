@@ -205,8 +205,16 @@ pub fn probability(events: usize, draws: usize, confidence: f64) -> Probability 
         draws,
         value: p,
         standard_error: (p * (1.0 - p) / n).sqrt(),
-        low: if events == 0 { 0.0 } else { (centre - half).max(0.0) },
-        high: if events == draws { 1.0 } else { (centre + half).min(1.0) },
+        low: if events == 0 {
+            0.0
+        } else {
+            (centre - half).max(0.0)
+        },
+        high: if events == draws {
+            1.0
+        } else {
+            (centre + half).min(1.0)
+        },
     }
 }
 
@@ -260,9 +268,15 @@ mod tests {
                     covered += 1;
                 }
             }
-            assert!(covered >= 1880, "level {level}: covered {covered} of {reps}");
+            assert!(
+                covered >= 1880,
+                "level {level}: covered {covered} of {reps}"
+            );
             // and the interval is not wildly conservative
-            assert!(covered <= 1980, "level {level}: covered {covered} of {reps}");
+            assert!(
+                covered <= 1980,
+                "level {level}: covered {covered} of {reps}"
+            );
         }
     }
 
@@ -275,12 +289,19 @@ mod tests {
             .map(|i| inverse_normal_cdf(uniform01(3, i, 0)))
             .collect();
         let level = 0.05;
-        let q = quantiles(&mut xs, &[level], &[order_statistic_interval(n, level, 0.95)])[0];
+        let q = quantiles(
+            &mut xs,
+            &[level],
+            &[order_statistic_interval(n, level, 0.95)],
+        )[0];
         let xi = inverse_normal_cdf(level);
         let density = (-0.5 * xi * xi).exp() / (2.0 * std::f64::consts::PI).sqrt();
         let asymptotic = 1.959964 * (level * (1.0 - level) / n as f64).sqrt() / density;
         let half = 0.5 * (q.high.unwrap() - q.low.unwrap());
-        assert!((half / asymptotic - 1.0).abs() < 0.15, "half-width {half}, asymptotic {asymptotic}");
+        assert!(
+            (half / asymptotic - 1.0).abs() < 0.15,
+            "half-width {half}, asymptotic {asymptotic}"
+        );
     }
 
     #[test]

@@ -23,7 +23,9 @@
 //! centre exactly (no rounding through `exp`/`ln`), so an ensemble of it
 //! reproduces the deterministic answer bit for bit.
 
-use crate::numerics::params::{InvalidInput, require_finite, require_non_negative, require_positive};
+use crate::numerics::params::{
+    InvalidInput, require_finite, require_non_negative, require_positive,
+};
 
 /// One step of SplitMix64: a bijective mix of a 64-bit word.
 #[inline]
@@ -45,10 +47,19 @@ pub fn uniform01(seed: u64, sample: u64, dimension: u64) -> f64 {
 /// A distribution of one uncertain input.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Distribution {
-    Normal { mean: f64, std_dev: f64 },
-    Uniform { low: f64, high: f64 },
+    Normal {
+        mean: f64,
+        std_dev: f64,
+    },
+    Uniform {
+        low: f64,
+        high: f64,
+    },
     /// Mean and standard deviation of the variable (not of its log).
-    Lognormal { mean: f64, std_dev: f64 },
+    Lognormal {
+        mean: f64,
+        std_dev: f64,
+    },
 }
 
 impl Distribution {
@@ -312,7 +323,10 @@ mod tests {
             (0.025, -1.959963984540054),
         ] {
             let got = inverse_normal_cdf(p);
-            assert!((got - z).abs() <= 1e-13 * z.abs().max(1.0), "Φ⁻¹({p}) = {got}, want {z}");
+            assert!(
+                (got - z).abs() <= 1e-13 * z.abs().max(1.0),
+                "Φ⁻¹({p}) = {got}, want {z}"
+            );
         }
     }
 
@@ -359,15 +373,39 @@ mod tests {
     #[test]
     fn zero_width_distributions_return_their_centre_exactly() {
         for u in [1e-9, 0.3, 0.5, 0.999] {
-            assert_eq!(Distribution::Normal { mean: 1000.0, std_dev: 0.0 }.quantile(u), 1000.0);
-            assert_eq!(Distribution::Uniform { low: 0.078, high: 0.078 }.quantile(u), 0.078);
-            assert_eq!(Distribution::Lognormal { mean: 0.078, std_dev: 0.0 }.quantile(u), 0.078);
+            assert_eq!(
+                Distribution::Normal {
+                    mean: 1000.0,
+                    std_dev: 0.0
+                }
+                .quantile(u),
+                1000.0
+            );
+            assert_eq!(
+                Distribution::Uniform {
+                    low: 0.078,
+                    high: 0.078
+                }
+                .quantile(u),
+                0.078
+            );
+            assert_eq!(
+                Distribution::Lognormal {
+                    mean: 0.078,
+                    std_dev: 0.0
+                }
+                .quantile(u),
+                0.078
+            );
         }
     }
 
     #[test]
     fn lognormal_has_the_stated_mean_and_std_dev() {
-        let d = Distribution::Lognormal { mean: 2.0, std_dev: 0.5 };
+        let d = Distribution::Lognormal {
+            mean: 2.0,
+            std_dev: 0.5,
+        };
         let n = 200_000u64;
         let xs: Vec<f64> = (0..n).map(|i| d.quantile(uniform01(11, i, 0))).collect();
         let mean = xs.iter().sum::<f64>() / n as f64;
