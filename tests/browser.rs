@@ -186,7 +186,6 @@ fn chart_page_in_headless_chromium() {
 fn transient_page_in_headless_chromium() {
     run_page_script("transient_page.mjs");
 }
-<<<<<<< HEAD
 
 #[test]
 fn docs_try_it_out_in_headless_chromium() {
@@ -197,11 +196,8 @@ fn docs_try_it_out_in_headless_chromium() {
 fn plan_page_in_headless_chromium() {
     run_page_script("plan_page.mjs");
 }
-||||||| b30d068
-=======
 
 #[test]
 fn bands_page_in_headless_chromium() {
     run_page_script("bands_page.mjs");
 }
->>>>>>> bands
