@@ -10,6 +10,7 @@ pub mod ge;
 pub mod ge_charts;
 pub mod run;
 pub mod simulate;
+pub mod tension;
 pub mod transient;
 
 pub use run::{Progress, RequestError};

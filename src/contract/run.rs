@@ -268,6 +268,7 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
         SearchMethod::QepScan => "qep_scan",
     };
     let t = result.time_s();
+    let strength = req.system.cable.breaking_strength()?;
     Ok(CriticalResponse {
         critical_time_s: t,
         critical_time_nondim: t.map(|t| t / sys.time_scale_s()),
@@ -288,6 +289,9 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
                 expected_stable: p.expected_stable,
             })
             .collect(),
+        tension_at_onset: t.map(|t| {
+            crate::contract::tension::TensionOutput::at(&sys, profile.kinematics(t), strength)
+        }),
         groups: groups(&sys),
         elements: model.elements(),
     })
@@ -381,6 +385,9 @@ pub fn chart(
                         critical_time_s: p.critical_time_s,
                         max_elevation_m: p.max_elevation_m,
                         closed_form_elevation_m: p.closed_form_elevation_m,
+                        winch_tension_at_onset_n: s.net_buoyancy_n
+                            - sys.mass_per_length_kg_m * sys.gravity_m_s2 * p.max_elevation_m,
+                        kinematic_tension_n: sys.mass_per_length_kg_m * p.rate_m_s * p.rate_m_s,
                     })
                     .collect(),
             })

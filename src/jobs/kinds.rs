@@ -188,6 +188,9 @@ impl JobKind for ChartRequest {
                         critical_time_s: p.critical_time_s,
                         max_elevation_m: p.max_elevation_m,
                         closed_form_elevation_m: p.closed_form_elevation_m,
+                        winch_tension_at_onset_n: s.net_buoyancy_n
+                            - sys.mass_per_length_kg_m * sys.gravity_m_s2 * p.max_elevation_m,
+                        kinematic_tension_n: sys.mass_per_length_kg_m * p.rate_m_s * p.rate_m_s,
                     }));
             }
         }
