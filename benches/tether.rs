@@ -1,6 +1,6 @@
 //! Speed of the static tether in wind (issue 12 targets in brackets): one
-//! equilibrium with tether drag in a uniform and a log-law wind, 200 RK4
-//! steps [≤ 100 µs]; an envelope of 40 winds × 50 lengths without stability,
+//! equilibrium with tether drag in a uniform and a log-law wind, 100 RK4
+//! steps (the default) [≤ 100 µs]; an envelope of 40 winds × 50 lengths without stability,
 //! power-law wind, on rayon [≤ 0.5 s on 2 cores].
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -38,11 +38,11 @@ fn problem(wind: WindProfile) -> EquilibriumProblem {
 fn benches(c: &mut Criterion) {
     let config = EquilibriumConfig::default();
     let uniform = problem(WindProfile::uniform(12.0));
-    c.bench_function("equilibrium_tether_drag_uniform_200_steps", |b| {
+    c.bench_function("equilibrium_tether_drag_uniform_100_steps", |b| {
         b.iter(|| black_box(&uniform).solve(&config).unwrap())
     });
     let log = problem(WindProfile::log_law(12.0, 10.0, 0.03, "wind").unwrap());
-    c.bench_function("equilibrium_tether_drag_log_law_200_steps", |b| {
+    c.bench_function("equilibrium_tether_drag_log_law_100_steps", |b| {
         b.iter(|| black_box(&log).solve(&config).unwrap())
     });
     let env = EnvelopeProblem {

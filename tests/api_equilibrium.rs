@@ -361,3 +361,50 @@ fn cli_answers_equilibrium_and_envelope() {
     assert_eq!(code, 2);
     assert!(v["error"]["field"].is_string());
 }
+
+#[test]
+fn critical_and_chart_answers_carry_the_tensions() {
+    use tetherplan::contract::dto::{ChartRequest, CriticalRequest};
+    let system = json!({"cable": {"mass_per_length_kg_m": 0.078, "breaking_strength_n": 20000.0},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0}, "model": {"elements": 50}});
+    let with = |extra: Value| {
+        let mut v = system.clone();
+        for (k, x) in extra.as_object().unwrap() {
+            v[k] = x.clone();
+        }
+        serde_json::to_vec(&v).unwrap()
+    };
+    let (rho_a, f, m, g) = (0.078, 1000.0, 10.0, 9.81);
+    let req: CriticalRequest =
+        contract::parse(&with(json!({"profile": {"kind": "constant_rate", "rate_m_s": 10.0}}))).unwrap();
+    let out = tetherplan::contract::run::critical(&req).unwrap();
+    let t = out.tension_at_onset.expect("unstable at some length");
+    let h = out.max_elevation_m.unwrap();
+    assert_eq!(t.length_m, h);
+    assert!((t.top_tension_n - f).abs() < 1e-9);
+    assert!((t.winch_tension_n - (f - rho_a * g * h)).abs() < 1e-9);
+    assert!((t.kinematic_tension_n - rho_a * 100.0).abs() < 1e-9);
+    // the converged h* sits near the continuum limit: effective tension ≈ 0
+    assert!(t.effective_winch_tension_n.abs() < 0.05 * f, "{t:?}");
+    assert!((t.safety_factor_nondim.unwrap() - 20.0).abs() < 1e-12);
+    let req: CriticalRequest = contract::parse(&with(
+        json!({"profile": {"kind": "constant_acceleration", "acceleration_m_s2": 0.5}}),
+    ))
+    .unwrap();
+    let out = tetherplan::contract::run::critical(&req).unwrap();
+    let t = out.tension_at_onset.unwrap();
+    assert!((t.top_tension_n - (f - m * 0.5)).abs() < 1e-9);
+    assert!((t.winch_tension_n - (f - m * 0.5 - rho_a * (g + 0.5) * t.length_m)).abs() < 1e-9);
+    let req: ChartRequest =
+        contract::parse(&with(json!({"rates_m_s": {"min": 1.0, "max": 50.0, "count": 5}}))).unwrap();
+    let out = tetherplan::contract::run::chart(&req, Parallelism::Serial, &NoProgress).unwrap();
+    for p in &out.series[0].points {
+        assert!((p.winch_tension_at_onset_n - (f - rho_a * g * p.max_elevation_m)).abs() < 1e-9);
+        assert!((p.kinematic_tension_n - rho_a * p.rate_m_s * p.rate_m_s).abs() < 1e-12);
+    }
+    let bad: Result<CriticalRequest, _> = contract::parse(&serde_json::to_vec(&json!({
+        "cable": {"mass_per_length_kg_m": 0.078, "breaking_strength_n": -1.0},
+        "aerostat": {"net_buoyancy_n": 1000.0}, "profile": {"kind": "constant_rate", "rate_m_s": 10.0}})).unwrap());
+    let err = tetherplan::contract::run::critical(&bad.unwrap()).unwrap_err();
+    assert_eq!(err.body().error.field.as_deref(), Some("cable.breaking_strength_n"));
+}

@@ -18,6 +18,10 @@ pub struct CableInput {
     /// Cross-section area A (m²), with `density_kg_m3` (e.g. 1e-5).
     #[schema(exclusive_minimum = 0.0)]
     pub area_m2: Option<f64>,
+    /// Breaking strength (N): gives `critical` a safety factor (optional).
+    #[serde(default)]
+    #[schema(exclusive_minimum = 0.0, maximum = 1e9)]
+    pub breaking_strength_n: Option<f64>,
 }
 
 /// The aerostat at the top of the cable.
@@ -428,6 +432,8 @@ pub struct CriticalResponse {
     /// Whether every QEP probe agreed with the answer (true if none were made).
     pub confirmed_by_qep: bool,
     pub qep_probes: Vec<QepProbeOutput>,
+    /// Tensions at t* (rate and acceleration terms included); null if never unstable.
+    pub tension_at_onset: Option<crate::contract::tension::TensionOutput>,
     pub groups: Groups,
     pub elements: usize,
 }
@@ -470,6 +476,10 @@ pub struct ChartPointOutput {
     pub critical_time_error_s: f64,
     /// Estimated discretisation error of `max_elevation_m` (m).
     pub max_elevation_error_m: f64,
+    /// Winch tension F − ρA g h* at the onset (N).
+    pub winch_tension_at_onset_n: f64,
+    /// Kinematic term ρA v² (N): the winch tension it must exceed.
+    pub kinematic_tension_n: f64,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]

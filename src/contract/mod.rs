@@ -15,6 +15,7 @@ pub mod ge_numerics;
 pub mod plan;
 pub mod run;
 pub mod simulate;
+pub mod tension;
 pub mod transient;
 
 pub use run::{Progress, RequestError};

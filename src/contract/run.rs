@@ -449,6 +449,7 @@ pub fn critical_with(
         Onset::During { time_s, .. } => Some(time_s),
         Onset::Never { .. } => None,
     };
+    let strength = req.system.cable.breaking_strength()?;
     Ok(CriticalResponse {
         critical_time_s: t,
         critical_time_nondim: t.map(|t| t / sys.time_scale_s()),
@@ -473,6 +474,9 @@ pub fn critical_with(
                 expected_stable: p.expected_stable,
             })
             .collect(),
+        tension_at_onset: t.map(|t| {
+            crate::contract::tension::TensionOutput::at(&sys, profile.kinematics(t), strength)
+        }),
         groups: groups(&sys),
         elements: result.elements,
     })
@@ -623,6 +627,9 @@ pub fn chart(
                         closed_form_elevation_m: p.closed_form_elevation_m,
                         critical_time_error_s: p.critical_time_error_s,
                         max_elevation_error_m: p.max_elevation_error_m,
+                        winch_tension_at_onset_n: s.net_buoyancy_n
+                            - sys.mass_per_length_kg_m * sys.gravity_m_s2 * p.max_elevation_m,
+                        kinematic_tension_n: sys.mass_per_length_kg_m * p.rate_m_s * p.rate_m_s,
                     })
                     .collect(),
             })

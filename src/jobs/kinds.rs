@@ -209,6 +209,9 @@ impl JobKind for ChartRequest {
                         closed_form_elevation_m: p.closed_form_elevation_m,
                         critical_time_error_s: p.critical_time_error_s,
                         max_elevation_error_m: p.max_elevation_error_m,
+                        winch_tension_at_onset_n: s.net_buoyancy_n
+                            - sys.mass_per_length_kg_m * sys.gravity_m_s2 * p.max_elevation_m,
+                        kinematic_tension_n: sys.mass_per_length_kg_m * p.rate_m_s * p.rate_m_s,
                     }));
             }
         }

@@ -106,9 +106,9 @@ pub struct EnvelopeRequest {
     #[serde(default)]
     #[schema(example = 5.0, minimum = 0.0, maximum = 1000.0)]
     pub payout_rate_m_s: Option<f64>,
-    /// RK4 steps per equilibrium (default 200).
+    /// RK4 steps per equilibrium (default 100).
     #[serde(default = "default_steps")]
-    #[schema(example = 200, minimum = 8, maximum = 100000)]
+    #[schema(example = 100, minimum = 8, maximum = 100000)]
     pub integration_steps: usize,
 }
 

@@ -14,7 +14,7 @@ use crate::numerics::tether::envelope::{EnvelopeProblem, Limits, MAX_ENVELOPE_PO
 use crate::numerics::tether::{EquilibriumConfig, EquilibriumProblem, WindProfile};
 use dto::*;
 
-/// Points a synchronous envelope may have (about 0.1 s at 200 steps).
+/// Points a synchronous envelope may have (about 0.1 s of CPU at 100 steps).
 pub const MAX_SYNC_ENVELOPE_POINTS: usize = 5_000;
 
 /// What "stable" means in the envelope.

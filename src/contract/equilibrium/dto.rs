@@ -165,7 +165,7 @@ pub(crate) fn default_safety_factor() -> f64 {
 }
 
 pub(crate) fn default_steps() -> usize {
-    200
+    100
 }
 
 fn default_shape_samples() -> usize {
@@ -206,9 +206,9 @@ pub struct EquilibriumRequest {
     #[serde(default)]
     #[schema(example = 2.0, minimum = 0.0, maximum = 1000.0)]
     pub payout_rate_m_s: Option<f64>,
-    /// Fourth-order Runge–Kutta steps over the tether (default 200).
+    /// Fourth-order Runge–Kutta steps over the tether (default 100: about 1e-11 relative).
     #[serde(default = "default_steps")]
-    #[schema(example = 200, minimum = 8, maximum = 100000)]
+    #[schema(example = 100, minimum = 8, maximum = 100000)]
     pub integration_steps: usize,
     /// Points of the returned shape, evenly spaced in s (default 51).
     #[serde(default = "default_shape_samples")]
@@ -260,7 +260,7 @@ pub struct EquilibriumNumerics {
     pub shooting_iterations: usize,
     /// |z at the winch| of the last pass (m): the shooting residual.
     pub residual_m: f64,
-    /// Whether the shooting met its tolerance (1e-12 L).
+    /// Whether the shooting met its tolerance (1e-11 L).
     pub converged: bool,
 }
 

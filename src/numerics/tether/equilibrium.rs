@@ -30,6 +30,7 @@
 //! the answer is reported with `slack = true`: an outcome, not an error.
 
 use crate::numerics::params::{InvalidInput, require_finite, require_positive};
+use crate::numerics::aero::SteadyFlow;
 use crate::numerics::tether::wind::WindProfile;
 
 /// The tether.
@@ -89,7 +90,7 @@ pub struct EquilibriumConfig {
 impl Default for EquilibriumConfig {
     fn default() -> Self {
         Self {
-            steps: 200,
+            steps: 100,
             max_iterations: 60,
             keep_shape: true,
         }
@@ -161,23 +162,74 @@ struct Rhs<'a> {
     drag_n_s2_m3: f64,
     /// 1/EA (0: inextensible).
     compliance_1_n: f64,
-    wind: &'a WindProfile,
+    wind: FastWind<'a>,
+}
+
+/// The profile prepared for many evaluations.
+enum FastWind<'a> {
+    Uniform(f64),
+    Power { a: f64, p: f64 },
+    /// `k (ln z − ln z0)` above `z0`.
+    Log { k: f64, z0: f64, ln_z0: f64 },
+    Other(&'a WindProfile),
+}
+
+impl<'a> FastWind<'a> {
+    fn new(wind: &'a WindProfile) -> Self {
+        match *wind {
+            WindProfile::Flow(SteadyFlow::Uniform { speed_m_s }) => Self::Uniform(speed_m_s),
+            WindProfile::Flow(SteadyFlow::PowerLaw {
+                coefficient,
+                exponent,
+            }) => Self::Power {
+                a: coefficient,
+                p: exponent,
+            },
+            WindProfile::LogLaw {
+                reference_speed_m_s,
+                reference_height_m,
+                roughness_length_m,
+            } => Self::Log {
+                k: reference_speed_m_s / (reference_height_m / roughness_length_m).ln(),
+                z0: roughness_length_m,
+                ln_z0: roughness_length_m.ln(),
+            },
+            _ => Self::Other(wind),
+        }
+    }
+
+    #[inline]
+    fn speed(&self, z: f64) -> f64 {
+        match *self {
+            Self::Uniform(u) => u,
+            Self::Power { a, p } => a * z.max(1e-6).powf(p),
+            Self::Log { k, z0, ln_z0 } => {
+                if z <= z0 {
+                    0.0
+                } else {
+                    k * (z.ln() - ln_z0)
+                }
+            }
+            Self::Other(w) => w.speed_m_s(z),
+        }
+    }
 }
 
 impl Rhs<'_> {
     #[inline]
     fn eval(&self, y: &State) -> State {
         let [tx, tz, _, z, _] = *y;
-        let t = tx.hypot(tz);
+        let t = (tx * tx + tz * tz).sqrt();
         if t <= 0.0 {
             return [0.0, -self.weight_n_m, 0.0, -1.0, 1.0];
         }
-        let (ux, uz) = (tx / t, tz / t);
+        let inv = 1.0 / t;
+        let (ux, uz) = (tx * inv, tz * inv);
         let stretch = 1.0 + t * self.compliance_1_n;
         let mut fx = 0.0;
         let mut fz = -self.weight_n_m;
         if self.drag_n_s2_m3 > 0.0 {
-            let u = self.wind.speed_m_s(z);
+            let u = self.wind.speed(z);
             let un = u * uz; // u_n = un (uz, −ux)
             let k = self.drag_n_s2_m3 * stretch * un.abs() * un;
             fx += k * uz;
@@ -209,6 +261,17 @@ fn axpy(y: &State, a: f64, k: &State) -> State {
         y[3] + a * k[3],
         y[4] + a * k[4],
     ]
+}
+
+/// The outcome of a shooting iteration: its best pass.
+struct Shot {
+    z_top: f64,
+    residual: f64,
+    pass: Pass,
+    iterations: usize,
+    converged: bool,
+    /// Last secant slope of `g`.
+    slope: Option<f64>,
 }
 
 /// One pass from the top down.
@@ -285,7 +348,7 @@ impl EquilibriumProblem {
                 * self.cable.normal_drag_coefficient
                 * self.cable.diameter_m,
             compliance_1_n: self.cable.axial_stiffness_n.map_or(0.0, |ea| 1.0 / ea),
-            wind: &self.wind,
+            wind: FastWind::new(&self.wind),
         }
     }
 
@@ -333,7 +396,7 @@ impl EquilibriumProblem {
                 };
             }
             y = next;
-            let t = y[0].hypot(y[1]);
+            let t = (y[0] * y[0] + y[1] * y[1]).sqrt();
             max_tension = max_tension.max(t);
             min_tension = min_tension.min(t);
             if keep {
@@ -361,56 +424,109 @@ impl EquilibriumProblem {
             ));
         }
         let l = self.tether_length_m;
-        let tol = 1e-12 * l.max(1.0);
-        let g = |z: f64| self.pass(z, config.steps, false);
-        // g(z_top) = z at the winch: increasing in z_top (slope 1 in a uniform wind).
-        let mut iterations = 0usize;
-        let mut z0 = l;
-        let p0 = g(z0);
-        iterations += 1;
-        let mut g0 = p0.end[3];
-        let mut best = (z0, g0);
-        let mut converged = g0.abs() <= tol;
-        if !converged && self.wind.is_uniform() {
-            // The shape does not depend on z_top: shift it.
-            best = (z0 - g0, 0.0);
-            converged = true;
+        if self.wind.is_uniform() {
+            // The shape does not depend on z_top: one pass from z_top = L, shifted.
+            let pass = self.pass(l, config.steps, config.keep_shape);
+            return Ok(self.assemble(pass, l, 1, true));
         }
-        let (mut lo, mut hi): (Option<(f64, f64)>, Option<(f64, f64)>) = (None, None);
-        let note = |z: f64, gz: f64, lo: &mut Option<(f64, f64)>, hi: &mut Option<(f64, f64)>| {
-            if gz < 0.0 && lo.is_none_or(|b| z > b.0) {
-                *lo = Some((z, gz));
-            }
-            if gz > 0.0 && hi.is_none_or(|b| z < b.0) {
-                *hi = Some((z, gz));
-            }
+        let tol = 1e-11 * l.max(1.0);
+        // A coarse solve (an eighth of the steps, loose tolerance) gives the
+        // start of the fine one, which then needs two or three passes.
+        let coarse_steps = (config.steps / 8).max(8);
+        let (start, slope, coarse_iterations) = if coarse_steps < config.steps {
+            let c = self.shoot(l, None, coarse_steps, false, 1e-7 * l.max(1.0), config.max_iterations);
+            (c.z_top, c.slope, c.iterations)
+        } else {
+            (l, None, 0)
         };
-        note(z0, g0, &mut lo, &mut hi);
-        let mut z1 = (z0 - g0).max(0.0);
-        while !converged && iterations < config.max_iterations {
-            let g1 = g(z1).end[3];
+        let fine = self.shoot(
+            start,
+            slope,
+            config.steps,
+            config.keep_shape,
+            tol,
+            config.max_iterations.saturating_sub(coarse_iterations).max(2),
+        );
+        let iterations = coarse_iterations + fine.iterations;
+        Ok(self.assemble(fine.pass, fine.z_top, iterations, fine.converged))
+    }
+
+    /// Secant iteration on `g(z_top) = z(winch)`, safeguarded by a bracket
+    /// (bisection when the secant leaves it), from `z_start`; keeps the best pass.
+    fn shoot(
+        &self,
+        z_start: f64,
+        slope: Option<f64>,
+        steps: usize,
+        keep: bool,
+        tol: f64,
+        max_iterations: usize,
+    ) -> Shot {
+        let g = |z: f64| self.pass(z, steps, keep);
+        let mut z0 = z_start;
+        let p0 = g(z0);
+        let mut g0 = p0.end[3];
+        let mut iterations = 1usize;
+        let mut best = Shot {
+            z_top: z0,
+            residual: g0.abs(),
+            pass: p0,
+            iterations: 0,
+            converged: g0.abs() <= tol,
+            slope: None,
+        };
+        let mut lo: Option<f64> = None;
+        let mut hi: Option<f64> = None;
+        let mut note = |z: f64, gz: f64| {
+            if gz < 0.0 && lo.is_none_or(|b| z > b) {
+                lo = Some(z);
+            }
+            if gz > 0.0 && hi.is_none_or(|b| z < b) {
+                hi = Some(z);
+            }
+            (lo, hi)
+        };
+        note(z0, g0);
+        // First step: Newton with a known slope of g (from a coarser solve), else fixed point.
+        let mut z1 = match slope {
+            Some(d) if d.is_finite() && d > 0.05 => z0 - g0 / d,
+            _ => z0 - g0,
+        }
+        .max(0.0);
+        let mut last_slope = None;
+        while !best.converged && iterations < max_iterations {
+            let p1 = g(z1);
+            let g1 = p1.end[3];
             iterations += 1;
-            if g1.abs() < best.1.abs() {
-                best = (z1, g1);
+            if g1.abs() < best.residual {
+                best = Shot {
+                    z_top: z1,
+                    residual: g1.abs(),
+                    pass: p1,
+                    iterations: 0,
+                    converged: g1.abs() <= tol,
+                    slope: None,
+                };
+                if best.converged {
+                    break;
+                }
             }
-            if g1.abs() <= tol {
-                converged = true;
-                break;
+            let (lo, hi) = note(z1, g1);
+            if z1 != z0 && g1 != g0 {
+                last_slope = Some((g1 - g0) / (z1 - z0));
             }
-            note(z1, g1, &mut lo, &mut hi);
             let mut z2 = if g1 != g0 {
                 z1 - g1 * (z1 - z0) / (g1 - g0)
             } else {
                 z1 - g1
             };
             if let (Some(a), Some(b)) = (lo, hi) {
-                if !(z2 > a.0.min(b.0) && z2 < a.0.max(b.0)) || !z2.is_finite() {
-                    z2 = 0.5 * (a.0 + b.0);
-                }
-                if (a.0 - b.0).abs() <= tol {
-                    best = if a.1.abs() < b.1.abs() { a } else { b };
-                    converged = true;
+                if (a - b).abs() <= tol {
+                    best.converged = true;
                     break;
+                }
+                if !(z2 > a.min(b) && z2 < a.max(b)) || !z2.is_finite() {
+                    z2 = 0.5 * (a + b);
                 }
             } else if !z2.is_finite() {
                 z2 = z1 - g1;
@@ -418,10 +534,9 @@ impl EquilibriumProblem {
             (z0, g0) = (z1, g1);
             z1 = z2.max(0.0);
         }
-        let z_top = best.0;
-        let last = self.pass(z_top, config.steps, config.keep_shape);
-        iterations += 1;
-        Ok(self.assemble(last, z_top, iterations, converged))
+        best.iterations = iterations;
+        best.slope = last_slope;
+        best
     }
 
     fn assemble(&self, p: Pass, z_top: f64, iterations: usize, converged: bool) -> Equilibrium {
@@ -514,31 +629,37 @@ fn touchdown(rhs: &Rhs<'_>, y: &State, next: State, h: f64, scale: f64) -> (f64,
     let (mut b, mut fb, mut sb) = (1.0f64, next[1], next);
     let tol = 1e-14 * scale.max(f64::MIN_POSITIVE);
     let mut side = 0i8;
-    for _ in 0..100 {
-        if fb.abs() <= tol || (b - a).abs() <= 1e-15 {
-            break;
-        }
-        let c = (a * fb - b * fa) / (fb - fa);
-        let c = if c.is_finite() && c > a.min(b) && c < a.max(b) {
-            c
-        } else {
-            0.5 * (a + b)
-        };
-        let sc = rhs.step(y, c * h);
-        let fc = sc[1];
-        if fc > 0.0 {
-            // the root lies between c and b
-            (a, fa) = (c, fc);
-            if side == -1 {
-                fb *= 0.5;
+    if fb.abs() > tol {
+        for _ in 0..200 {
+            let c = (a * fb - b * fa) / (fb - fa);
+            let c = if c.is_finite() && c > a && c < b {
+                c
+            } else {
+                0.5 * (a + b)
+            };
+            let sc = rhs.step(y, c * h);
+            let fc = sc[1];
+            if fc.abs() <= tol {
+                (b, sb) = (c, sc);
+                break;
             }
-            side = -1;
-        } else {
-            (b, fb, sb) = (c, fc, sc);
-            if side == 1 {
-                fa *= 0.5;
+            if fc > 0.0 {
+                // the root lies between c and b
+                (a, fa) = (c, fc);
+                if side == -1 {
+                    fb *= 0.5;
+                }
+                side = -1;
+            } else {
+                (b, fb, sb) = (c, fc, sc);
+                if side == 1 {
+                    fa *= 0.5;
+                }
+                side = 1;
             }
-            side = 1;
+            if b - a <= 1e-15 {
+                break;
+            }
         }
     }
     // Report the state at τ_z = 0 exactly (the residual is below tolerance).
@@ -594,7 +715,7 @@ mod tests {
         assert_eq!(e.downwind_m, 0.0);
         assert!((e.winch_tension_n - (2000.0 - 0.05 * 9.81 * 1000.0)).abs() < 1e-9);
         assert!(!e.slack && e.converged);
-        assert_eq!(e.shape.len(), 201);
+        assert_eq!(e.shape.len(), 101);
         assert_eq!(e.shape[0].s_m, 0.0);
         assert!((e.safety_factor.unwrap() - 15.0).abs() < 1e-12);
     }

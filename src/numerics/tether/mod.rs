@@ -8,6 +8,7 @@
 pub mod envelope;
 pub mod equilibrium;
 pub mod presets;
+pub mod string_tension;
 pub mod wind;
 
 pub use equilibrium::{
