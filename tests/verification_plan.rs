@@ -196,7 +196,10 @@ fn thesis_plan_meets_the_spec_bound_of_50_s() {
         c.rate_m_s, c.duration_s, c.time_saved_s
     );
     let phases: Vec<&str> = r.phases.iter().map(|p| p.limit.as_str()).collect();
-    assert_eq!(phases, ["winch_acceleration", "winch_rate", "winch_braking"]);
+    assert_eq!(
+        phases,
+        ["winch_acceleration", "winch_rate", "winch_braking"]
+    );
 }
 
 #[test]
@@ -226,7 +229,11 @@ fn the_tension_rating_limits_braking() {
     let r = run(body);
     assert!(r.feasible, "{}", r.reason);
     for s in &r.schedule {
-        assert!(s.max_tension_n <= 1010.0 * (1.0 + 1e-12), "{}", s.max_tension_n);
+        assert!(
+            s.max_tension_n <= 1010.0 * (1.0 + 1e-12),
+            "{}",
+            s.max_tension_n
+        );
         assert!(s.acceleration_m_s2 >= -1.0 - 1e-9);
     }
     assert!(r.phases.iter().any(|p| p.limit == "tension"));
@@ -286,19 +293,28 @@ fn slow_retrieval_amplification_matches_wkb() {
     let wkb = osc.wkb_amplification_nondim.unwrap();
     let fe = osc.transient_amplification_nondim.unwrap();
     let wkb_fe = osc.wkb_fe_mode_amplification_nondim.unwrap();
-    eprintln!("retrieval 600 → 200 m: transient {fe:.4}, WKB {wkb:.4}, WKB with the FE mode {wkb_fe:.4}");
+    eprintln!(
+        "retrieval 600 → 200 m: transient {fe:.4}, WKB {wkb:.4}, WKB with the FE mode {wkb_fe:.4}"
+    );
     // The one-mode WKB (sin(πζ/2), thesis (3.12)) within 5 %; the rest is
     // the assumed shape: with the FE string's own first mode the invariant
     // matches the run to 0.5 % (the run is converged in rate and elements:
     // 0.8711 / 0.8707 / 0.8708 at 1 / 0.5 / 0.25 m/s, 0.8707 at 50–200 elements).
     assert!((fe / wkb - 1.0).abs() < 0.05, "transient {fe} vs WKB {wkb}");
-    assert!((fe / wkb_fe - 1.0).abs() < 0.005, "transient {fe} vs FE-mode WKB {wkb_fe}");
+    assert!(
+        (fe / wkb_fe - 1.0).abs() < 0.005,
+        "transient {fe} vs FE-mode WKB {wkb_fe}"
+    );
     // Shortening: the mode energy grows (ψ rises as the cable shortens).
     assert!(osc.wkb_energy_amplification_nondim.unwrap() > 1.0);
     let ret = r.retrieval.unwrap();
     // Hauling in speeds up with L̈ = −0.05 m/s² at 600 m: (m + ρA L)·0.05.
     let rise = (10.0 + 0.078 * 600.0) * 0.05;
-    assert!((ret.tension_rise_n - rise).abs() < 0.01 * rise, "{} vs {rise}", ret.tension_rise_n);
+    assert!(
+        (ret.tension_rise_n - rise).abs() < 0.01 * rise,
+        "{} vs {rise}",
+        ret.tension_rise_n
+    );
     assert!(r.schedule.iter().all(|s| s.rate_m_s <= 1e-12));
 }
 
@@ -314,7 +330,11 @@ fn a_retrieval_amplification_limit_slows_the_winch_or_names_the_limit() {
         "samples": 51
     });
     let free = run(base.clone());
-    let amp = free.oscillation.unwrap().transient_amplification_nondim.unwrap();
+    let amp = free
+        .oscillation
+        .unwrap()
+        .transient_amplification_nondim
+        .unwrap();
     // A limit far below what any rate gives is named.
     let mut body = base.clone();
     body["max_amplification_nondim"] = json!(0.01);

@@ -73,7 +73,12 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
         Some(t) => {
             let b = require_positive("tether.breaking_strength_n", t.breaking_strength_n)?;
             bounded("tether.breaking_strength_n", b, 0.0, 1e9)?;
-            let sf = bounded("tether.safety_factor_nondim", t.safety_factor_nondim, 1.0, 100.0)?;
+            let sf = bounded(
+                "tether.safety_factor_nondim",
+                t.safety_factor_nondim,
+                1.0,
+                100.0,
+            )?;
             (Some(b / sf), Some(b))
         }
         None => (None, None),
@@ -136,10 +141,8 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
                 )?;
             }
             let f = Forecast::new(&pts, "haul_down.forecast")?;
-            let limit = require_positive(
-                "haul_down.max_operating_wind_m_s",
-                h.max_operating_wind_m_s,
-            )?;
+            let limit =
+                require_positive("haul_down.max_operating_wind_m_s", h.max_operating_wind_m_s)?;
             bounded("haul_down.max_operating_wind_m_s", limit, 0.0, 200.0)?;
             Some((f, limit))
         }
@@ -248,7 +251,11 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
     let p = v.problem;
     let observer = ProgressObserver(progress);
     let retrieving = p.direction() < 0.0;
-    let direction = if retrieving { "retrieval" } else { "deployment" };
+    let direction = if retrieving {
+        "retrieval"
+    } else {
+        "deployment"
+    };
     let inputs = serde_json::to_value(req).expect("requests serialise");
     let limits_base = PlanLimitsOutput {
         reserve_buoyancy_n: p.reserve_buoyancy_n(),
@@ -322,9 +329,8 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         return Err(RequestError::Cancelled);
     }
     let schedule_out = samples_output(&p, &sched, req.samples);
-    let min_of = |f: fn(&PlanSampleOutput) -> f64| {
-        schedule_out.iter().map(f).fold(f64::INFINITY, f64::min)
-    };
+    let min_of =
+        |f: fn(&PlanSampleOutput) -> f64| schedule_out.iter().map(f).fold(f64::INFINITY, f64::min);
     let peak_tension = schedule_out
         .iter()
         .map(|s| s.max_tension_n)

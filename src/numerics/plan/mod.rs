@@ -112,9 +112,7 @@ impl PlanProblem {
         if target_length_m == system.initial_length_m {
             return Err(InvalidInput::new(
                 "target_elevation_m",
-                format!(
-                    "equals initial_length_m ({target_length_m} m): there is nothing to plan"
-                ),
+                format!("equals initial_length_m ({target_length_m} m): there is nothing to plan"),
             ));
         }
         if !(lift_reserve.is_finite() && (0.0..=MAX_LIFT_RESERVE).contains(&lift_reserve)) {

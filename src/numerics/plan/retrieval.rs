@@ -281,9 +281,11 @@ pub fn bounded_retrieval(
 /// `T_winch(L, L̈) − T_winch(L, 0) = −(m + ρA L) L̈` over the samples (N),
 /// and the largest winch tension (N).
 pub fn tension_rise_n(problem: &PlanProblem, samples: &[(f64, Kinematics)]) -> (f64, f64) {
-    samples.iter().fold((0.0f64, f64::NEG_INFINITY), |(rise, peak), (_, k)| {
-        let t = problem.winch_tension_n(k.length_m, k.acceleration_m_s2);
-        let rest = problem.winch_tension_n(k.length_m, 0.0);
-        (rise.max(t - rest), peak.max(t))
-    })
+    samples
+        .iter()
+        .fold((0.0f64, f64::NEG_INFINITY), |(rise, peak), (_, k)| {
+            let t = problem.winch_tension_n(k.length_m, k.acceleration_m_s2);
+            let rest = problem.winch_tension_n(k.length_m, 0.0);
+            (rise.max(t - rest), peak.max(t))
+        })
 }

@@ -263,7 +263,10 @@ fn max_u(upper: &[Line], lower: &[Line], lo: f64, hi: f64) -> Option<(f64, f64)>
     }
     let mut best: Option<(f64, f64)> = None;
     for alpha in candidates {
-        let u = upper.iter().map(|l| l.at(alpha)).fold(f64::INFINITY, f64::min);
+        let u = upper
+            .iter()
+            .map(|l| l.at(alpha))
+            .fold(f64::INFINITY, f64::min);
         let need = lower
             .iter()
             .map(|l| l.at(alpha))
