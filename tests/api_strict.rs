@@ -738,3 +738,60 @@ fn a_job_envelope_refuses_unknown_keys() {
     let e = error_of("/api/v1/jobs", body);
     assert_eq!(e.field.as_deref(), Some("request[0].extra"));
 }
+
+/// Item 5: a run past onset states the first unstable time (the profile's
+/// t*) and stops at the stated cap instead of printing 1e60 m.
+#[test]
+fn a_transient_past_divergence_stops_at_the_stated_cap() {
+    let body = with(
+        thesis(),
+        json!({"model": {"elements": 20},
+               "profile": {"kind": "constant_rate", "rate_m_s": 10.0, "target_length_m": 3000.0},
+               "duration_s": 400.0, "samples": 400,
+               "initial": {"kind": "shape", "tip_deflection_m": 0.01}}),
+    );
+    let (status, text) = post(&app(), "/api/v1/simulate", &body);
+    assert_eq!(status, 200, "{text}");
+    let v: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["stopped_reason"], "magnitude_cap", "{}", v["explanation"]);
+    assert_eq!(v["outcome"], "diverged");
+    let t_star = v["first_unstable_time_s"].as_f64().unwrap();
+    // /critical gives the same onset
+    let (_, c) = post(
+        &app(),
+        "/api/v1/critical",
+        &with(
+            thesis(),
+            json!({"model": {"elements": 20}, "profile": {"kind": "constant_rate", "rate_m_s": 10.0, "target_length_m": 3000.0}}),
+        ),
+    );
+    let c: Value = serde_json::from_str(&c).unwrap();
+    assert!((t_star - c["critical_time_s"].as_f64().unwrap()).abs() < 1e-6 * t_star);
+    let stop = v["outcome_time_s"].as_f64().unwrap();
+    assert!(stop > t_star, "stopped at {stop} s before onset {t_star} s");
+    let cap = v["magnitude_cap_m"].as_f64().unwrap();
+    let length_at_stop = v["length_m"]
+        .as_array()
+        .unwrap()
+        .last()
+        .unwrap()
+        .as_f64()
+        .unwrap();
+    assert!(
+        (cap - v["magnitude_cap_lengths_nondim"].as_f64().unwrap() * length_at_stop).abs()
+            < 1e-9 * cap
+    );
+    // every printed deflection is finite and within a step's growth of the cap
+    for y in v["tip_deflection_m"].as_array().unwrap() {
+        let y = y.as_f64().expect("a number, not null");
+        assert!(y.abs() <= 10.0 * cap, "{y} m against the cap {cap} m");
+    }
+    // before onset the run is small
+    let times = v["time_s"].as_array().unwrap();
+    let tips = v["tip_envelope_m"].as_array().unwrap();
+    for (t, y) in times.iter().zip(tips) {
+        if t.as_f64().unwrap() < 0.9 * t_star {
+            assert!(y.as_f64().unwrap() < 1.0, "{y} m at {t} s before onset");
+        }
+    }
+}

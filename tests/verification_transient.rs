@@ -618,24 +618,30 @@ fn ramped_deployment_goes_unstable_past_the_critical_length_only() {
         .map(|s| s.tip_envelope_m)
         .fold(0.0, f64::max);
     assert!(before < 2.0, "pre-critical peak {before} m");
-    let blow_up = r
+    // The tip passes 100× its pre-t* peak, or the run stops first because
+    // a deflection near the roller (where the onset is) passed the
+    // magnitude cap of MAGNITUDE_CAP_LENGTHS × the length.
+    let blow_up_time_s = match r
         .samples
         .iter()
         .find(|s| s.tip_envelope_m > 100.0 * before)
-        .expect("the tip must grow without bound");
-    println!(
-        "pre-t* peak {before:.3} m; 100x exceeded at {:.1} s (L = {:.0} m)",
-        blow_up.time_s, blow_up.length_m
-    );
-    assert!(blow_up.time_s > t_star);
+    {
+        Some(s) => s.time_s,
+        None => match r.outcome {
+            RunOutcome::Diverged { time_s } if r.stopped_at_cap => time_s,
+            other => panic!("the deflection must grow without bound, got {other:?}"),
+        },
+    };
+    println!("pre-t* peak {before:.3} m; blow-up (100x tip or cap) at {blow_up_time_s:.1} s");
+    assert!(blow_up_time_s > t_star);
     // Eigenvalues while the deflection is still within the linear model
     // (beyond, the drag linearised about ẏ ~ 1e5 m/s swamps the QEP).
     let tracked: Vec<_> = r
         .eigen
         .iter()
-        .filter(|e| e.time_s < blow_up.time_s)
+        .filter(|e| e.time_s < blow_up_time_s)
         .collect();
-    assert!(tracked.iter().any(|e| e.time_s > t_star + 20.0));
+    assert!(tracked.iter().any(|e| e.time_s > t_star + 10.0));
     for ev in tracked {
         if ev.time_s < t_star - 0.5 {
             assert!(ev.stable, "unstable at {} s before t*", ev.time_s);

@@ -63,7 +63,7 @@ pub const DIVERGENCE_LIMIT: f64 = 1e100;
 /// the cable length at that instant: far past the linear model (whose
 /// deflections are small against the length), so the growth after onset
 /// is shown up to a stated magnitude instead of to overflow.
-pub const MAGNITUDE_CAP_LENGTHS: f64 = 10.0;
+pub const MAGNITUDE_CAP_LENGTHS: f64 = 1000.0;
 /// The run stops when the length falls below this fraction of `L0`.
 pub const MIN_LENGTH_FRACTION: f64 = 1e-3;
 
