@@ -104,6 +104,8 @@
     } else {
       cable.mass_per_length_kg_m = num("cable.mass_per_length_kg_m", errors, { fallback: 0.078 });
     }
+    // An empty element count (the chart's "converged") runs the default mesh.
+    const elements = num("model.elements", errors, { integer: true, optional: true, fallback: 50 });
     return {
       cable,
       aerostat: {
@@ -112,7 +114,7 @@
       },
       initial_length_m: num("initial_length_m", errors),
       gravity_m_s2: num("gravity_m_s2", errors, { fallback: 9.81 }),
-      model: { kind: "linear_string", elements: num("model.elements", errors, { integer: true, fallback: 50 }) },
+      model: elements === undefined ? { kind: "linear_string" } : { kind: "linear_string", elements },
     };
   }
 

@@ -56,12 +56,15 @@ pub struct JobView {
 /// The schemas a finished job's `result` may have: the answer of every
 /// synchronous route a job kind stands for, and a batch's outcome.
 pub const JOB_RESULT_SCHEMAS: &[&str] = &[
-    "StabilityResponse",
-    "CriticalResponse",
+    "AnyStabilityResponse",
+    "AnyCriticalResponse",
     "SafeRateResponse",
     "AnyChartResponse",
     "AnySimulateResponse",
     "AnyFrequencyResponseResponse",
+    "EquilibriumResponse",
+    "EnvelopeResponse",
+    "BandsResponse",
     "BatchOutcome",
 ];
 

@@ -112,20 +112,23 @@ impl AppState {
             let _ = tx.send(out);
         });
         let timeout = self.limits.solve_timeout;
+        let timed_out = || {
+            ApiError::new(
+                StatusCode::GATEWAY_TIMEOUT,
+                "timeout",
+                None,
+                format!(
+                    "no answer within {:.1} s; submit it as a batch job instead: POST /api/v1/jobs",
+                    timeout.as_secs_f64()
+                ),
+            )
+        };
         let body = match tokio::time::timeout(timeout, rx).await {
+            // A solve stopped by its own deadline answers as the timeout it is.
+            Ok(Ok(Err(e))) if e.body.error.code == "cancelled" => return Err(timed_out()),
             Ok(Ok(out)) => out?,
-            Ok(Err(_)) => return Err(ApiError::internal("the solver ended without an answer")),
-            Err(_) => {
-                return Err(ApiError::new(
-                    StatusCode::GATEWAY_TIMEOUT,
-                    "timeout",
-                    None,
-                    format!(
-                        "no answer within {:.1} s; submit it as a batch job instead: POST /api/v1/jobs",
-                        timeout.as_secs_f64()
-                    ),
-                ));
-            }
+            Ok(Err(_)) => return Err(timed_out()),
+            Err(_) => return Err(timed_out()),
         };
         Ok((
             StatusCode::OK,

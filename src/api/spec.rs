@@ -139,8 +139,87 @@ pub fn refine(doc: utoipa::openapi::OpenApi) -> utoipa::openapi::OpenApi {
     serde_json::from_value(v).unwrap_or(doc)
 }
 
+/// A request made of two parts (`allOf` of the system and its parameters,
+/// each refusing unknown fields) becomes one object with both parts'
+/// properties: as `allOf` the parts would forbid each other's keys.
+fn merge_all_of(v: &mut Value) {
+    let Some(schemas) = v.pointer("/components/schemas").and_then(Value::as_object).cloned() else {
+        return;
+    };
+    for (name, schema) in &schemas {
+        let Some(parts) = schema.get("allOf").and_then(Value::as_array) else {
+            continue;
+        };
+        let mut properties = serde_json::Map::new();
+        let mut required: Vec<Value> = Vec::new();
+        let mut mergeable = true;
+        for part in parts {
+            let resolved = match part.get("$ref").and_then(Value::as_str) {
+                Some(r) => r.rsplit('/').next().and_then(|n| schemas.get(n)).cloned(),
+                None => Some(part.clone()),
+            };
+            let Some(obj) = resolved.filter(|o| o.get("properties").is_some()) else {
+                mergeable = false;
+                break;
+            };
+            if let Some(p) = obj.get("properties").and_then(Value::as_object) {
+                properties.extend(p.clone());
+            }
+            if let Some(r) = obj.get("required").and_then(Value::as_array) {
+                required.extend(r.iter().cloned());
+            }
+        }
+        if !mergeable {
+            continue;
+        }
+        let mut merged = serde_json::Map::new();
+        merged.insert("type".into(), json!("object"));
+        merged.insert("properties".into(), Value::Object(properties));
+        if !required.is_empty() {
+            merged.insert("required".into(), Value::Array(required));
+        }
+        merged.insert("additionalProperties".into(), json!(false));
+        for key in ["description", "example", "title"] {
+            if let Some(x) = schema.get(key) {
+                merged.insert(key.into(), x.clone());
+            }
+        }
+        if let Some(slot) = v.pointer_mut(&format!("/components/schemas/{name}")) {
+            *slot = Value::Object(merged);
+        }
+    }
+}
+
 fn refine_value(v: &mut Value) {
+    merge_all_of(v);
     for (path, example) in request_examples() {
+        if let Some(media) = v
+            .pointer_mut(&format!(
+                "/paths/{}/post/requestBody/content/application~1json",
+                path.replace('~', "~0").replace('/', "~1")
+            ))
+            .and_then(Value::as_object_mut)
+        {
+            media.insert("example".into(), example);
+        }
+    }
+    // Routes without a hand-written example take their request schema's own.
+    let schema_examples: Vec<(String, Value)> = v["paths"]
+        .as_object()
+        .into_iter()
+        .flatten()
+        .filter_map(|(path, ops)| {
+            let media = ops.pointer("/post/requestBody/content/application~1json")?;
+            if media.get("example").is_some() {
+                return None;
+            }
+            let reference = media.pointer("/schema/$ref")?.as_str()?;
+            let name = reference.rsplit('/').next()?;
+            let example = v.pointer(&format!("/components/schemas/{name}/example"))?;
+            Some((path.clone(), example.clone()))
+        })
+        .collect();
+    for (path, example) in schema_examples {
         if let Some(media) = v
             .pointer_mut(&format!(
                 "/paths/{}/post/requestBody/content/application~1json",

@@ -112,6 +112,7 @@ pub const SYSTEM_KEYS: &[&str] = &[
     "aerostat",
     "initial_length_m",
     "gravity_m_s2",
+    "numerics",
     "model",
 ];
 

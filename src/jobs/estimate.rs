@@ -23,8 +23,8 @@ pub const PER_EIGENVALUE: u64 = 6 * PER_NUMBER + 120;
 pub const CHART_BASE: u64 = 512;
 /// One chart series without its points.
 pub const PER_CHART_SERIES: u64 = 256;
-/// One chart point: 6 numbers and their keys.
-pub const PER_CHART_POINT: u64 = 6 * PER_NUMBER + 160;
+/// One chart point: 8 numbers and their keys.
+pub const PER_CHART_POINT: u64 = 8 * PER_NUMBER + 240;
 /// One GE chart point: 12 numbers or nulls, the onset, the closed-form
 /// note and their keys.
 pub const PER_GE_CHART_POINT: u64 = 12 * PER_NUMBER + 900;

@@ -690,12 +690,15 @@ pub struct BatchItemOutcome {
 
 /// The schemas of one request's answer: those of the synchronous routes.
 pub const ITEM_RESULT_SCHEMAS: &[&str] = &[
-    "StabilityResponse",
-    "CriticalResponse",
+    "AnyStabilityResponse",
+    "AnyCriticalResponse",
     "SafeRateResponse",
     "AnyChartResponse",
     "AnySimulateResponse",
     "AnyFrequencyResponseResponse",
+    "EquilibriumResponse",
+    "EnvelopeResponse",
+    "BandsResponse",
 ];
 
 fn item_result_schema() -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {

@@ -679,7 +679,7 @@ mod tests {
         assert_eq!(
             field_of(body(json!({"uncertainty": {"inputs": [
                 {"field": "aerostat.mass_kg", "distribution": "normal", "mean": 10.0, "std_dev": 1.0, "skew": 1}]}}))),
-            "uncertainty.inputs[0]"
+            "uncertainty.inputs[0].skew"
         );
         // 2.3 % of a N(10, 5) mass is negative: refused
         assert_eq!(
