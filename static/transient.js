@@ -203,7 +203,7 @@
     return req;
   }
 
-  const work = (req) => (req.duration_s || 0) * (req.model.elements || 0);
+  const work = (req) => (req.duration_s || 0) * (req.model.elements || 50);
   const runWantsJob = (req) => work(req) > JOB_WORK;
   const frWantsJob = (req) => (req.frequencies_rad_s.count || 0) > SYNC_FREQUENCIES;
 

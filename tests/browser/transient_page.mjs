@@ -192,7 +192,7 @@ try {
   await page.click("#tr-run");
   const radiusError = page.locator(".field:has(#tr-radius) .field-error");
   await radiusError.waitFor({ timeout: 30_000 });
-  check((await radiusError.getAttribute("data-error-for")) === "aero.radius_m" && /greater than zero|positive/.test(await radiusError.textContent()), `error next to the radius: “${await radiusError.textContent()}”`);
+  check((await radiusError.getAttribute("data-error-for")) === "aero.radius_m" && /greater than zero|positive|must be between/.test(await radiusError.textContent()), `error next to the radius: “${await radiusError.textContent()}”`);
   check((await page.getAttribute("#tr-radius", "aria-invalid")) === "true", "radius input marked invalid");
   check((await page.getAttribute("#tr-status", "data-state")) === "error", "transient status shows the error");
   await page.locator("#transient-run").screenshot({ path: path.join(artifacts, "transient_page_error.png") });

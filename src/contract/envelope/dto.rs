@@ -79,8 +79,8 @@ pub struct LengthGridInput {
                  "reference_area_m2": 20.0},
     "wind": {"shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0},
              "air_density_kg_m3": 1.225},
-    "wind_speeds_m_s": {"min": 0.0, "max": 30.0, "count": 4},
-    "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 5},
+    "wind_speeds_m_s": {"min": 0.0, "max": 30.0, "count": 40},
+    "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 50},
     "required_safety_factor_nondim": 5.0,
     "ceiling_m": 2500.0,
     "payout_rate_m_s": 5.0
