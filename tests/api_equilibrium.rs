@@ -61,7 +61,13 @@ fn parse_equilibrium(v: &Value) -> EquilibriumRequest {
 #[tokio::test]
 async fn the_schema_examples_succeed_as_they_are() {
     let (app, _) = app();
-    let (status, body) = send(&app, "POST", "/api/v1/equilibrium", Some(&example::<EquilibriumRequest>())).await;
+    let (status, body) = send(
+        &app,
+        "POST",
+        "/api/v1/equilibrium",
+        Some(&example::<EquilibriumRequest>()),
+    )
+    .await;
     assert_eq!(status, StatusCode::OK, "{body}");
     for field in [
         "aerostat_altitude_m",
@@ -82,8 +88,16 @@ async fn the_schema_examples_succeed_as_they_are() {
     assert_eq!(shape[0]["z_m"], 0.0);
     assert_eq!(shape[50]["s_m"], 1000.0);
     // preset dyneema 6 mm: 0.0195 kg/m, 30 kN
-    assert!((body["cable"]["mass_per_length_kg_m"].as_f64().unwrap() - 690.0 * 2.827e-5).abs() < 1e-4);
-    let (status, body) = send(&app, "POST", "/api/v1/envelope", Some(&example::<EnvelopeRequest>())).await;
+    assert!(
+        (body["cable"]["mass_per_length_kg_m"].as_f64().unwrap() - 690.0 * 2.827e-5).abs() < 1e-4
+    );
+    let (status, body) = send(
+        &app,
+        "POST",
+        "/api/v1/envelope",
+        Some(&example::<EnvelopeRequest>()),
+    )
+    .await;
     assert_eq!(status, StatusCode::OK, "{body}");
     assert_eq!(body["points"].as_array().unwrap().len(), 2000);
     assert_eq!(body["max_wind_per_length"].as_array().unwrap().len(), 50);
@@ -95,13 +109,62 @@ async fn bad_input_names_its_field() {
     let (app, _) = app();
     let base = example::<EquilibriumRequest>();
     let cases: Vec<(Value, &str)> = vec![
-        ({ let mut b = base.clone(); b["cable"]["colour"] = json!("red"); b }, "cable"),
-        ({ let mut b = base.clone(); b["cable"] = json!({"diameter_m": 0.006}); b }, "cable.mass_per_length_kg_m"),
-        ({ let mut b = base.clone(); b["tether_length_m"] = json!(-5.0); b }, "tether_length_m"),
-        ({ let mut b = base.clone(); b["wind"]["flow"]["roughness_length_m"] = json!(50.0); b }, "wind.flow.roughness_length_m"),
-        ({ let mut b = base.clone(); b["aerostat"] = json!({"net_buoyancy_n": 10.0, "preset": "sphere"}); b }, "aerostat.radius_m"),
-        ({ let mut b = base.clone(); b["required_safety_factor_nondim"] = json!(0.5); b }, "required_safety_factor_nondim"),
-        ({ let mut b = base.clone(); b["integration_steps"] = json!(2); b }, "integration_steps"),
+        (
+            {
+                let mut b = base.clone();
+                b["cable"]["colour"] = json!("red");
+                b
+            },
+            "cable",
+        ),
+        (
+            {
+                let mut b = base.clone();
+                b["cable"] = json!({"diameter_m": 0.006});
+                b
+            },
+            "cable.mass_per_length_kg_m",
+        ),
+        (
+            {
+                let mut b = base.clone();
+                b["tether_length_m"] = json!(-5.0);
+                b
+            },
+            "tether_length_m",
+        ),
+        (
+            {
+                let mut b = base.clone();
+                b["wind"]["flow"]["roughness_length_m"] = json!(50.0);
+                b
+            },
+            "wind.flow.roughness_length_m",
+        ),
+        (
+            {
+                let mut b = base.clone();
+                b["aerostat"] = json!({"net_buoyancy_n": 10.0, "preset": "sphere"});
+                b
+            },
+            "aerostat.radius_m",
+        ),
+        (
+            {
+                let mut b = base.clone();
+                b["required_safety_factor_nondim"] = json!(0.5);
+                b
+            },
+            "required_safety_factor_nondim",
+        ),
+        (
+            {
+                let mut b = base.clone();
+                b["integration_steps"] = json!(2);
+                b
+            },
+            "integration_steps",
+        ),
     ];
     for (body, field) in cases {
         let (status, err) = send(&app, "POST", "/api/v1/equilibrium", Some(&body)).await;
@@ -166,8 +229,12 @@ fn envelope_points_equal_single_point_answers() {
             let u = p.wind_speed_m_s;
             let flow = match shape["kind"].as_str().unwrap() {
                 "uniform" => json!({"kind": "uniform", "speed_m_s": u}),
-                "power_law" => json!({"kind": "power_law", "coefficient_m_s": u / 10f64.powf(0.14), "exponent_nondim": 0.14}),
-                _ => json!({"kind": "log_law", "reference_speed_m_s": u, "reference_height_m": 10.0, "roughness_length_m": 0.03}),
+                "power_law" => {
+                    json!({"kind": "power_law", "coefficient_m_s": u / 10f64.powf(0.14), "exponent_nondim": 0.14})
+                }
+                _ => {
+                    json!({"kind": "log_law", "reference_speed_m_s": u, "reference_height_m": 10.0, "roughness_length_m": 0.03})
+                }
             };
             let single = json!({
                 "cable": v["cable"], "aerostat": v["aerostat"], "tether_length_m": p.tether_length_m,
@@ -180,17 +247,29 @@ fn envelope_points_equal_single_point_answers() {
             single.tether_length_m = p.tether_length_m;
             single.wind.flow = match single.wind.flow {
                 WindFlowInput::Uniform { .. } => WindFlowInput::Uniform { speed_m_s: u },
-                WindFlowInput::PowerLaw { exponent_nondim, .. } => WindFlowInput::PowerLaw {
+                WindFlowInput::PowerLaw {
+                    exponent_nondim, ..
+                } => WindFlowInput::PowerLaw {
                     coefficient_m_s: u / 10f64.powf(0.14),
                     exponent_nondim,
                 },
-                WindFlowInput::LogLaw { reference_height_m, roughness_length_m, .. } => {
-                    WindFlowInput::LogLaw { reference_speed_m_s: u, reference_height_m, roughness_length_m }
-                }
+                WindFlowInput::LogLaw {
+                    reference_height_m,
+                    roughness_length_m,
+                    ..
+                } => WindFlowInput::LogLaw {
+                    reference_speed_m_s: u,
+                    reference_height_m,
+                    roughness_length_m,
+                },
                 other => other,
             };
             let one = equilibrium::equilibrium(&single).unwrap();
-            assert_eq!(p.aerostat_altitude_m, one.aerostat_altitude_m, "{shape} {u} {}", p.tether_length_m);
+            assert_eq!(
+                p.aerostat_altitude_m, one.aerostat_altitude_m,
+                "{shape} {u} {}",
+                p.tether_length_m
+            );
             assert_eq!(p.aerostat_downwind_m, one.aerostat_downwind_m);
             assert_eq!(p.winch_tension_n, one.winch_tension_n);
             assert_eq!(p.top_tension_n, one.top_tension_n);
@@ -199,11 +278,18 @@ fn envelope_points_equal_single_point_answers() {
             assert_eq!(p.stable, one.stable);
             // the ceiling is the envelope's own limit
             let ceiling = p.aerostat_altitude_m > 2500.0 && one.binding_limit.is_none();
-            let want = if ceiling { Some("ceiling".to_string()) } else { one.binding_limit.clone() };
+            let want = if ceiling {
+                Some("ceiling".to_string())
+            } else {
+                one.binding_limit.clone()
+            };
             assert_eq!(p.binding_limit, want, "{u} m/s, {} m", p.tether_length_m);
             kinds.insert(p.binding_limit.clone());
         }
-        assert!(kinds.len() >= 3, "the grid should cross several limits: {kinds:?}");
+        assert!(
+            kinds.len() >= 3,
+            "the grid should cross several limits: {kinds:?}"
+        );
         // largest operating wind per length: every lower wind is feasible, the next is not
         for (j, m) in env.max_wind_per_length.iter().enumerate() {
             let column: Vec<_> = (0..7).map(|i| &env.points[i * 6 + j]).collect();
@@ -229,7 +315,13 @@ async fn envelope_runs_as_a_job_with_progress() {
     let (app, queue) = app();
     let mut req = example::<EnvelopeRequest>();
     req["tether_lengths_m"]["count"] = json!(200);
-    let (status, body) = send(&app, "POST", "/api/v1/jobs", Some(&json!({"kind": "envelope", "request": req}))).await;
+    let (status, body) = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        Some(&json!({"kind": "envelope", "request": req})),
+    )
+    .await;
     assert_eq!(status, StatusCode::ACCEPTED, "{body}");
     let id = body["id"].as_i64().unwrap();
     let q = queue.clone();
@@ -239,7 +331,11 @@ async fn envelope_runs_as_a_job_with_progress() {
         .expect("a job ran");
     let (status, job) = send(&app, "GET", &format!("/api/v1/jobs/{id}"), None).await;
     assert_eq!(status, StatusCode::OK);
-    assert_eq!(job["status"], serde_json::to_value(JobStatus::Done).unwrap(), "{job}");
+    assert_eq!(
+        job["status"],
+        serde_json::to_value(JobStatus::Done).unwrap(),
+        "{job}"
+    );
     assert_eq!(job["result"]["points"].as_array().unwrap().len(), 40 * 200);
     assert_eq!(job["progress"], 1.0);
 }
@@ -313,7 +409,10 @@ async fn any_one_field_replaced_never_gives_a_5xx() {
             for new in &bad {
                 let b = replaced(&body, path, new.clone());
                 let (status, answer) = send(&app, "POST", route, Some(&b)).await;
-                assert!(status.as_u16() < 500, "{route} {path:?} = {new} → {status} {answer}");
+                assert!(
+                    status.as_u16() < 500,
+                    "{route} {path:?} = {new} → {status} {answer}"
+                );
                 if status.is_success() {
                     let text = answer.to_string();
                     assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
@@ -351,7 +450,10 @@ fn cli_answers_equilibrium_and_envelope() {
     let (code, v) = run("equilibrium", &req);
     assert_eq!(code, 0, "{v}");
     let direct = equilibrium::equilibrium(&parse_equilibrium(&req)).unwrap();
-    assert_eq!(v["aerostat_altitude_m"].as_f64().unwrap(), direct.aerostat_altitude_m);
+    assert_eq!(
+        v["aerostat_altitude_m"].as_f64().unwrap(),
+        direct.aerostat_altitude_m
+    );
     let mut env = example::<EnvelopeRequest>();
     env["wind_speeds_m_s"]["count"] = json!(4);
     let (code, v) = run("envelope", &env);
@@ -375,8 +477,10 @@ fn critical_and_chart_answers_carry_the_tensions() {
         serde_json::to_vec(&v).unwrap()
     };
     let (rho_a, f, m, g) = (0.078, 1000.0, 10.0, 9.81);
-    let req: CriticalRequest =
-        contract::parse(&with(json!({"profile": {"kind": "constant_rate", "rate_m_s": 10.0}}))).unwrap();
+    let req: CriticalRequest = contract::parse(&with(
+        json!({"profile": {"kind": "constant_rate", "rate_m_s": 10.0}}),
+    ))
+    .unwrap();
     let out = tetherplan::contract::run::critical(&req).unwrap();
     let t = out.tension_at_onset.expect("unstable at some length");
     let h = out.max_elevation_m.unwrap();
@@ -395,8 +499,10 @@ fn critical_and_chart_answers_carry_the_tensions() {
     let t = out.tension_at_onset.unwrap();
     assert!((t.top_tension_n - (f - m * 0.5)).abs() < 1e-9);
     assert!((t.winch_tension_n - (f - m * 0.5 - rho_a * (g + 0.5) * t.length_m)).abs() < 1e-9);
-    let req: ChartRequest =
-        contract::parse(&with(json!({"rates_m_s": {"min": 1.0, "max": 50.0, "count": 5}}))).unwrap();
+    let req: ChartRequest = contract::parse(&with(
+        json!({"rates_m_s": {"min": 1.0, "max": 50.0, "count": 5}}),
+    ))
+    .unwrap();
     let out = tetherplan::contract::run::chart(&req, Parallelism::Serial, &NoProgress).unwrap();
     for p in &out.series[0].points {
         assert!((p.winch_tension_at_onset_n - (f - rho_a * g * p.max_elevation_m)).abs() < 1e-9);
@@ -406,5 +512,8 @@ fn critical_and_chart_answers_carry_the_tensions() {
         "cable": {"mass_per_length_kg_m": 0.078, "breaking_strength_n": -1.0},
         "aerostat": {"net_buoyancy_n": 1000.0}, "profile": {"kind": "constant_rate", "rate_m_s": 10.0}})).unwrap());
     let err = tetherplan::contract::run::critical(&bad.unwrap()).unwrap_err();
-    assert_eq!(err.body().error.field.as_deref(), Some("cable.breaking_strength_n"));
+    assert_eq!(
+        err.body().error.field.as_deref(),
+        Some("cable.breaking_strength_n")
+    );
 }

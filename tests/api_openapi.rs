@@ -27,69 +27,96 @@ fn every_route_is_documented_with_its_statuses() {
             "post",
             "/api/v1/stability",
             "compute_stability",
-            &["200", "400", "401", "413", "415", "422", "500", "503", "504"],
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
         ),
         (
             "post",
             "/api/v1/critical",
             "compute_critical",
-            &["200", "400", "401", "413", "415", "422", "500", "503", "504"],
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
         ),
         (
             "post",
             "/api/v1/safe-rate",
             "compute_safe_rate",
-            &["200", "400", "401", "413", "415", "422", "500", "503", "504"],
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
         ),
         (
             "post",
             "/api/v1/charts",
             "create_chart",
-            &["200", "400", "401", "413", "415", "422", "500", "503", "504"],
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
         ),
         (
             "post",
             "/api/v1/simulate",
             "run_simulation",
-            &["200", "400", "401", "413", "415", "422", "500", "503", "504"],
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
         ),
         (
             "post",
             "/api/v1/frequency-response",
             "compute_frequency_response",
-            &["200", "400", "401", "413", "415", "422", "500", "503", "504"],
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
         ),
         (
             "post",
             "/api/v1/equilibrium",
             "compute_equilibrium",
-            &["200", "400", "401", "413", "415", "422", "500", "503", "504"],
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
         ),
         (
             "post",
             "/api/v1/envelope",
             "compute_envelope",
-            &["200", "400", "401", "413", "415", "422", "500", "503", "504"],
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
         ),
         (
             "post",
             "/api/v1/plan",
             "compute_plan",
-            &["200", "400", "401", "413", "415", "422", "500", "503", "504"],
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
         ),
         (
             "post",
             "/api/v1/bands",
             "compute_bands",
-            &["200", "400", "401", "413", "415", "422", "500", "503", "504"],
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
         ),
         (
             "post",
             "/api/v1/jobs",
             "create_job",
-            &["200", "202", "400", "401", "413", "415", "422", "429", "500"],
+            &[
+                "200", "202", "400", "401", "413", "415", "422", "429", "500",
+            ],
         ),
-        ("get", "/api/v1/jobs", "list_jobs", &["200", "400", "401", "500"]),
+        (
+            "get",
+            "/api/v1/jobs",
+            "list_jobs",
+            &["200", "400", "401", "500"],
+        ),
         (
             "get",
             "/api/v1/jobs/{id}",
@@ -153,11 +180,33 @@ fn numeric_fields_name_their_unit() {
     ];
     // Counts, ids and fractions; RateGrid's bounds are described in m/s by its parent `rates_m_s`.
     const UNITLESS: &[&str] = &[
-        "elements", "modes", "count", "id", "attempts", "progress", "min", "max",
+        "elements",
+        "modes",
+        "count",
+        "id",
+        "attempts",
+        "progress",
+        "min",
+        "max",
         // Percentile bands and distributions carry their parent's unit
         // (`max_elevation_m.p05`, the `field` an uncertain input names).
-        "p05", "p50", "p95", "p05_error", "p50_error", "p95_error", "p05_low", "p05_high",
-        "p50_low", "p50_high", "p95_low", "p95_high", "mean", "std_dev", "low", "high", "seed",
+        "p05",
+        "p50",
+        "p95",
+        "p05_error",
+        "p50_error",
+        "p95_error",
+        "p05_low",
+        "p05_high",
+        "p50_low",
+        "p50_high",
+        "p95_low",
+        "p95_high",
+        "mean",
+        "std_dev",
+        "low",
+        "high",
+        "seed",
     ];
     // Dimensionless by name: ratios (E*, γ̃ as the issues name them), step
     // and sample counts, Newton iteration counts, relative tolerances,

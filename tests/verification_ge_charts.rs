@@ -334,7 +334,10 @@ fn ge_chart_parallel_equals_serial() {
         last.fetch_max(done, Ordering::Relaxed);
     };
     let serial = deployment_chart(&request, Parallelism::Serial, &progress, &never).unwrap();
-    assert_eq!(last.swap(0, Ordering::Relaxed), 12 * PROGRESS_UNITS_PER_POINT);
+    assert_eq!(
+        last.swap(0, Ordering::Relaxed),
+        12 * PROGRESS_UNITS_PER_POINT
+    );
     let parallel = deployment_chart(&request, Parallelism::Rayon, &progress, &never).unwrap();
     assert_eq!(last.load(Ordering::Relaxed), 12 * PROGRESS_UNITS_PER_POINT);
     assert_eq!(serial, parallel);
@@ -833,10 +836,7 @@ fn ge_chart_progress_advances_within_a_point() {
         .copied()
         .filter(|&d| d > 0 && d < PROGRESS_UNITS_PER_POINT)
         .collect();
-    assert!(
-        within.len() >= 3,
-        "progress within the point: {seen:?}"
-    );
+    assert!(within.len() >= 3, "progress within the point: {seen:?}");
     assert!(seen.windows(2).all(|w| w[0] < w[1]), "increasing: {seen:?}");
     assert_eq!(*seen.last().unwrap(), PROGRESS_UNITS_PER_POINT);
 }

@@ -53,7 +53,11 @@ fn calm_air_winch_tension_and_altitude_to_1e_9() {
         p.body.net_buoyancy_n = f;
         let e = p.solve(&config(200)).unwrap();
         let w = 0.06 * G;
-        assert!(((e.winch_tension_n - (f - w * l)) / f).abs() < 1e-9, "{l}: {}", e.winch_tension_n);
+        assert!(
+            ((e.winch_tension_n - (f - w * l)) / f).abs() < 1e-9,
+            "{l}: {}",
+            e.winch_tension_n
+        );
         assert!((e.altitude_m - l).abs() < 1e-9 * l, "{l}: {}", e.altitude_m);
         assert!((e.top_tension_n - f).abs() < 1e-9 * f);
         assert_eq!(e.downwind_m, 0.0);
@@ -115,8 +119,16 @@ fn aerostat_drag_only_is_the_catenary_to_1e_6() {
             ((e.altitude_m - z) / z).abs(),
             ((e.downwind_m - x) / x).abs()
         );
-        assert!(((e.altitude_m - z) / z).abs() < tol, "{u}: z {} vs {z}", e.altitude_m);
-        assert!(((e.downwind_m - x) / x).abs() < tol, "{u}: x {} vs {x}", e.downwind_m);
+        assert!(
+            ((e.altitude_m - z) / z).abs() < tol,
+            "{u}: z {} vs {z}",
+            e.altitude_m
+        );
+        assert!(
+            ((e.downwind_m - x) / x).abs() < tol,
+            "{u}: x {} vs {x}",
+            e.downwind_m
+        );
         let top = h.hypot(v);
         let winch = h.hypot(v - w * l);
         assert!(((e.top_tension_n - top) / top).abs() < tol);
@@ -136,12 +148,20 @@ fn aerostat_drag_only_in_a_power_law_wind_is_the_catenary_at_the_found_altitude(
     assert!((e.aerostat_wind_m_s - u).abs() < 1e-9 * u);
     let (h, v) = p.top_force_n(u);
     let (x, z) = catenary_top(h, v, 0.06 * G, 1500.0);
-    assert!(((e.altitude_m - z) / z).abs() < 1e-6, "{} vs {z}", e.altitude_m);
+    assert!(
+        ((e.altitude_m - z) / z).abs() < 1e-6,
+        "{} vs {z}",
+        e.altitude_m
+    );
     assert!(((e.downwind_m - x) / x).abs() < 1e-6);
 }
 
 /// Observed order from three step counts (N, 2N, 4N).
-fn observed_order(p: &EquilibriumProblem, n: usize, pick: fn(&tetherplan::numerics::tether::Equilibrium) -> f64) -> f64 {
+fn observed_order(
+    p: &EquilibriumProblem,
+    n: usize,
+    pick: fn(&tetherplan::numerics::tether::Equilibrium) -> f64,
+) -> f64 {
     let a = pick(&p.solve(&config(n)).unwrap());
     let b = pick(&p.solve(&config(2 * n)).unwrap());
     let c = pick(&p.solve(&config(4 * n)).unwrap());
@@ -164,7 +184,9 @@ fn tether_drag_converges_at_fourth_order_in_the_step() {
         let oz = observed_order(&p, n, |e| e.altitude_m);
         let ox = observed_order(&p, n, |e| e.downwind_m);
         let ot = observed_order(&p, n, |e| e.winch_tension_n);
-        eprintln!("observed order at N = {n}: altitude {oz:.3}, downwind {ox:.3}, winch tension {ot:.3}");
+        eprintln!(
+            "observed order at N = {n}: altitude {oz:.3}, downwind {ox:.3}, winch tension {ot:.3}"
+        );
         for (what, o) in [("altitude", oz), ("downwind", ox), ("winch tension", ot)] {
             assert!((3.6..=4.4).contains(&o), "{what} order {o} at N = {n}");
         }
@@ -222,8 +244,16 @@ fn tether_drag_agrees_with_an_independent_polar_integrator() {
             ((e.downwind_m - x) / x).abs(),
             ((e.winch_tension_n - t0) / t0).abs()
         );
-        assert!(((e.altitude_m - z) / z).abs() < 1e-7, "{u}: {} vs {z}", e.altitude_m);
-        assert!(((e.downwind_m - x) / x).abs() < 1e-7, "{u}: {} vs {x}", e.downwind_m);
+        assert!(
+            ((e.altitude_m - z) / z).abs() < 1e-7,
+            "{u}: {} vs {z}",
+            e.altitude_m
+        );
+        assert!(
+            ((e.downwind_m - x) / x).abs() < 1e-7,
+            "{u}: {} vs {x}",
+            e.downwind_m
+        );
         assert!(((e.winch_tension_n - t0) / t0).abs() < 1e-7);
     }
 }
@@ -240,8 +270,14 @@ fn small_wind_matches_the_linear_string_blowdown() {
         let want = fd / w * (f / (f - w * l)).ln();
         // the difference is O((F_D/F)²) relative
         let rel = ((e.downwind_m - want) / want).abs();
-        eprintln!("small wind U = {u}: F_D = {fd:.4} N, rel. diff from the string's blow-down {rel:.1e}");
-        assert!(rel < 10.0 * (fd / (f - w * l)).powi(2) + 1e-9, "{u}: {} vs {want} ({rel:e})", e.downwind_m);
+        eprintln!(
+            "small wind U = {u}: F_D = {fd:.4} N, rel. diff from the string's blow-down {rel:.1e}"
+        );
+        assert!(
+            rel < 10.0 * (fd / (f - w * l)).powi(2) + 1e-9,
+            "{u}: {} vs {want} ({rel:e})",
+            e.downwind_m
+        );
         assert!(rel < 1e-4);
     }
 }
@@ -266,7 +302,11 @@ fn too_little_lift_rests_the_tether_on_the_ground() {
     let w = 0.06 * G;
     let (x, z) = catenary_top(h, v, w, v / w);
     assert!(e.slack);
-    assert!(((e.altitude_m - z) / z).abs() < 1e-6, "{} vs {z}", e.altitude_m);
+    assert!(
+        ((e.altitude_m - z) / z).abs() < 1e-6,
+        "{} vs {z}",
+        e.altitude_m
+    );
     let ground = 8000.0 - v / w;
     assert!(((e.grounded_length_m - ground) / ground).abs() < 1e-6);
     assert!(((e.downwind_m - (x + ground)) / (x + ground)).abs() < 1e-6);
@@ -278,8 +318,11 @@ fn strong_shear_and_tabulated_winds_converge() {
     for wind in [
         WindProfile::log_law(12.0, 10.0, 0.1, "w").unwrap(),
         WindProfile::Flow(
-            SteadyFlow::tabulated(&[(0.0, 2.0), (300.0, 15.0), (900.0, 5.0), (2000.0, 25.0)], "w")
-                .unwrap(),
+            SteadyFlow::tabulated(
+                &[(0.0, 2.0), (300.0, 15.0), (900.0, 5.0), (2000.0, 25.0)],
+                "w",
+            )
+            .unwrap(),
         ),
     ] {
         let mut p = problem(0.0, 1.2, Some(5e5));

@@ -621,11 +621,7 @@ fn ramped_deployment_goes_unstable_past_the_critical_length_only() {
     // The tip passes 100× its pre-t* peak, or the run stops first because
     // a deflection near the roller (where the onset is) passed the
     // magnitude cap of MAGNITUDE_CAP_LENGTHS × the length.
-    let blow_up_time_s = match r
-        .samples
-        .iter()
-        .find(|s| s.tip_envelope_m > 100.0 * before)
-    {
+    let blow_up_time_s = match r.samples.iter().find(|s| s.tip_envelope_m > 100.0 * before) {
         Some(s) => s.time_s,
         None => match r.outcome {
             RunOutcome::Diverged { time_s } if r.stopped_at_cap => time_s,

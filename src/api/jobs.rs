@@ -18,9 +18,9 @@ use crate::api::AppState;
 use crate::api::auth::Caller;
 use crate::api::error::{ApiError, JsonBody};
 use crate::contract::dto::ErrorBody;
-use crate::jobs::{SubmitError, Submitter};
 use crate::jobs::kinds::JobSubmission;
 use crate::jobs::store::{InsertError, JobRecord, JobStatus};
+use crate::jobs::{SubmitError, Submitter};
 
 /// A job: status, progress, and its answer or error.
 #[derive(Debug, Serialize, ToSchema)]

@@ -144,7 +144,10 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
         .route("/api", any(api_not_found))
         .route("/api/{*rest}", any(api_not_found))
         .method_not_allowed_fallback(method_not_allowed)
-        .layer(axum::middleware::from_fn_with_state(tokens, auth::require_token))
+        .layer(axum::middleware::from_fn_with_state(
+            tokens,
+            auth::require_token,
+        ))
         .with_state(state)
         .merge(SwaggerUi::new("/docs").url("/openapi.json", openapi::openapi()));
     let routes = match static_dir {

@@ -175,7 +175,8 @@ pub fn check_sync_chart(req: &ChartRequest, limits: &Limits) -> Result<(), ApiEr
             "rates_m_s.count",
             format!(
                 "the chart has {points} points × {} elements = {work}; synchronous charts have at most {}",
-                req.system.model.mesh_elements(), limits.max_sync_chart_work
+                req.system.model.mesh_elements(),
+                limits.max_sync_chart_work
             ),
         ));
     }
@@ -306,7 +307,9 @@ fn limit_ge_elements(n: usize, max: usize, why: &str) -> Result<(), ApiError> {
     if n > max {
         return Err(ApiError::too_large(
             "model.elements",
-            format!("{why} with {n} elements takes too long to answer synchronously (at most {max}; submit a job)"),
+            format!(
+                "{why} with {n} elements takes too long to answer synchronously (at most {max}; submit a job)"
+            ),
         ));
     }
     Ok(())

@@ -143,7 +143,11 @@ pub fn refine(doc: utoipa::openapi::OpenApi) -> utoipa::openapi::OpenApi {
 /// each refusing unknown fields) becomes one object with both parts'
 /// properties: as `allOf` the parts would forbid each other's keys.
 fn merge_all_of(v: &mut Value) {
-    let Some(schemas) = v.pointer("/components/schemas").and_then(Value::as_object).cloned() else {
+    let Some(schemas) = v
+        .pointer("/components/schemas")
+        .and_then(Value::as_object)
+        .cloned()
+    else {
         return;
     };
     for (name, schema) in &schemas {

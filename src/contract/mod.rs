@@ -9,10 +9,10 @@ pub mod envelope;
 pub mod equilibrium;
 pub mod ge;
 pub mod ge_charts;
-pub mod ranges;
 pub mod ge_critical;
 pub mod ge_numerics;
 pub mod plan;
+pub mod ranges;
 pub mod run;
 pub mod simulate;
 pub mod tension;
@@ -37,15 +37,12 @@ pub fn parse<T: dto::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
         .into_iter()
         .partition(|(k, _)| dto::SYSTEM_KEYS.contains(&k.as_str()));
     let system = parse_value::<dto::SystemInput>(&serde_json::Value::Object(system_part))?;
-    let params = parse_value::<T::Params>(&serde_json::Value::Object(params_part))
-        .map_err(|e| match e {
+    let params =
+        parse_value::<T::Params>(&serde_json::Value::Object(params_part)).map_err(|e| match e {
             RequestError::Invalid(InvalidInput { field, reason })
                 if !field.contains('.') && reason.starts_with("unknown field") =>
             {
-                RequestError::Invalid(InvalidInput::new(
-                    field,
-                    with_system_keys(&reason),
-                ))
+                RequestError::Invalid(InvalidInput::new(field, with_system_keys(&reason)))
             }
             other => other,
         })?;
@@ -108,8 +105,9 @@ pub fn parse_value<T: serde::de::DeserializeOwned>(
             // of a plain struct (not inside a tagged enum).
             Some(name) if path == name || path.ends_with(&format!(".{name}")) => path,
             // inside a tagged enum the path stops at the enum: find the key below it
-            Some(name) if unknown => find_key(value, &path, name)
-                .unwrap_or_else(|| format!("{prefix}{name}")),
+            Some(name) if unknown => {
+                find_key(value, &path, name).unwrap_or_else(|| format!("{prefix}{name}"))
+            }
             Some(name) => format!("{prefix}{name}"),
             None if prefix.is_empty() => "body".to_string(),
             None => path,
@@ -158,7 +156,11 @@ fn find_key(value: &serde_json::Value, path: &str, key: &str) -> Option<String> 
             _ => None,
         }
     }
-    let at = if path == "." { String::new() } else { path.to_string() };
+    let at = if path == "." {
+        String::new()
+    } else {
+        path.to_string()
+    };
     search(node, at, key)
 }
 

@@ -524,24 +524,32 @@ pub fn safe_rate(req: &SafeRateRequest) -> Result<SafeRateResponse, RequestError
                 estimate.elements,
             ),
             (chart::Discretisation::Converged { .. }, ConvergedSafeRate::NoSafeRate { reason }) => {
-                (None, None, None, Some(reason), converged::graded_operators(0).dim())
+                (
+                    None,
+                    None,
+                    None,
+                    Some(reason),
+                    converged::graded_operators(0).dim(),
+                )
             }
-            (chart::Discretisation::Elements(n), conv) => match critical::safe_rate(&model, target)? {
-                SafeRate::Rate {
-                    rate_m_s,
-                    rate_nondim,
-                } => {
-                    let error = match conv {
-                        ConvergedSafeRate::Rate { estimate, .. } => {
-                            converged::mesh_error_estimate(rate_m_s, &estimate)
-                        }
-                        // the mesh finds a rate where the continuum has none
-                        ConvergedSafeRate::NoSafeRate { .. } => rate_m_s,
-                    };
-                    (Some(rate_m_s), Some(rate_nondim), Some(error), None, n)
+            (chart::Discretisation::Elements(n), conv) => {
+                match critical::safe_rate(&model, target)? {
+                    SafeRate::Rate {
+                        rate_m_s,
+                        rate_nondim,
+                    } => {
+                        let error = match conv {
+                            ConvergedSafeRate::Rate { estimate, .. } => {
+                                converged::mesh_error_estimate(rate_m_s, &estimate)
+                            }
+                            // the mesh finds a rate where the continuum has none
+                            ConvergedSafeRate::NoSafeRate { .. } => rate_m_s,
+                        };
+                        (Some(rate_m_s), Some(rate_nondim), Some(error), None, n)
+                    }
+                    SafeRate::NoSafeRate { reason } => (None, None, None, Some(reason), n),
                 }
-                SafeRate::NoSafeRate { reason } => (None, None, None, Some(reason), n),
-            },
+            }
         };
     Ok(SafeRateResponse {
         max_rate_m_s,

@@ -16,8 +16,7 @@ use crate::numerics::params::{
 use crate::numerics::reduced::ReducedModel;
 use crate::numerics::string::transient::{
     self, EigenTracking, InitialState, MAGNITUDE_CAP_LENGTHS, MAX_FREQUENCIES, Observer,
-    RunOutcome, TransientConfig,
-    TransientError, TransientRun,
+    RunOutcome, TransientConfig, TransientError, TransientRun,
 };
 
 /// Most numbers (frequencies × samples) one frequency response returns.

@@ -297,7 +297,8 @@ impl JobKind for AnySimulateRequest {
                 let tracks = r.params.eigenvalues.as_ref().map_or(0.0, |e| {
                     let solves = (r.params.duration_s / e.interval_s).ceil() + 1.0;
                     solves
-                        * (est::PER_EIGEN_TRACK as f64 + e.count as f64 * est::PER_EIGENVALUE as f64)
+                        * (est::PER_EIGEN_TRACK as f64
+                            + e.count as f64 * est::PER_EIGENVALUE as f64)
                 });
                 E::bytes(
                     "samples",
@@ -621,10 +622,7 @@ impl JobItem {
             )
             .into())
         })?;
-        est::check(
-            &item.estimate().prefixed(&request_field),
-            max_result_bytes,
-        )?;
+        est::check(&item.estimate().prefixed(&request_field), max_result_bytes)?;
         item.validate_kind()
             .map_err(|e| prefixed(e, &request_field))?;
         Ok(item)
@@ -707,7 +705,9 @@ fn item_result_schema() -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::sch
     for name in ITEM_RESULT_SCHEMAS {
         one_of = one_of.item(Ref::from_schema_name(*name));
     }
-    one_of.description(Some("The answer, as the synchronous route gives it; absent on error."))
+    one_of.description(Some(
+        "The answer, as the synchronous route gives it; absent on error.",
+    ))
 }
 
 /// The answer of a batch job, in submission order.

@@ -133,7 +133,10 @@ impl JobQueue {
         if let (Some(key), Some(first)) = (
             who.idempotency_key.as_deref(),
             self.store
-                .find_by_key(who.owner.as_deref(), who.idempotency_key.as_deref().unwrap_or(""))
+                .find_by_key(
+                    who.owner.as_deref(),
+                    who.idempotency_key.as_deref().unwrap_or(""),
+                )
                 .map_err(InsertError::Store)?,
         ) {
             if first.request_hash != request_hash {
@@ -194,7 +197,9 @@ impl JobQueue {
             owner,
             &serde_json::to_string(&body).expect("error bodies serialise"),
         )?;
-        if record.as_ref().is_some_and(|r| r.status == JobStatus::Cancelled)
+        if record
+            .as_ref()
+            .is_some_and(|r| r.status == JobStatus::Cancelled)
             && let Some(job) = self
                 .running
                 .lock()
@@ -427,16 +432,18 @@ pub fn try_execute_next(queue: &JobQueue) -> Result<Option<Executed>, StoreError
         }
     };
     let status = match outcome {
-        Ok(Ok(result)) if result.len() as u64 > limits.max_job_result_bytes => fail(ErrorBody::new(
-            "result_too_large",
-            None,
-            format!(
-                "the answer has {} bytes, more than the limit of {} bytes (TETHERPLAN_JOB_MAX_RESULT_BYTES); \
+        Ok(Ok(result)) if result.len() as u64 > limits.max_job_result_bytes => {
+            fail(ErrorBody::new(
+                "result_too_large",
+                None,
+                format!(
+                    "the answer has {} bytes, more than the limit of {} bytes (TETHERPLAN_JOB_MAX_RESULT_BYTES); \
                  ask for fewer points",
-                result.len(),
-                limits.max_job_result_bytes
-            ),
-        ))?,
+                    result.len(),
+                    limits.max_job_result_bytes
+                ),
+            ))?
+        }
         Ok(Ok(result)) => {
             if queue.store.finish_done(lease, &result)? {
                 JobStatus::Done

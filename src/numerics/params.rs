@@ -232,8 +232,10 @@ impl AerostatSystem {
             .and_then(|v| ranges::MASS_PER_LENGTH_KG_M.check("cable.mass_per_length_kg_m", v))?,
             net_buoyancy_n: require_positive("aerostat.net_buoyancy_n", net_buoyancy_n)
                 .and_then(|v| ranges::NET_BUOYANCY_N.check("aerostat.net_buoyancy_n", v))?,
-            aerostat_mass_kg: ranges::AEROSTAT_MASS_KG.check("aerostat.mass_kg", aerostat_mass_kg)?,
-            initial_length_m: ranges::INITIAL_LENGTH_M.check("initial_length_m", initial_length_m)?,
+            aerostat_mass_kg: ranges::AEROSTAT_MASS_KG
+                .check("aerostat.mass_kg", aerostat_mass_kg)?,
+            initial_length_m: ranges::INITIAL_LENGTH_M
+                .check("initial_length_m", initial_length_m)?,
             gravity_m_s2: ranges::GRAVITY_M_S2.check("gravity_m_s2", gravity_m_s2)?,
         })
     }

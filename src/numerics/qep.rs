@@ -242,7 +242,11 @@ mod tests {
                 let found = spectrum.eigenvalues.iter().any(|e| {
                     (e.re / s - re).abs() <= 1e-12 * 4.0 && (e.im / s - im).abs() <= 1e-12 * 4.0
                 });
-                assert!(found, "s = {s:e}: {re} + {im}i not in {:?}", spectrum.eigenvalues);
+                assert!(
+                    found,
+                    "s = {s:e}: {re} + {im}i not in {:?}",
+                    spectrum.eigenvalues
+                );
             }
         }
     }

@@ -185,7 +185,8 @@ pub fn envelope(
     let Some(env) = problem.solve(&config, parallelism, &report, &cancelled)? else {
         return Err(RequestError::Cancelled);
     };
-    let name = |l: Option<crate::numerics::tether::envelope::Limit>| l.map(|l| l.name().to_string());
+    let name =
+        |l: Option<crate::numerics::tether::envelope::Limit>| l.map(|l| l.name().to_string());
     let points: Vec<EnvelopePointOutput> = env
         .points
         .iter()

@@ -6,13 +6,13 @@
 pub mod dto;
 
 use crate::contract::RequestError;
+use crate::numerics::aero::SteadyFlow;
 use crate::numerics::params::{InvalidInput, require_finite};
 use crate::numerics::tether::envelope::{Limits, judge};
-use crate::numerics::tether::presets::{BodyPreset, CablePreset, CYLINDER_NORMAL_DRAG};
+use crate::numerics::tether::presets::{BodyPreset, CYLINDER_NORMAL_DRAG, CablePreset};
 use crate::numerics::tether::{
     Body, Cable, Equilibrium, EquilibriumConfig, EquilibriumProblem, WindProfile,
 };
-use crate::numerics::aero::SteadyFlow;
 use dto::*;
 
 /// `value` finite and within `[min, max]`; `exclusive_min` excludes `min`.
@@ -24,7 +24,11 @@ pub(crate) fn require_range(
     max: f64,
 ) -> Result<f64, InvalidInput> {
     require_finite(field, value)?;
-    let low_ok = if exclusive_min { value > min } else { value >= min };
+    let low_ok = if exclusive_min {
+        value > min
+    } else {
+        value >= min
+    };
     if !low_ok || value > max {
         let low = if exclusive_min { "above" } else { "at least" };
         return Err(InvalidInput::new(
@@ -139,9 +143,8 @@ impl TetherAerostatInput {
             }
         };
         let need = |v: Option<f64>, p: Option<f64>, name: &str| {
-            v.or(p).ok_or_else(|| {
-                InvalidInput::new(f(name), "is required without a preset")
-            })
+            v.or(p)
+                .ok_or_else(|| InvalidInput::new(f(name), "is required without a preset"))
         };
         let cd = need(
             self.drag_coefficient_nondim,
@@ -166,13 +169,7 @@ impl TetherAerostatInput {
                 1e8,
             )?,
             drag_coefficient: require_range(&f("drag_coefficient_nondim"), cd, 0.0, false, 10.0)?,
-            lift_coefficient: require_range(
-                &f("lift_coefficient_nondim"),
-                cl,
-                -10.0,
-                false,
-                10.0,
-            )?,
+            lift_coefficient: require_range(&f("lift_coefficient_nondim"), cl, -10.0, false, 10.0)?,
             reference_area_m2: require_range(&f("reference_area_m2"), area, 0.0, true, 1e5)?,
         })
     }
@@ -363,7 +360,9 @@ pub(crate) fn explain(eq: &Equilibrium, limit: Option<&str>) -> String {
         s.push_str(&format!(" Outside the operating limits: {limit}."));
     }
     if !eq.converged {
-        s.push_str(" The altitude iteration did not meet its tolerance: treat the answer with care.");
+        s.push_str(
+            " The altitude iteration did not meet its tolerance: treat the answer with care.",
+        );
     }
     s
 }

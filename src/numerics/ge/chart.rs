@@ -11,8 +11,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use super::critical::{
-    CriticalConfig, CriticalProblem, GeOnset, StartState, TipPerturbation,
-    critical_time_observed,
+    CriticalConfig, CriticalProblem, GeOnset, StartState, TipPerturbation, critical_time_observed,
 };
 use super::extensible::ExtensibleString;
 use super::{GeModel, Section, TipBody};

@@ -334,7 +334,11 @@ pub(crate) fn looks_unstable(model: &StringModel, k: Kinematics) -> bool {
 
 /// Shortening profiles that stop near zero length would make `l → 0`;
 /// keep the search away from it.
-pub(crate) fn clamp_to_positive_length(model: &StringModel, profile: &Profile, horizon_s: f64) -> f64 {
+pub(crate) fn clamp_to_positive_length(
+    model: &StringModel,
+    profile: &Profile,
+    horizon_s: f64,
+) -> f64 {
     let min_length = 1e-3 * model.system.initial_length_m;
     if profile.kinematics(horizon_s).length_m >= min_length {
         return horizon_s;
@@ -392,7 +396,13 @@ fn general_profile(
     profile: &Profile,
     cancel: &dyn Fn() -> bool,
 ) -> Result<CriticalTime, QepError> {
-    let check = || if cancel() { Err(QepError::Cancelled) } else { Ok(()) };
+    let check = || {
+        if cancel() {
+            Err(QepError::Cancelled)
+        } else {
+            Ok(())
+        }
+    };
     let horizon = clamp_to_positive_length(model, profile, search_horizon_s(model, profile));
     // A profile that starts retrieving (e.g. decelerating from rest) is
     // shortening from its first instant: unstable at once.

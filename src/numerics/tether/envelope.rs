@@ -250,7 +250,11 @@ impl EnvelopeProblem {
             Ok(out)
         };
         let rows: Vec<Vec<EnvelopePoint>> = match parallelism {
-            Parallelism::Serial => self.wind_speeds_m_s.iter().map(row).collect::<Result<_, _>>()?,
+            Parallelism::Serial => self
+                .wind_speeds_m_s
+                .iter()
+                .map(row)
+                .collect::<Result<_, _>>()?,
             Parallelism::Rayon => self
                 .wind_speeds_m_s
                 .par_iter()

@@ -29,8 +29,8 @@
 //! inside the RK4 step by regula falsi (Illinois) on sub-step length, and
 //! the answer is reported with `slack = true`: an outcome, not an error.
 
-use crate::numerics::params::{InvalidInput, require_finite, require_positive};
 use crate::numerics::aero::SteadyFlow;
+use crate::numerics::params::{InvalidInput, require_finite, require_positive};
 use crate::numerics::tether::wind::WindProfile;
 
 /// The tether.
@@ -168,9 +168,16 @@ struct Rhs<'a> {
 /// The profile prepared for many evaluations.
 enum FastWind<'a> {
     Uniform(f64),
-    Power { a: f64, p: f64 },
+    Power {
+        a: f64,
+        p: f64,
+    },
     /// `k (ln z − ln z0)` above `z0`.
-    Log { k: f64, z0: f64, ln_z0: f64 },
+    Log {
+        k: f64,
+        z0: f64,
+        ln_z0: f64,
+    },
     Other(&'a WindProfile),
 }
 
@@ -434,7 +441,14 @@ impl EquilibriumProblem {
         // start of the fine one, which then needs two or three passes.
         let coarse_steps = (config.steps / 8).max(8);
         let (start, slope, coarse_iterations) = if coarse_steps < config.steps {
-            let c = self.shoot(l, None, coarse_steps, false, 1e-7 * l.max(1.0), config.max_iterations);
+            let c = self.shoot(
+                l,
+                None,
+                coarse_steps,
+                false,
+                1e-7 * l.max(1.0),
+                config.max_iterations,
+            );
             (c.z_top, c.slope, c.iterations)
         } else {
             (l, None, 0)
@@ -445,7 +459,10 @@ impl EquilibriumProblem {
             config.steps,
             config.keep_shape,
             tol,
-            config.max_iterations.saturating_sub(coarse_iterations).max(2),
+            config
+                .max_iterations
+                .saturating_sub(coarse_iterations)
+                .max(2),
         );
         let iterations = coarse_iterations + fine.iterations;
         Ok(self.assemble(fine.pass, fine.z_top, iterations, fine.converged))
@@ -609,10 +626,13 @@ impl EquilibriumProblem {
             grounded_length_m: grounded,
             slack: touched,
             stretched_length_m: stretched,
-            safety_factor: self
-                .cable
-                .breaking_strength_n
-                .map(|b| if max_tension > 0.0 { b / max_tension } else { f64::INFINITY }),
+            safety_factor: self.cable.breaking_strength_n.map(|b| {
+                if max_tension > 0.0 {
+                    b / max_tension
+                } else {
+                    f64::INFINITY
+                }
+            }),
             shape,
             iterations,
             residual_m: ze.abs(),

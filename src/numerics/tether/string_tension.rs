@@ -84,7 +84,9 @@ mod tests {
             },
         );
         let rho_a = sys.mass_per_length_kg_m;
-        let want = sys.net_buoyancy_n - sys.aerostat_mass_kg * 2.0 - rho_a * (sys.gravity_m_s2 + 2.0) * 100.0;
+        let want = sys.net_buoyancy_n
+            - sys.aerostat_mass_kg * 2.0
+            - rho_a * (sys.gravity_m_s2 + 2.0) * 100.0;
         assert!((a.winch_n - want).abs() < 1e-9);
     }
 }

@@ -45,10 +45,7 @@ impl WindProfile {
         roughness_length_m: f64,
         field: &str,
     ) -> Result<Self, InvalidInput> {
-        require_finite(
-            &format!("{field}.reference_speed_m_s"),
-            reference_speed_m_s,
-        )?;
+        require_finite(&format!("{field}.reference_speed_m_s"), reference_speed_m_s)?;
         require_positive(&format!("{field}.reference_height_m"), reference_height_m)?;
         require_positive(&format!("{field}.roughness_length_m"), roughness_length_m)?;
         if roughness_length_m >= reference_height_m {
