@@ -380,36 +380,100 @@
 
   // One x axis for curves on different rate grids: the union of the rates,
   // gaps where a curve has no point (drawn across).
-  function mergedSpec(stringChart, geChart, quantity) {
+  // A GE series' name: E* (and F0, buoyancy, A0 when the chart varies them).
+  function geLabel(s) {
+    let label = `GE, E* = ${s.stiffness_ratio.toExponential(0)}`;
+    if (s.perturbation_force_n) label += `, F0 = ${s.perturbation_force_n} N`;
+    if (s.wind_amplitude_nondim != null) label += `, A0 = ${s.wind_amplitude_nondim}`;
+    return label;
+  }
+
+  // GE curves that lie on top of each other (E* = 1e3 and 1e5 often agree to
+  // a fraction of a percent): each drawn wider than the next and with its own
+  // dash and marker, so the one underneath shows as a halo; the note says
+  // which curves coincide and by how much.
+  const GE_DASHES = [undefined, [10, 4], [2, 3], [12, 3, 2, 3]];
+  const GE_MARKERS = [9, 6, 4, 3];
+
+  function coincidences(geChart) {
+    const out = [];
+    const ss = geChart.series;
+    for (let a = 0; a < ss.length; a++) {
+      for (let b = a + 1; b < ss.length; b++) {
+        let worst = 0;
+        let common = 0;
+        const pb = new Map(ss[b].points.map((p) => [p.rate_m_s, p.max_elevation_m]));
+        for (const p of ss[a].points) {
+          const hb = pb.get(p.rate_m_s);
+          if (p.max_elevation_m == null || hb == null) continue;
+          common++;
+          worst = Math.max(worst, Math.abs(p.max_elevation_m - hb) / Math.max(Math.abs(hb), 1e-9));
+        }
+        if (common > 0 && worst < 0.01) out.push({ a: geLabel(ss[a]), b: geLabel(ss[b]), worst });
+      }
+    }
+    return out;
+  }
+
+  function mergedSpec(stringChart, geChart, quantity, log = false) {
     const pick = (p) => (quantity === "time" ? p.critical_time_s : p.max_elevation_m);
     const curves = [];
     const F = geChart.series[0]?.net_buoyancy_n;
     const str = stringChart?.series.find((s) => s.net_buoyancy_n === F);
-    if (str) curves.push({ label: `string, ${F} N`, points: str.points.map((p) => [p.rate_m_s, pick(p)]), dash: [6, 4] });
-    for (const s of geChart.series) {
-      curves.push({ label: `GE, E* = ${s.stiffness_ratio.toExponential(0)}`, points: s.points.map((p) => [p.rate_m_s, pick(p)]) });
-    }
+    const n = geChart.series.length;
+    geChart.series.forEach((s, k) => {
+      curves.push({
+        label: geLabel(s),
+        points: s.points.map((p) => [p.rate_m_s, pick(p)]),
+        // The first is the widest (drawn first, underneath), the last the thinnest.
+        width: 1.5 + 1.5 * (n - 1 - k),
+        dash: GE_DASHES[k % GE_DASHES.length],
+        marker: GE_MARKERS[k % GE_MARKERS.length],
+        color: COLORS[(k + 1) % COLORS.length],
+      });
+    });
+    // The string FE model last, dashed, on top.
+    if (str) curves.push({ label: `string FE model, ${F} N`, points: str.points.map((p) => [p.rate_m_s, pick(p)]), dash: [6, 4], width: 2, color: COLORS[0] });
     const x = [...new Set(curves.flatMap((c) => c.points.map(([v]) => v)))].sort((a, b) => a - b);
     const data = [x];
     const unit = quantity === "time" ? "s" : "m";
     const series = [{ label: "v (m/s)", value: legendValue(2) }];
-    curves.forEach((c, i) => {
+    for (const c of curves) {
       const map = new Map(c.points);
-      data.push(x.map((v) => (map.has(v) && map.get(v) != null ? map.get(v) : null)));
-      const color = COLORS[i % COLORS.length];
-      series.push({ label: `${c.label} (${unit})`, color, stroke: color, width: 2, dash: c.dash, spanGaps: true, value: legendValue(1) });
-    });
-    return { data, series, log: false };
+      // On a log axis, t* = 0 (unstable at once) has no place: leave a gap.
+      data.push(x.map((v) => {
+        const y = map.has(v) ? map.get(v) : null;
+        return y == null || (log && !(y > 0)) ? null : y;
+      }));
+      const points = c.marker ? { show: true, size: c.marker, width: 1.5, stroke: c.color, fill: "#fff" } : { show: false };
+      series.push({ label: `${c.label} (${unit})`, color: c.color, stroke: c.color, width: c.width, dash: c.dash, points, spanGaps: true, value: legendValue(1) });
+    }
+    return { data, series, log };
   }
 
   function renderGe(geChart, stringChart) {
     state.ge = geChart;
-    for (const id of ["#ge-time-figure", "#ge-elevation-figure"]) $(id).hidden = false;
+    state.geString = stringChart;
+    for (const id of ["#ge-time-figure", "#ge-elevation-figure", "#ge-actions"]) $(id).hidden = false;
     state.plots.geTime?.destroy();
     state.plots.geElevation?.destroy();
-    state.plots.geTime = makePlot($("#plot-ge-time"), mergedSpec(stringChart, geChart, "time"), "t* (s)");
+    state.plots.geTime = makePlot($("#plot-ge-time"), mergedSpec(stringChart, geChart, "time", $("#ge-log-time").checked), "t* (s)");
     state.plots.geElevation = makePlot($("#plot-ge-elevation"), mergedSpec(stringChart, geChart, "elevation"), "h* (m)");
+    const same = coincidences(geChart);
+    state.geCoincide = same;
+    const note = $("#ge-note");
+    note.textContent = same.length
+      ? same.map((c) => `${c.a} and ${c.b} coincide within ${(100 * c.worst).toFixed(2)} % at every rate`).join("; ") +
+        ": the first is drawn wider, underneath, with larger markers, so both stay visible."
+      : "";
+    note.hidden = !same.length;
+    $("#ge-csv").disabled = false;
+    $("#ge-png").disabled = false;
   }
+
+  $("#ge-log-time").addEventListener("change", () => {
+    if (state.ge) renderGe(state.ge, state.geString);
+  });
 
   // ---------- chart form ----------
 
@@ -471,6 +535,7 @@
           const points = geReq.rates_m_s.count * geReq.stiffness_ratios.length;
           geAfterString = true;
           setStatus("busy", `Submitting a GE job for ${points} points…`);
+          state.geRequest = geReq;
           const ge = await runChartJob(geReq, points).finally(() => {
             geAfterString = false;
           });
@@ -614,21 +679,26 @@
   }
 
   // Both plots on one white canvas, each with its caption and a drawn legend.
-  function chartPng() {
+  function chartPng(
+    blocks = [
+      [state.plots.time, `Critical time t* (s) against deployment rate v (m/s)${$("#log-time").checked ? ", log scale" : ""}`],
+      [state.plots.elevation, "Highest safe elevation h* (m) against deployment rate v (m/s)"],
+    ],
+    footer = `Inputs: ${inputLines(state.request).map((l) => l.replace("# input ", "").replace(",", " = ")).join("; ")}.`,
+  ) {
     const ratio = window.devicePixelRatio || 1;
     const pad = 12 * ratio;
     const line = 18 * ratio;
-    const blocks = [
-      [state.plots.time, `Critical time t* (s) against deployment rate v (m/s)${$("#log-time").checked ? ", log scale" : ""}`],
-      [state.plots.elevation, "Highest safe elevation h* (m) against deployment rate v (m/s)"],
-    ];
     const width = Math.max(...blocks.map(([u]) => u.ctx.canvas.width)) + 2 * pad;
     const legendRows = (u) => u.series.length - 1;
     const canvas = document.createElement("canvas");
     const ctx = canvas.getContext("2d");
+    ctx.font = `${11 * ratio}px sans-serif`;
+    const footerRows = footer ? wrap(ctx, footer, width - 2 * pad) : [];
     ctx.font = `bold ${13 * ratio}px sans-serif`;
     const captionRows = (c) => wrap(ctx, c, width - 2 * pad).length;
-    const height = blocks.reduce((h, [u, c]) => h + line * (captionRows(c) + 0.5) + u.ctx.canvas.height + legendRows(u) * line + pad, pad);
+    const height = blocks.reduce((h, [u, c]) => h + line * (captionRows(c) + 0.5) + u.ctx.canvas.height + legendRows(u) * line + pad, pad) +
+      footerRows.length * 15 * ratio + pad;
     canvas.width = width;
     canvas.height = height;
     ctx.fillStyle = "#fff";
@@ -662,12 +732,58 @@
       }
       y += pad;
     }
+    ctx.fillStyle = "#333";
+    ctx.font = `${11 * ratio}px sans-serif`;
+    ctx.textBaseline = "top";
+    for (const row of footerRows) {
+      ctx.fillText(row, pad, y);
+      y += 15 * ratio;
+    }
     return canvas;
   }
 
   $("#download-png").addEventListener("click", () => {
     if (!state.chart) return;
     chartPng().toBlob((blob) => download(blob, "deployment-chart.png"), "image/png");
+  });
+
+  // The GE chart: its request and the string chart's as inputs, one row per
+  // point of every GE series and of the string curve drawn beside them.
+  function geCsv() {
+    const ge = state.ge;
+    const lines = ["# tetherplan GE deployment chart beside the linear string", ...inputLines(state.geRequest).map((l) => l.replace("# input ", "# input ge.")),
+      ...inputLines(state.request).map((l) => l.replace("# input ", "# input string.")),
+      `# ge.elements,${ge.elements}`, `# ge.time_scale_s,${sig(ge.time_scale_s)}`, `# ge.wave_speed_m_s,${sig(ge.wave_speed_m_s)}`,
+      ...inputLines({ integrator: ge.integrator }).map((l) => l.replace("# input ", "# ge.")),
+      "model,stiffness_ratio,perturbation_force_n,net_buoyancy_n,wind_amplitude_nondim,rate_m_s,onset,critical_time_s,max_elevation_m,string_closed_form_elevation_m,extensible_closed_form_elevation_m,closed_form_applies"];
+    const cell = (v) => (v == null ? "" : sig(v));
+    for (const s of ge.series) {
+      for (const p of s.points) {
+        lines.push(["ge", s.stiffness_ratio, s.perturbation_force_n, s.net_buoyancy_n, s.wind_amplitude_nondim, p.rate_m_s, p.onset, p.critical_time_s,
+          p.max_elevation_m, p.string_closed_form_elevation_m, p.extensible_closed_form_elevation_m, p.closed_form_applies].map(cell).join(","));
+      }
+    }
+    const F = ge.series[0]?.net_buoyancy_n;
+    const str = state.geString?.series.find((s) => s.net_buoyancy_n === F);
+    for (const p of str?.points ?? []) {
+      lines.push(["string", "", "", F, "", p.rate_m_s, p.critical_time_s > 0 ? "during" : "immediate", p.critical_time_s, p.max_elevation_m, p.closed_form_elevation_m, "", ""].map(cell).join(","));
+    }
+    return lines.join("\n") + "\n";
+  }
+
+  $("#ge-csv").addEventListener("click", () => {
+    if (state.ge) download(new Blob([geCsv()], { type: "text/csv" }), "ge-deployment-chart.csv");
+  });
+
+  $("#ge-png").addEventListener("click", () => {
+    if (!state.ge) return;
+    const note = $("#ge-note").hidden ? "" : ` ${$("#ge-note").textContent}`;
+    const inputs = [...inputLines(state.geRequest).map((l) => l.replace("# input ", "GE ")), `string elements ${state.geString?.converged ? "converged" : state.geString?.elements}`]
+      .map((l) => l.replace(",", " = "));
+    chartPng([
+      [state.plots.geTime, `GE beam beside the string: critical time t* (s) against deployment rate v (m/s)${$("#ge-log-time").checked ? ", log scale" : ""}. Solid and dotted: the GE beam, one curve per E*; dashed: the linear-string FE model, not a closed form.${note}`],
+      [state.plots.geElevation, "GE beam beside the string: highest safe elevation h* (m) against deployment rate v (m/s)"],
+    ], `Inputs: ${inputs.join("; ")}.`).toBlob((blob) => download(blob, "ge-deployment-chart.png"), "image/png");
   });
 
   updateHint();

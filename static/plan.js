@@ -234,7 +234,7 @@
       ["Binding limit", r.binding_limit ?? null],
       ["Best constant rate", c ? `${fmt(c.rate_m_s, 2)} m/s, ${fmt(c.duration_s, 1)} s` : null],
       ["Time saved", c ? `${fmt(c.time_saved_s, 1)} s (${fmt(100 * c.time_saved_fraction_nondim, 0)} %)` : null],
-      ["SPEC §7 bound", r.bound ? `${fmt(r.bound.duration_s, 1)} s: ${r.bound.explanation}` : null],
+      ["Minimum-time bound", r.bound ? `${fmt(r.bound.duration_s, 1)} s: ${r.bound.explanation}` : null],
       ["Lift limit with reserve", `${fmt(r.limits.lift_limit_m, 1)} m`],
       ["Smallest stability margin", r.limits.min_stability_margin_m_s === null ? null : `${fmt(r.limits.min_stability_margin_m_s, 2)} m/s`],
       ["Peak tension", r.limits.peak_tension_n === null ? null : `${fmt(r.limits.peak_tension_n, 0)} N`],

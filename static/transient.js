@@ -421,18 +421,63 @@
     return { width, height: Math.round(Math.min(340, Math.max(240, width * aspect))) };
   }
 
-  // Vertical dashed lines, labelled: where ω₁ passes the wind frequency, and
-  // where the eigenvalue track first shows an unstable mode.
+  // A hatch pattern (device pixels) for the region past the onset of instability.
+  let hatch = null;
+  function hatchPattern(ctx, dpr) {
+    if (hatch && hatch.dpr === dpr) return hatch.pattern;
+    const size = Math.round(8 * dpr);
+    const tile = document.createElement("canvas");
+    tile.width = size;
+    tile.height = size;
+    const t = tile.getContext("2d");
+    t.fillStyle = "rgba(110,110,110,0.22)";
+    t.fillRect(0, 0, size, size);
+    t.strokeStyle = "rgba(60,60,60,0.35)";
+    t.lineWidth = dpr;
+    t.beginPath();
+    t.moveTo(0, size);
+    t.lineTo(size, 0);
+    t.moveTo(-size / 2, size / 2);
+    t.lineTo(size / 2, -size / 2);
+    t.moveTo(size / 2, size * 1.5);
+    t.lineTo(size * 1.5, size / 2);
+    t.stroke();
+    hatch = { dpr, pattern: ctx.createPattern(tile, "repeat") };
+    return hatch.pattern;
+  }
+
+  // Past the onset (the API's first_unstable_time_s) the linear model's
+  // growth is not a prediction: that part of each time plot is greyed and
+  // hatched over the curves, and labelled. Also vertical dashed lines,
+  // labelled: where ω₁ passes the wind frequency, and the onset itself.
   const resonanceMarker = {
     hooks: {
       draw: [
         (u) => {
           const marks = [];
           if (state.resonance) marks.push([state.resonance.time_s, "ω₁ = ω", "#777"]);
-          if (state.firstUnstable) marks.push([state.firstUnstable.time_s, "Re λ > 0", "#b00020"]);
+          if (state.firstUnstable) marks.push([state.firstUnstable.time_s, "onset", "#b00020"]);
           const dpr = devicePixelRatio;
           const { top, height, left: bl, width: bw } = u.bbox;
           const ctx = u.ctx;
+          if (state.firstUnstable) {
+            const x0 = Math.max(bl, Math.round(u.valToPos(state.firstUnstable.time_s, "x", true)));
+            if (x0 < bl + bw) {
+              ctx.save();
+              ctx.fillStyle = hatchPattern(ctx, dpr);
+              ctx.fillRect(x0, top, bl + bw - x0, height);
+              const label = "past onset: unstable";
+              ctx.font = `${11 * dpr}px sans-serif`;
+              ctx.textBaseline = "bottom";
+              const w = ctx.measureText(label).width;
+              const lx = Math.max(x0 + 4 * dpr, bl + bw - w - 6 * dpr);
+              ctx.fillStyle = "rgba(255,255,255,0.85)";
+              ctx.fillRect(lx - 3 * dpr, top + height - 18 * dpr, w + 6 * dpr, 16 * dpr);
+              ctx.fillStyle = "#b00020";
+              ctx.fillText(label, lx, top + height - 4 * dpr);
+              ctx.restore();
+            }
+          }
           for (const [time, label, colour] of marks) {
             const x = Math.round(u.valToPos(time, "x", true));
             if (x < bl || x > bl + bw) continue;
@@ -461,10 +506,12 @@
 
   function makePlot(el, series, data, xLabel, yLabel, extra = {}) {
     el.textContent = "";
+    // Legend values: blank until the cursor is on the plot (not a row of "–").
+    const blankIdle = series.map((s) => (s.value ? { ...s, value: (u, v, ...rest) => (v == null ? "" : s.value(u, v, ...rest)) } : s));
     return new uPlot(
       {
         ...plotSize(el),
-        series,
+        series: blankIdle,
         scales: { x: { time: false } },
         axes: [
           { ...axis, label: xLabel },
@@ -477,6 +524,23 @@
       data,
       el,
     );
+  }
+
+  // Why the run ended, in words (the API's stopped_reason).
+  function stopReason(res) {
+    const at = res.outcome_time_s != null ? ` at t = ${fmt(res.outcome_time_s, 4)} s` : "";
+    switch (res.stopped_reason) {
+      case "completed":
+        return `Stopped: the run completed its ${fmt(res.time_s[res.time_s.length - 1], 4)} s.`;
+      case "magnitude_cap":
+        return `Stopped${at}: magnitude cap, a deflection passed ${fmt(res.magnitude_cap_lengths_nondim)} × the cable length (${fmt(res.magnitude_cap_m)} m).`;
+      case "step_failed":
+        return `Stopped${at}: a time step failed (non-finite or singular).`;
+      case "length_collapsed":
+        return `Stopped${at}: the cable was shortened to almost zero length.`;
+      default:
+        return `Stopped${at}: ${String(res.stopped_reason).replace(/_/g, " ")}.`;
+    }
   }
 
   function renderRun(res, req, via, keepScale = false) {
@@ -496,8 +560,17 @@
     const env = peakEnvelope(res.tip_envelope_m, Math.max(1, Math.round(spacingS / dtSample)));
     state.envelope = { peak_spacing_s: spacingS, values: env };
     state.resonance = omegaWind > 0 ? resonance(res.eigenvalues, omegaWind) : null;
+    // The onset of instability as the API states it (t* of the profile, or the
+    // first unstable eigenvalue sample); the samples after it are growth past onset.
     const unstable = res.eigenvalues.find((e) => !e.stable);
-    state.firstUnstable = unstable ? { time_s: unstable.time_s, length_m: unstable.length_m } : null;
+    state.firstUnstable = res.first_unstable_time_s != null
+      ? { time_s: res.first_unstable_time_s, length_m: res.first_unstable_length_m, max_real_1_s: unstable?.max_real_1_s ?? null }
+      : null;
+    // What the plots shade: from the onset to the end of the run.
+    state.shade = state.firstUnstable && t.length && state.firstUnstable.time_s < t[t.length - 1]
+      ? { from_s: state.firstUnstable.time_s, to_s: t[t.length - 1] }
+      : null;
+    state.stoppedReason = res.stopped_reason;
 
     // A run that diverged spans hundreds of decades: switch to the log scale.
     if (!keepScale) $("#tr-log").checked = res.outcome === "diverged";
@@ -573,10 +646,20 @@
     } else {
       parts.push(` Peak |y| ${fmt(peakAt(-Infinity, Infinity))} m.`);
     }
-    if (unstable) {
-      parts.push(` The linearisation is first unstable at t ≈ ${fmt(unstable.time_s)} s (L ≈ ${fmt(unstable.length_m)} m, max Re λ = ${fmt(unstable.max_real_1_s)} 1/s).`);
+    const onset = state.firstUnstable;
+    if (onset) {
+      parts.push(
+        ` Unstable from t* ≈ ${fmt(onset.time_s)} s (L ≈ ${fmt(onset.length_m)} m${onset.max_real_1_s != null ? `, max Re λ = ${fmt(onset.max_real_1_s)} 1/s at the first unstable sample` : ""}):` +
+          " the greyed, hatched part of the plots is growth past onset, not a prediction of the linear model.",
+      );
     }
+    const stop = document.createElement("span");
+    stop.className = "tr-stop";
+    stop.dataset.stoppedReason = res.stopped_reason;
+    stop.textContent = ` ${stopReason(res)}`;
+    parts.push(stop);
     out.replaceChildren(...parts);
+    out.dataset.stoppedReason = res.stopped_reason;
     out.hidden = false;
     $("#tr-csv").disabled = false;
     const noTrack = req.eigenvalues ? "" : ` (natural frequencies not tracked above ${EIGEN_MAX_ELEMENTS} elements)`;
@@ -920,19 +1003,33 @@
 
   const RUN_COLUMNS = ["time_s", "length_m", "rate_m_s", "tip_deflection_m", "tip_velocity_m_s", "tip_envelope_m", "energy_j", "vibration_energy_j", "tip_force_n"];
 
+  // Every input of the request as `# input <path>,<value>` lines.
+  function inputLines(obj, prefix = "", out = []) {
+    for (const [k, v] of Object.entries(obj ?? {})) {
+      const key = prefix ? `${prefix}.${k}` : k;
+      if (v && typeof v === "object" && !Array.isArray(v)) inputLines(v, key, out);
+      else out.push(`# input ${key},${Array.isArray(v) ? v.join(" ") : sig(v)}`);
+    }
+    return out;
+  }
+
+  // Six significant digits: what the model resolves, not 16-digit floats.
+  const sig = (v) => (typeof v === "number" && Number.isFinite(v) ? String(Number(v.toPrecision(6))) : v == null ? "" : String(v));
+
   $("#tr-csv").addEventListener("click", () => {
     const r = state.result;
     if (!r) return;
-    const lines = [RUN_COLUMNS.join(",")];
-    for (let i = 0; i < r.time_s.length; i++) lines.push(RUN_COLUMNS.map((c) => r[c][i]).join(","));
+    const lines = ["# tetherplan transient run", ...inputLines(state.request), `# elements,${r.elements}`, `# time_step_s,${sig(r.time_step_s)}`,
+      `# outcome,${r.outcome}`, `# stopped_reason,${r.stopped_reason}`, `# first_unstable_time_s,${sig(r.first_unstable_time_s) || "none"}`, RUN_COLUMNS.join(",")];
+    for (let i = 0; i < r.time_s.length; i++) lines.push(RUN_COLUMNS.map((c) => sig(r[c][i])).join(","));
     download(lines.join("\n") + "\n", "transient-run.csv");
   });
 
   $("#fr-csv").addEventListener("click", () => {
     const r = state.fr.result;
     if (!r) return;
-    const lines = ["angular_frequency_rad_s,time_s,envelope_m"];
-    r.frequencies_rad_s.forEach((w, i) => r.time_s.forEach((t, j) => lines.push(`${w},${t},${r.envelope_m[i][j]}`)));
+    const lines = ["# tetherplan frequency response", ...inputLines(state.fr.request), "angular_frequency_rad_s,time_s,envelope_m"];
+    r.frequencies_rad_s.forEach((w, i) => r.time_s.forEach((t, j) => lines.push(`${sig(w)},${sig(t)},${sig(r.envelope_m[i][j])}`)));
     download(lines.join("\n") + "\n", "frequency-response.csv");
   });
 

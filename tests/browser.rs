@@ -10,6 +10,10 @@
 //!   checks the resonance in the plotted envelope, runs a small frequency
 //!   response directly and a larger one as a job, checks API errors next to
 //!   their fields, the phone layout and the console.
+//! * `envelope_page.mjs` runs the operating-envelope panel's default, checks
+//!   the feasible region's outline, the region labels, CSV/PNG export with
+//!   the inputs, a job with progress, and screenshots the page at 1280×800
+//!   and 390×844.
 //! * `docs_page.mjs` runs every POST operation's "Try it out" in `/docs`
 //!   with the document's example (each must answer 2xx) under the CSP.
 //!
@@ -200,4 +204,9 @@ fn plan_page_in_headless_chromium() {
 #[test]
 fn bands_page_in_headless_chromium() {
     run_page_script("bands_page.mjs");
+}
+
+#[test]
+fn envelope_page_in_headless_chromium() {
+    run_page_script("envelope_page.mjs");
 }

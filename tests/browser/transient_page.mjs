@@ -143,9 +143,17 @@ try {
     const [download] = await Promise.all([page.waitForEvent("download"), page.click("#tr-csv")]);
     const csvPath = path.join(artifacts, "transient_page.csv");
     await download.saveAs(csvPath);
-    const csv = readFileSync(csvPath, "utf8").trim().split("\n");
+    const lines = readFileSync(csvPath, "utf8").trim().split("\n");
+    const csv = lines.filter((l) => !l.startsWith("#"));
     check(csv[0] === "time_s,length_m,rate_m_s,tip_deflection_m,tip_velocity_m_s,tip_envelope_m,energy_j,vibration_energy_j,tip_force_n", "CSV header");
     check(csv.length === 1001, `CSV has ${csv.length - 1} rows`);
+    check(["# input profile.rate_m_s,1", "# input aero.flow.amplitude_m_s,10", "# input duration_s,60", "# input cable.mass_per_length_kg_m,0.078"].every((l) => lines.includes(l)), "CSV records the inputs");
+    const significant = (t) => t.replace(/^[-+]/, "").replace(/e.*$/i, "").replace(".", "").replace(/^0+/, "").length;
+    const tooLong = csv.slice(1).flatMap((l) => l.split(",")).filter((t) => significant(t) > 6);
+    check(tooLong.length === 0, `CSV numbers have at most six significant digits (${tooLong.slice(0, 3).join(" ")})`);
+    check(!(await page.evaluate(() => window.tetherplanTransient.shade)), "a stable run shades nothing");
+    check(/Stopped: the run completed/.test(await page.textContent("#tr-outcome")), "stop reason stated: completed");
+    check(!/–/.test(await page.textContent("#tr-plot-tip .u-legend")), "legend blank until hovered (no “–”)");
   }
 
   // ---------- a small frequency response, direct ----------
@@ -257,6 +265,36 @@ try {
     // The run stops at its magnitude cap (1000 × the length, reached near the
     // roller where the onset is), so the tip need not grow large first.
     check(d.log, `log scale switched on for the diverged run (log₁₀ max |y| = ${Math.max(...d.ys).toFixed(1)})`);
+    // Past the onset the plots are greyed and hatched, from first_unstable_time_s on.
+    const sh = await page.evaluate(() => {
+      const s = window.tetherplanTransient;
+      const u = s.plots.tip;
+      const { left, top, width, height } = u.bbox;
+      const x0 = u.valToPos(s.result.first_unstable_time_s, "x", true);
+      // Mean brightness of a strip just before and just after the onset, above the curves' lower half.
+      const mean = (a, b) => {
+        const w = Math.max(1, Math.round(b - a));
+        const img = u.ctx.getImageData(Math.round(a), Math.round(top), w, Math.round(height / 2)).data;
+        let sum = 0;
+        for (let k = 0; k < img.length; k += 4) sum += (img[k] + img[k + 1] + img[k + 2]) / 3;
+        return sum / (img.length / 4);
+      };
+      const strip = Math.min(40 * devicePixelRatio, (left + width - x0) * 0.8, (x0 - left) * 0.8);
+      return {
+        shade: s.shade,
+        onset: s.result.first_unstable_time_s,
+        stopped: s.result.stopped_reason,
+        end: s.result.time_s.at(-1),
+        before: mean(x0 - strip - 2, x0 - 2),
+        after: mean(x0 + 2, x0 + 2 + strip),
+      };
+    });
+    check(sh.shade && sh.onset != null && sh.shade.from_s === sh.onset && sh.shade.to_s === sh.end, `shaded from first_unstable_time_s = ${sh.onset?.toFixed(2)} s to the end ${sh.end?.toFixed(2)} s`);
+    check(sh.after < sh.before - 15, `the region past onset is greyed (mean brightness ${sh.after.toFixed(0)} after, ${sh.before.toFixed(0)} before)`);
+    const outcomeText = await page.textContent("#tr-outcome");
+    check(/past onset|greyed/.test(outcomeText) && /Unstable from t\*/.test(outcomeText), "the outcome explains the greyed region");
+    check(sh.stopped === "magnitude_cap" && (await page.getAttribute("#tr-outcome", "data-stopped-reason")) === "magnitude_cap" && /magnitude cap/.test(outcomeText),
+      `stop reason stated: “${(await page.textContent("#tr-outcome .tr-stop")).trim()}”`);
     await page.locator("#transient-run").screenshot({ path: path.join(artifacts, "transient_page_diverged.png") });
   }
   await page.fill("#tr-duration", "60");
