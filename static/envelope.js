@@ -293,11 +293,11 @@
     let frontier = [];
     for (let i = 0; i < nw; i++) {
       for (let j = 0; j < nl; j++) {
+        // The grid's own edge counts as a boundary: names sit inside the map.
         let edge = false;
         for (let a = i - 1; a <= i + 1 && !edge; a++) {
           for (let b = j - 1; b <= j + 1; b++) {
-            if (a < 0 || b < 0 || a >= nw || b >= nl) continue;
-            if (id[a * nl + b] !== id[i * nl + j]) edge = true;
+            if (a < 0 || b < 0 || a >= nw || b >= nl || id[a * nl + b] !== id[i * nl + j]) edge = true;
           }
         }
         if (edge) {
@@ -481,20 +481,46 @@
     const cellW = pw / nw;
     const cellH = ph / nl;
     const placed = [];
-    for (const r of regs.sort((a, b) => b.cells.length - a.cells.length)) {
+    const th = 16;
+    const overlaps = (box) => placed.some((b) => box[0] < b[0] + b[2] && b[0] < box[0] + box[2] && box[1] < b[1] + b[3] && b[1] < box[1] + box[3]);
+    const boxAt = (r, dy = 0) => {
       const [i, j] = r.anchor;
       const x = m.left + (i + 0.5) * cellW;
-      const y = m.top + ph - (j + 0.5) * cellH;
+      const y = Math.min(Math.max(m.top + ph - (j + 0.5) * cellH + dy, m.top + th / 2 + 1), m.top + ph - th / 2 - 1);
       const tw = ctx.measureText(r.name).width + 8;
-      const th = 16;
-      const box = [Math.min(Math.max(x - tw / 2, m.left + 1), m.left + pw - tw - 1), y - th / 2, tw, th];
-      const room = (2 * r.depth + 1) * Math.min(cellW, cellH) >= th || r.cells.length * cellW * cellH >= tw * th;
-      const overlaps = placed.some((b) => box[0] < b[0] + b[2] && b[0] < box[0] + box[2] && box[1] < b[1] + b[3] && b[1] < box[1] + box[3]);
-      r.labelled = room && !overlaps;
+      return [Math.min(Math.max(x - tw / 2, m.left + 1), m.left + pw - tw - 1), y - th / 2, tw, th];
+    };
+    const sorted = regs.sort((a, b) => b.cells.length - a.cells.length);
+    // First every region with room for its name; then, for a limit whose
+    // regions all lack room, its largest region anyway (moved up or down
+    // off other names), so each binding limit is named on the map.
+    for (const r of sorted) {
+      const box = boxAt(r);
+      const room = (2 * r.depth + 1) * Math.min(cellW, cellH) >= th || r.cells.length * cellW * cellH >= box[2] * th;
+      r.labelled = room && !overlaps(box);
+      if (r.labelled) {
+        r.box = box;
+        placed.push(box);
+      }
+    }
+    for (const r of sorted) {
+      if (sorted.some((o) => o.key === r.key && o.labelled) || sorted.find((o) => o.key === r.key) !== r) continue;
+      for (const dy of [0, -th, th, -2 * th, 2 * th, -3 * th, 3 * th]) {
+        const box = boxAt(r, dy);
+        if (overlaps(box)) continue;
+        r.labelled = true;
+        r.box = box;
+        placed.push(box);
+        break;
+      }
+    }
+    for (const r of sorted) {
+      if (!r.labelled) continue;
+      const box = r.box;
+      const tw = box[2];
+      const y = box[1] + th / 2;
       r.label_x = box[0] + tw / 2;
       r.label_y = y;
-      if (!r.labelled) continue;
-      placed.push(box);
       ctx.fillStyle = r.key === "feasible" ? "rgba(255,255,255,0.92)" : "rgba(255,240,242,0.92)";
       ctx.strokeStyle = r.key === "feasible" ? "#1a7f37" : "#b00020";
       ctx.lineWidth = 1;
@@ -503,7 +529,7 @@
       ctx.fillStyle = r.key === "feasible" ? "#0d4d21" : "#7a0016";
       ctx.fillText(r.name, box[0] + tw / 2, y + 0.5);
     }
-    state.regions = regs.map((r) => ({ key: r.key, name: r.name, cells: r.cells.length, labelled: r.labelled, x: r.label_x, y: r.label_y }));
+    state.regions = regs.map((r) => ({ key: r.key, name: r.name, cells: r.cells.length, labelled: r.labelled, x: r.label_x, y: r.label_y, box: r.labelled ? r.box : null }));
 
     ctx.strokeStyle = "#333";
     ctx.lineWidth = 1;
@@ -546,8 +572,15 @@
     ctx.strokeRect(bx + 0.5, m.top + 0.5, bw - 1, ph - 1);
     ctx.fillStyle = "#333";
     ctx.textAlign = "left";
-    for (const v of ticks(lo, hi, 5)) {
-      if (logColour && !Number.isInteger(v)) continue;
+    // Log colour: 1, 2 and 5 × 10^k when the range spans few decades.
+    const barTicks = logColour
+      ? (() => {
+          const out = [];
+          for (let d = Math.floor(lo); d <= Math.ceil(hi); d++) for (const f of hi - lo > 3 ? [1] : [1, 2, 5]) out.push(d + Math.log10(f));
+          return out.filter((v) => v >= lo - 1e-9 && v <= hi + 1e-9);
+        })()
+      : ticks(lo, hi, 5);
+    for (const v of barTicks) {
       const y = m.top + ph - ((v - lo) / (hi - lo)) * ph;
       ctx.fillRect(bx + bw, y, 3, 1);
       ctx.fillText(logColour ? fmt(10 ** v, 2) : fmt(v, 3), bx + bw + 5, Math.min(m.top + ph - 5, Math.max(m.top + 5, y)));
@@ -638,9 +671,10 @@
     const sfOption = $("env-quantity").querySelector('option[value="safety_factor"]');
     sfOption.disabled = res.cable.breaking_strength_n == null;
     if (sfOption.disabled && $("env-quantity").value === "safety_factor") $("env-quantity").value = "altitude";
+    // Shown before drawing: a hidden box has no width to draw into.
+    $("env-output").hidden = false;
     draw();
     fillTables(res);
-    $("env-output").hidden = false;
     $("env-csv").disabled = false;
     $("env-png").disabled = false;
     $("env-criterion").textContent = res.payout_rate_m_s != null

@@ -456,7 +456,7 @@
         (u) => {
           const marks = [];
           if (state.resonance) marks.push([state.resonance.time_s, "ω₁ = ω", "#777"]);
-          if (state.firstUnstable) marks.push([state.firstUnstable.time_s, "onset", "#b00020"]);
+          if (state.firstUnstable) marks.push([state.firstUnstable.time_s, `onset t* = ${fmt(state.firstUnstable.time_s)} s: unstable past it`, "#b00020"]);
           const dpr = devicePixelRatio;
           const { top, height, left: bl, width: bw } = u.bbox;
           const ctx = u.ctx;
@@ -466,15 +466,6 @@
               ctx.save();
               ctx.fillStyle = hatchPattern(ctx, dpr);
               ctx.fillRect(x0, top, bl + bw - x0, height);
-              const label = "past onset: unstable";
-              ctx.font = `${11 * dpr}px sans-serif`;
-              ctx.textBaseline = "bottom";
-              const w = ctx.measureText(label).width;
-              const lx = Math.max(x0 + 4 * dpr, bl + bw - w - 6 * dpr);
-              ctx.fillStyle = "rgba(255,255,255,0.85)";
-              ctx.fillRect(lx - 3 * dpr, top + height - 18 * dpr, w + 6 * dpr, 16 * dpr);
-              ctx.fillStyle = "#b00020";
-              ctx.fillText(label, lx, top + height - 4 * dpr);
               ctx.restore();
             }
           }
@@ -490,12 +481,14 @@
             ctx.lineTo(x, top + height);
             ctx.stroke();
             ctx.setLineDash([]);
-            ctx.fillStyle = colour;
             ctx.font = `${11 * dpr}px sans-serif`;
             ctx.textBaseline = "top";
             ctx.textAlign = "left";
             const w = ctx.measureText(label).width;
-            const left = x + 4 * dpr + w > bl + bw ? x - 4 * dpr - w : x + 4 * dpr;
+            const left = x + 4 * dpr + w > bl + bw ? Math.max(bl + 2 * dpr, x - 4 * dpr - w) : x + 4 * dpr;
+            ctx.fillStyle = "rgba(255,255,255,0.85)";
+            ctx.fillRect(left - 2 * dpr, top + 2 * dpr, w + 4 * dpr, 15 * dpr);
+            ctx.fillStyle = colour;
             ctx.fillText(label, left, top + 4 * dpr);
             ctx.restore();
           }

@@ -189,6 +189,10 @@ try {
     await gp.fill("#ge-count", "3");
     await gp.fill("#ge-ratios", "1e3, 1e5");
     await gp.click("#plot-button");
+    // While the GE job runs, the finished string chart is the current answer: not dimmed.
+    await gp.waitForSelector("#job:not([hidden])", { timeout: 60_000 }).catch(() => {});
+    const dimmed = await gp.evaluate(() => ({ job: !document.querySelector("#job").hidden, stale: document.querySelector("#results").hasAttribute("data-stale"), string: !!window.tetherplan.chart }));
+    check(dimmed.job && dimmed.string && !dimmed.stale, `the finished string chart is not dimmed while the GE job runs (job shown ${dimmed.job}, stale ${dimmed.stale})`);
     await gp.waitForSelector("#ge-time-figure:not([hidden])", { timeout: 120_000 }).catch(() => {});
     await gp.waitForSelector('#status[data-state="ready"], #status[data-state="error"]', { timeout: 120_000 });
     const g = await gp.evaluate(() => ({
@@ -201,6 +205,32 @@ try {
     const hGe = g.series?.[1][1][2];
     // near the wave speed the short stiff cable holds on longer (bending): above the string, within 50 %
     check(hGe > g.string && hGe < g.string * 1.5, `GE h*(100 m/s, E* = 1e5) = ${hGe?.toFixed(1)} m, above the string h* ${g.string?.toFixed(1)} m`);
+    // E* = 1e3 and 1e5 do not hide each other: distinct widths, dashes and markers.
+    const styles = await gp.evaluate(() => window.tetherplan.plots.geElevation.series.slice(1).map((s) => ({ label: s.label, width: s.width, dash: s.dash ?? null, marker: s.points?.show ? s.points.size : 0 })));
+    const geStyles = styles.filter((s) => /^GE/.test(s.label));
+    check(geStyles.length === 2 && geStyles[0].width > geStyles[1].width && geStyles[0].marker > geStyles[1].marker && JSON.stringify(geStyles[0].dash) !== JSON.stringify(geStyles[1].dash),
+      `GE curves distinct: ${geStyles.map((s) => `${s.label} width ${s.width} marker ${s.marker} dash ${JSON.stringify(s.dash)}`).join("; ")}`);
+    check(/string FE model/.test(styles.at(-1)?.label ?? "") && Array.isArray(styles.at(-1).dash), "the dashed curve is the string FE model, drawn last");
+    check(/not a closed form/.test(await gp.textContent("#ge-time-figure figcaption")), "caption: the dashed line is the string model, not a closed form");
+    check(!/–/.test(await gp.textContent("#plot-ge-time .u-legend")), "GE legend blank until hovered (no “–”)");
+    // A log t* axis.
+    await gp.check("#ge-log-time");
+    check(await gp.evaluate(() => window.tetherplan.plots.geTime.scales.y.distr === 3), "GE t* on a log axis when asked");
+    // GE CSV with the inputs, six significant digits at most; GE PNG.
+    const [geCsv] = await Promise.all([gp.waitForEvent("download"), gp.click("#ge-csv")]);
+    const geCsvPath = path.join(artifacts, "chart_page_ge.csv");
+    await geCsv.saveAs(geCsvPath);
+    const geLines = readFileSync(geCsvPath, "utf8").trim().split("\n");
+    check(["# input ge.stiffness_ratios,1000 100000", "# input ge.model.elements,20", "# input ge.rates_m_s.count,3", "# input string.net_buoyancies_n,1000"].every((l) => geLines.includes(l)),
+      "GE CSV records the GE and string inputs");
+    const geRows = geLines.filter((l) => !l.startsWith("#"));
+    check(geRows.length === 1 + 6 + 10 && geRows[0].startsWith("model,stiffness_ratio"), `GE CSV: header and ${geRows.length - 1} rows (2 × 3 GE points, 10 string points)`);
+    const sigDigits = (t) => t.replace(/^[-+]/, "").replace(/e.*$/i, "").replace(".", "").replace(/^0+/, "").length;
+    const geLong = geRows.slice(1).flatMap((l) => l.split(",")).filter((t) => /^[-+]?\d*\.?\d+(e[-+]?\d+)?$/i.test(t) && sigDigits(t) > 6);
+    check(geLong.length === 0, `GE CSV numbers have at most six significant digits (${geLong.slice(0, 3).join(" ")})`);
+    const [gePng] = await Promise.all([gp.waitForEvent("download"), gp.click("#ge-png")]);
+    await gePng.saveAs(path.join(artifacts, "chart_page_ge_download.png"));
+    check(gePng.suggestedFilename() === "ge-deployment-chart.png", `GE PNG download (${gePng.suggestedFilename()})`);
     await gp.screenshot({ path: path.join(artifacts, "chart_page_ge.png"), fullPage: true });
     await geContext.close();
   }

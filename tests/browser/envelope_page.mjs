@@ -83,7 +83,7 @@ try {
       const r = s.regions.find((x) => x.key === "feasible" && x.labelled);
       const c = document.querySelector("#env-heatmap");
       const dpr = c.width / c.getBoundingClientRect().width;
-      const box = c.getContext("2d").getImageData(Math.round((r.x - 30) * dpr), Math.round((r.y - 6) * dpr), 1, 1).data;
+      const box = c.getContext("2d").getImageData(Math.round((r.box[0] + 2.5) * dpr), Math.round(r.y * dpr), 1, 1).data;
       return Array.from(box);
     });
     check(px[0] > 200 && px[1] > 200 && px[2] > 200, `a label box is drawn on the feasible region (pixel rgb ${px.slice(0, 3).join(",")})`);

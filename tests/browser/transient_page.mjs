@@ -276,7 +276,11 @@ try {
         const w = Math.max(1, Math.round(b - a));
         const img = u.ctx.getImageData(Math.round(a), Math.round(top), w, Math.round(height / 2)).data;
         let sum = 0;
-        for (let k = 0; k < img.length; k += 4) sum += (img[k] + img[k + 1] + img[k + 2]) / 3;
+        // The plot canvas is transparent over the white page: composite over white.
+        for (let k = 0; k < img.length; k += 4) {
+          const a = img[k + 3] / 255;
+          sum += (a * (img[k] + img[k + 1] + img[k + 2])) / 3 + 255 * (1 - a);
+        }
         return sum / (img.length / 4);
       };
       const strip = Math.min(40 * devicePixelRatio, (left + width - x0) * 0.8, (x0 - left) * 0.8);
