@@ -382,7 +382,7 @@
   // gaps where a curve has no point (drawn across).
   // A GE series' name: E* (and F0, buoyancy, A0 when the chart varies them).
   function geLabel(s) {
-    let label = `GE, E* = ${s.stiffness_ratio.toExponential(0)}`;
+    let label = `GE, E* = ${s.stiffness_ratio.toExponential(0).replace("e+", "e")}`;
     if (s.perturbation_force_n) label += `, F0 = ${s.perturbation_force_n} N`;
     if (s.wind_amplitude_nondim != null) label += `, A0 = ${s.wind_amplitude_nondim}`;
     return label;
@@ -392,8 +392,10 @@
   // a fraction of a percent): each drawn wider than the next and with its own
   // dash and marker, so the one underneath shows as a halo; the note says
   // which curves coincide and by how much.
-  const GE_DASHES = [undefined, [10, 4], [2, 3], [12, 3, 2, 3]];
-  const GE_MARKERS = [9, 6, 4, 3];
+  const GE_DASHES = [undefined, [2, 3], [10, 4], [12, 3, 2, 3]];
+  const GE_MARKERS = [11, 6, 4, 3];
+  // Colour with alpha, for a wide curve underneath another.
+  const translucent = (hex, a) => `rgba(${parseInt(hex.slice(1, 3), 16)},${parseInt(hex.slice(3, 5), 16)},${parseInt(hex.slice(5, 7), 16)},${a})`;
 
   function coincidences(geChart) {
     const out = [];
@@ -425,8 +427,9 @@
       curves.push({
         label: geLabel(s),
         points: s.points.map((p) => [p.rate_m_s, pick(p)]),
-        // The first is the widest (drawn first, underneath), the last the thinnest.
-        width: 1.5 + 1.5 * (n - 1 - k),
+        // The first is the widest (drawn first, underneath, translucent), the last the thinnest.
+        width: 2 + 2.5 * (n - 1 - k),
+        alpha: k < n - 1 ? 0.5 : 1,
         dash: GE_DASHES[k % GE_DASHES.length],
         marker: GE_MARKERS[k % GE_MARKERS.length],
         color: COLORS[(k + 1) % COLORS.length],
@@ -446,7 +449,8 @@
         return y == null || (log && !(y > 0)) ? null : y;
       }));
       const points = c.marker ? { show: true, size: c.marker, width: 1.5, stroke: c.color, fill: "#fff" } : { show: false };
-      series.push({ label: `${c.label} (${unit})`, color: c.color, stroke: c.color, width: c.width, dash: c.dash, points, spanGaps: true, value: legendValue(1) });
+      const stroke = c.alpha && c.alpha < 1 ? translucent(c.color, c.alpha) : c.color;
+      series.push({ label: `${c.label} (${unit})`, color: c.color, stroke, width: c.width, dash: c.dash, points, spanGaps: true, value: legendValue(1) });
     }
     return { data, series, log };
   }
@@ -464,7 +468,7 @@
     const note = $("#ge-note");
     note.textContent = same.length
       ? same.map((c) => `${c.a} and ${c.b} coincide within ${(100 * c.worst).toFixed(2)} % at every rate`).join("; ") +
-        ": the first is drawn wider, underneath, with larger markers, so both stay visible."
+        ": the first is drawn wider and translucent, underneath, with larger markers, so both stay visible."
       : "";
     note.hidden = !same.length;
     $("#ge-csv").disabled = false;
