@@ -102,7 +102,7 @@
       const pu = p.probability_unsafe;
       lines.push([p.rate_m_s, h.p05, h.p50, h.p95, h.p05_error, h.p50_error, h.p95_error, t.p05, t.p50, t.p95,
         t.p05_error, t.p50_error, t.p95_error, p.nominal_max_elevation_m, p.nominal_critical_time_s,
-        pu?.probability_nondim, pu?.standard_error_nondim].map((v) => (v == null ? "" : v)).join(","));
+        pu?.probability_nondim, pu?.standard_error_nondim].map((v) => (v == null ? "" : Number(v.toPrecision(6)))).join(","));
     }
     return lines.join("\n") + "\n";
   }

@@ -126,13 +126,13 @@ try {
 
   // A grid above the synchronous limit: a job with progress.
   phase = "job";
-  await page.fill("#env-wcount", "60");
+  await page.fill("#env-wcount", "52");
   await page.fill("#env-lcount", "100");
   check(/background job/.test(await page.textContent("#env-hint")), `hint announces a job: “${await page.textContent("#env-hint")}”`);
   if (await runEnvelope(page)) {
     const j = await page.evaluate(() => ({ via: window.tetherplanEnvelope.via, progress: window.tetherplanEnvelope.jobProgress.slice(), n: window.tetherplanEnvelope.result.points.length }));
     const last = j.progress.at(-1);
-    check(/^job /.test(j.via ?? "") && j.n === 6000, `6000 points came from a ${j.via}`);
+    check(/^job /.test(j.via ?? "") && j.n === 5200, `5200 points came from a ${j.via}`);
     check(last && last[0] === "done" && last[1] === 1, `job progress reported (${j.progress.map(([s, p]) => `${s} ${p.toFixed(2)}`).join(", ")})`);
     check(await page.isHidden("#env-job"), "progress bar hidden once the job is done");
   }

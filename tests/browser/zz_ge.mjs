@@ -1,0 +1,14 @@
+import path from "node:path";
+import { launch, target } from "./harness.mjs";
+const { url, artifacts } = target("zz_ge.mjs");
+const browser = await launch();
+const ctx = await browser.newContext({ viewport: { width: 1280, height: 800 } });
+const gp = await ctx.newPage();
+await gp.goto(url, { waitUntil: "load" });
+await gp.fill("#rate-min", "10"); await gp.fill("#rate-count", "10"); await gp.fill("#buoyancies", "1000");
+await gp.check("#ge-enabled"); await gp.fill("#ge-count", "5"); await gp.fill("#ge-ratios", "1e3, 1e5");
+await gp.click("#plot-button");
+await gp.waitForSelector("#ge-time-figure:not([hidden])", { timeout: 180000 });
+await gp.waitForSelector('#status[data-state="ready"]', { timeout: 180000 });
+await gp.locator("#ge-time-figure").screenshot({ path: path.join(artifacts, "zz_ge_t.png") }); await gp.locator("#ge-elevation-figure").screenshot({ path: path.join(artifacts, "zz_ge_h.png") });
+await browser.close();
