@@ -550,7 +550,7 @@ fn wind_lowers_the_reachable_altitude_and_lengthens_the_plan() {
     assert!((zero.wind.as_ref().unwrap().target_length_m.unwrap() - 1000.0).abs() < 1e-6);
     let mut last_duration = 0.0;
     let mut last_reach = f64::INFINITY;
-    for u in [0.0, 3.0, 6.0, 9.0, 12.0] {
+    for u in [0.0, 2.0, 4.0, 6.0] {
         let r = run(windy(1000.0, u));
         let w = r.wind.as_ref().unwrap();
         assert!(w.stability_criterion.contains("string tension"));
@@ -583,7 +583,7 @@ fn wind_lowers_the_reachable_altitude_and_lengthens_the_plan() {
         last_reach = w.reachable_altitude_m;
     }
     // Beyond reach: named.
-    let r = run(windy(1200.0, 12.0));
+    let r = run(windy(1000.0, 9.0));
     assert!(!r.feasible);
     assert_eq!(
         r.binding_limit.as_deref(),
