@@ -19,12 +19,40 @@ use tetherplan::jobs::store::JobStore;
 use tower::ServiceExt;
 
 fn app() -> axum::Router {
+    app_and_queue().0
+}
+
+fn app_and_queue() -> (axum::Router, Arc<JobQueue>) {
     let queue = Arc::new(JobQueue::new(
         JobStore::open_in_memory().unwrap(),
         1,
         Limits::default(),
     ));
-    api::router(AppState::new(queue), Path::new("static"))
+    (
+        api::router(AppState::new(queue.clone()), Path::new("static")),
+        queue,
+    )
+}
+
+async fn send(
+    app: &axum::Router,
+    method: &str,
+    uri: &str,
+    body: Option<&Value>,
+) -> (StatusCode, Value) {
+    let req = Request::builder()
+        .method(method)
+        .uri(uri)
+        .header(header::CONTENT_TYPE, "application/json")
+        .body(match body {
+            Some(b) => Body::from(serde_json::to_vec(b).unwrap()),
+            None => Body::empty(),
+        })
+        .unwrap();
+    let resp = app.clone().oneshot(req).await.unwrap();
+    let status = resp.status();
+    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
+    (status, serde_json::from_slice(&bytes).unwrap())
 }
 
 async fn post(body: &Value) -> (StatusCode, Value) {
@@ -69,6 +97,22 @@ async fn the_documented_example_succeeds_as_is() {
 #[tokio::test]
 async fn unknown_fields_and_bad_values_name_their_path() {
     let mut body = example();
+    body["winch"]["max_jerk_m_s3"] = json!(0.0);
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
+    assert_eq!(r["error"]["field"], "winch.max_jerk_m_s3", "{r}");
+
+    let mut body = example();
+    body["wind"] = json!({"flow": {"kind": "uniform", "speed_m_s": 5.0}, "cable_diameter_m": 0.006,
+        "aerostat_drag_coefficient_nondim": -1.0, "aerostat_reference_area_m2": 20.0});
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
+    assert_eq!(
+        r["error"]["field"], "wind.aerostat_drag_coefficient_nondim",
+        "{r}"
+    );
+
+    let mut body = example();
     body["winch"]["max_jerk"] = json!(1.0);
     let (status, r) = post(&body).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
@@ -98,6 +142,57 @@ async fn unknown_fields_and_bad_values_name_their_path() {
     let (status, r) = post(&body).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
     assert!(r["error"]["message"].as_str().unwrap().contains("surprise"));
+}
+
+/// `POST /api/v1/jobs` with `kind: plan` answers what `POST /api/v1/plan`
+/// answers (all but the computation time), with a jerk limit and wind.
+#[tokio::test]
+async fn a_plan_job_answers_what_the_route_answers() {
+    let (app, queue) = app_and_queue();
+    let mut body = example();
+    body["winch"]["max_jerk_m_s3"] = json!(1.0);
+    body["wind"] = json!({"flow": {"kind": "uniform", "speed_m_s": 3.0}, "cable_diameter_m": 0.006,
+        "aerostat_drag_coefficient_nondim": 0.47, "aerostat_reference_area_m2": 3.0});
+    body["samples"] = json!(41);
+    let (status, sync) = post(&body).await;
+    assert_eq!(status, StatusCode::OK, "{sync}");
+    assert_eq!(sync["feasible"], true, "{}", sync["reason"]);
+    let (status, job) = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        Some(&json!({"kind": "plan", "request": body})),
+    )
+    .await;
+    assert_eq!(status, StatusCode::ACCEPTED, "{job}");
+    let id = job["id"].as_i64().unwrap();
+    let q = queue.clone();
+    tokio::task::spawn_blocking(move || tetherplan::jobs::try_execute_next(&q).unwrap().unwrap())
+        .await
+        .unwrap();
+    let (status, view) = send(&app, "GET", &format!("/api/v1/jobs/{id}"), None).await;
+    assert_eq!(status, StatusCode::OK);
+    assert_eq!(view["status"], "done", "{view}");
+    assert_eq!(view["kind"], "plan");
+    assert_eq!(view["progress"].as_f64(), Some(1.0));
+    let mut result = view["result"].clone();
+    let mut sync = sync;
+    for v in [&mut result, &mut sync] {
+        v.as_object_mut().unwrap().remove("compute_time_s");
+    }
+    assert_eq!(result, sync);
+    // A bad plan is refused at submission with its path.
+    let mut bad = example();
+    bad["winch"]["max_jerk_m_s3"] = json!(-1.0);
+    let (status, r) = send(
+        &app,
+        "POST",
+        "/api/v1/jobs",
+        Some(&json!({"kind": "plan", "request": bad})),
+    )
+    .await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
+    assert_eq!(r["error"]["field"], "request.winch.max_jerk_m_s3");
 }
 
 #[tokio::test]

@@ -383,3 +383,212 @@ fn the_deadline_moves_earlier_as_the_wind_rises_faster() {
     assert!(r.feasible && !r.go, "{}", r.reason);
     assert!(r.haul_down.unwrap().reason.starts_with("no-go"));
 }
+
+// ------------------------------------------------------------------ jerk
+
+/// Largest `|Δa/Δt|` between consecutive samples (finite differences of
+/// the schedule's acceleration; exact for a piecewise-linear `L̈`).
+fn finite_difference_jerk(r: &PlanResponse) -> f64 {
+    r.schedule
+        .windows(2)
+        .filter(|w| w[1].time_s > w[0].time_s + 1e-9)
+        .map(|w| {
+            ((w[1].acceleration_m_s2 - w[0].acceleration_m_s2) / (w[1].time_s - w[0].time_s)).abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_jerk_limited_trapezoid_is_the_seven_segment_s_curve() {
+    // Thesis data to 1200 m, 40 m/s, 2 m/s²: the ceiling never binds, so the
+    // jerk-limited minimum time is the classical 7-segment S-curve
+    // T = D/v + v/a + a/j (v ≥ a²/j: both limits reached).
+    for j in [0.5, 1.0, 4.0, 1e4] {
+        let mut body = thesis_body(1200.0, 0.05);
+        body["winch"]["max_jerk_m_s3"] = json!(j);
+        body["samples"] = json!(4001);
+        let r = run(body);
+        assert!(r.feasible, "{}", r.reason);
+        let d = r.duration_s.unwrap();
+        let closed = 1199.0 / 40.0 + 40.0 / 2.0 + 2.0 / j;
+        assert!((d - closed).abs() < 0.01, "j = {j}: {d} vs {closed}");
+        let fd = finite_difference_jerk(&r);
+        assert!(
+            fd <= j * (1.0 + 1e-6),
+            "j = {j}: finite-difference jerk {fd}"
+        );
+        let jerk = r.jerk.as_ref().unwrap();
+        assert!(jerk.peak_jerk_m_s3 <= j * (1.0 + 1e-9));
+        assert!((jerk.averaging_window_s - 2.0 / j).abs() < 1e-9);
+        // Rest to rest, within the winch limits.
+        assert_eq!(r.schedule.first().unwrap().rate_m_s, 0.0);
+        assert_eq!(r.schedule.last().unwrap().rate_m_s, 0.0);
+        assert!((r.schedule.last().unwrap().length_m - 1200.0).abs() < 1e-9);
+        for s in &r.schedule {
+            assert!(s.rate_m_s.abs() <= 40.0 * (1.0 + 1e-12));
+            assert!(s.acceleration_m_s2.abs() <= 2.0 * (1.0 + 1e-12));
+        }
+        // The constant-rate comparison has S-curve ramps too.
+        let c = r.constant_rate.unwrap();
+        let v = c.rate_m_s;
+        assert!((c.duration_s - (1199.0 / v + v / 2.0 + 2.0 / j)).abs() < 1e-9 || v < 4.0 / j);
+        eprintln!("jerk {j}: plan {d:.4} s, 7-segment S-curve {closed:.4} s, FD jerk {fd:.4}");
+    }
+}
+
+#[test]
+fn jerk_limited_plans_are_qep_stable_within_every_limit() {
+    // The tight-reserve case rides the stability ceiling: the averaged
+    // schedule is tightened until every instant keeps the margin.
+    for (c, j) in cases().into_iter().zip([0.5, 0.05, 2.0]) {
+        let mut body = c.body.clone();
+        body["winch"]["max_jerk_m_s3"] = json!(j);
+        body["samples"] = json!(81);
+        let r = run(body.clone());
+        assert!(r.feasible, "{}: {}", c.name, r.reason);
+        let l0 = body["initial_length_m"].as_f64().unwrap();
+        let allow = body["tether"]["breaking_strength_n"]
+            .as_f64()
+            .map(|b| b / body["tether"]["safety_factor_nondim"].as_f64().unwrap());
+        for s in &r.schedule {
+            let k = Kinematics {
+                length_m: s.length_m,
+                rate_m_s: s.rate_m_s,
+                acceleration_m_s2: s.acceleration_m_s2,
+            };
+            let (stable, max_re) = qep_stable(&c, l0, 100, k);
+            assert!(
+                stable,
+                "{}: t = {:.2} s: max Re λ = {max_re:e}",
+                c.name, s.time_s
+            );
+            assert!(s.rate_m_s.abs() <= c.max_rate * (1.0 + 1e-9), "{}", c.name);
+            assert!(
+                s.acceleration_m_s2.abs() <= c.max_acc * (1.0 + 1e-9),
+                "{}",
+                c.name
+            );
+            assert!(s.effective_tension_margin_n >= 0.0, "{}", c.name);
+            if let Some(a) = allow {
+                assert!(s.max_tension_n <= a * (1.0 + 1e-9), "{}", c.name);
+            }
+        }
+        // Jerk on a dense sampling.
+        body["samples"] = json!(6001);
+        let dense = run(body);
+        let fd = finite_difference_jerk(&dense);
+        assert!(fd <= j * (1.0 + 1e-6), "{}: FD jerk {fd} > {j}", c.name);
+        let free = run(c.body.clone()).duration_s.unwrap();
+        let d = r.duration_s.unwrap();
+        assert!(d >= free - 1e-6, "{}: {d} < {free}", c.name);
+        eprintln!(
+            "{} with jerk {j}: {d:.3} s (without {free:.3} s), window {:.3} s, FD jerk {fd:.4}",
+            c.name,
+            r.jerk.as_ref().unwrap().averaging_window_s
+        );
+    }
+}
+
+// ------------------------------------------------------------------ wind
+
+fn windy(target_altitude: f64, wind_m_s: f64) -> Value {
+    let mut b = thesis_body(target_altitude, 0.05);
+    b["wind"] = json!({
+        "flow": {"kind": "uniform", "speed_m_s": wind_m_s},
+        "cable_diameter_m": 0.006,
+        "aerostat_drag_coefficient_nondim": 0.47,
+        "aerostat_reference_area_m2": 3.0
+    });
+    b
+}
+
+/// Independent check of a wind sample: the tether equilibrium at that
+/// length with the reserve buoyancy, solved here at a finer integration,
+/// and the string criterion with the payout terms.
+fn wind_margin(s: &tetherplan::contract::plan::dto::PlanSampleOutput, wind_m_s: f64) -> f64 {
+    use tetherplan::numerics::tether::{
+        Body, Cable, EquilibriumConfig, EquilibriumProblem, WindProfile,
+    };
+    let eq = EquilibriumProblem {
+        cable: Cable {
+            mass_per_length_kg_m: 0.078,
+            diameter_m: 0.006,
+            normal_drag_coefficient: 1.2,
+            axial_stiffness_n: None,
+            breaking_strength_n: None,
+        },
+        body: Body {
+            net_buoyancy_n: 0.95 * 1000.0,
+            drag_coefficient: 0.47,
+            lift_coefficient: 0.0,
+            reference_area_m2: 3.0,
+        },
+        wind: WindProfile::uniform(wind_m_s),
+        air_density_kg_m3: 1.225,
+        tether_length_m: s.length_m,
+        gravity_m_s2: 9.81,
+    }
+    .solve(&EquilibriumConfig {
+        steps: 400,
+        max_iterations: 60,
+        keep_shape: false,
+    })
+    .unwrap();
+    assert!(!eq.slack);
+    eq.min_tension_n
+        - (10.0 + 0.078 * s.length_m) * s.acceleration_m_s2
+        - 0.078 * s.rate_m_s * s.rate_m_s
+}
+
+#[test]
+fn wind_lowers_the_reachable_altitude_and_lengthens_the_plan() {
+    // Calm air through the wind path (U = 0) is the calm-air plan.
+    let calm = run(thesis_body(1000.0, 0.05));
+    let zero = run(windy(1000.0, 0.0));
+    let (dc, dz) = (calm.duration_s.unwrap(), zero.duration_s.unwrap());
+    assert!((dc - dz).abs() < 1e-9 * dc, "{dc} vs {dz}");
+    assert!((zero.wind.as_ref().unwrap().target_length_m.unwrap() - 1000.0).abs() < 1e-6);
+    let mut last_duration = 0.0;
+    let mut last_reach = f64::INFINITY;
+    for u in [0.0, 2.0, 4.0, 6.0] {
+        let r = run(windy(1000.0, u));
+        let w = r.wind.as_ref().unwrap();
+        assert!(w.stability_criterion.contains("string tension"));
+        assert!(r.feasible, "U = {u}: {}", r.reason);
+        let d = r.duration_s.unwrap();
+        let l = w.target_length_m.unwrap();
+        assert!(d > last_duration, "U = {u}: {d} after {last_duration}");
+        assert!(w.reachable_altitude_m < last_reach, "U = {u}");
+        // The plan ends at the target altitude.
+        let end = r.schedule.last().unwrap();
+        assert!(
+            (end.altitude_m - 1000.0).abs() < 1e-3 * 1000.0,
+            "{}",
+            end.altitude_m
+        );
+        for s in &r.schedule {
+            let m = wind_margin(s, u);
+            assert!(
+                m >= -1e-6 * 950.0,
+                "U = {u}: t = {:.2} s: margin {m} N",
+                s.time_s
+            );
+            assert!(s.rate_m_s.abs() <= 40.0 * (1.0 + 1e-12));
+        }
+        eprintln!(
+            "U = {u} m/s: length {l:.1} m for 1000 m, plan {d:.3} s, reachable {:.1} m (lift limit {:.1} m)",
+            w.reachable_altitude_m, w.lift_limit_m
+        );
+        last_duration = d;
+        last_reach = w.reachable_altitude_m;
+    }
+    // Beyond reach: named.
+    let r = run(windy(1000.0, 9.0));
+    assert!(!r.feasible);
+    assert_eq!(
+        r.binding_limit.as_deref(),
+        Some("wind_blowdown"),
+        "{}",
+        r.reason
+    );
+}

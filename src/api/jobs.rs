@@ -65,6 +65,7 @@ pub const JOB_RESULT_SCHEMAS: &[&str] = &[
     "EquilibriumResponse",
     "EnvelopeResponse",
     "BandsResponse",
+    "PlanResponse",
     "BatchOutcome",
 ];
 

@@ -571,6 +571,8 @@ job_kinds!(
     Envelope(crate::contract::envelope::dto::EnvelopeRequest),
     /// `POST /api/v1/bands`, up to 2 000 000 chart points (samples × rates).
     Bands(crate::contract::bands::BandsRequest),
+    /// `POST /api/v1/plan`: the deployment plan (progress of its transient check).
+    Plan(crate::contract::plan::PlanRequest),
 );
 
 impl JobItem {
@@ -697,6 +699,7 @@ pub const ITEM_RESULT_SCHEMAS: &[&str] = &[
     "EquilibriumResponse",
     "EnvelopeResponse",
     "BandsResponse",
+    "PlanResponse",
 ];
 
 fn item_result_schema() -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {
@@ -865,6 +868,8 @@ mod tests {
             }
             "bands" => json!({"rates_m_s": [10.0], "uncertainty": {"samples": 4, "inputs": [
                 {"field": "aerostat.net_buoyancy_n", "distribution": "uniform", "low": 900.0, "high": 1100.0}]}}),
+            "plan" => json!({"target_elevation_m": 100.0,
+                "winch": {"max_rate_m_s": 10.0, "max_acceleration_m_s2": 1.0}}),
             other => panic!("a new kind needs a valid request here: {other}"),
         };
         v.as_object_mut()

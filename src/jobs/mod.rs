@@ -17,6 +17,7 @@
 pub mod estimate;
 pub mod kinds;
 pub mod lease;
+pub mod plan;
 pub mod sqlite;
 pub mod store;
 pub mod tether;

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::dto::{AerostatInput, CableInput, Groups, ModelInput};
+use crate::contract::equilibrium::dto::WindFlowInput;
 
 /// Winch limits.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
@@ -16,6 +17,49 @@ pub struct WinchInput {
     /// Largest winch acceleration |L̈| (m/s²), speeding up and braking.
     #[schema(example = 2.0, exclusive_minimum = 0.0, maximum = 100.0)]
     pub max_acceleration_m_s2: f64,
+    /// Largest rate of change of the winch acceleration (m/s³); absent: not
+    /// limited. With it the schedule is an S-curve (the acceleration ramps).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 1.0, exclusive_minimum = 0.0, maximum = 10000.0)]
+    pub max_jerk_m_s3: Option<f64>,
+}
+
+/// Steady wind for the plan, with the aerodynamic data it needs. With it
+/// `target_elevation_m` is the aerostat's altitude in this wind (the tether
+/// is blown down, so it needs more length), and the tension limit and the
+/// stability ceiling use the steady-wind tether equilibrium.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PlanWindInput {
+    pub flow: WindFlowInput,
+    /// Air density (kg/m³), default 1.225 (ISA sea level).
+    #[serde(default = "default_air_density")]
+    #[schema(example = 1.225, exclusive_minimum = 0.0, maximum = 5.0)]
+    pub air_density_kg_m3: f64,
+    /// Tether diameter d (m): the reference width of its normal drag.
+    #[schema(example = 0.006, exclusive_minimum = 0.0, maximum = 1.0)]
+    pub cable_diameter_m: f64,
+    /// Normal drag coefficient C_n of the tether (default 1.2, a cylinder in cross flow).
+    #[serde(default = "default_cable_drag")]
+    #[schema(example = 1.2, minimum = 0.0, maximum = 10.0)]
+    pub cable_normal_drag_coefficient_nondim: f64,
+    /// Drag coefficient C_D of the aerostat on `aerostat_reference_area_m2`.
+    #[schema(example = 0.47, minimum = 0.0, maximum = 10.0)]
+    pub aerostat_drag_coefficient_nondim: f64,
+    /// Reference area A of the aerostat (m²).
+    #[schema(example = 3.0, exclusive_minimum = 0.0, maximum = 1e5)]
+    pub aerostat_reference_area_m2: f64,
+    /// Aerodynamic lift coefficient C_L of the aerostat (default 0).
+    #[serde(default)]
+    #[schema(example = 0.0, minimum = -10.0, maximum = 10.0)]
+    pub aerostat_lift_coefficient_nondim: f64,
+}
+
+fn default_air_density() -> f64 {
+    1.225
+}
+fn default_cable_drag() -> f64 {
+    1.2
 }
 
 /// The tether's rating.
@@ -112,6 +156,9 @@ pub struct PlanRequest {
     /// Haul-down deadline under a wind forecast.
     #[serde(default)]
     pub haul_down: Option<HaulDownInput>,
+    /// Steady wind during the plan; absent: calm air.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wind: Option<PlanWindInput>,
     /// Tip deflection of the first-mode disturbance of the transient check (m).
     #[serde(default = "default_disturbance")]
     #[schema(example = 0.1, exclusive_minimum = 0.0, maximum = 1e3)]
@@ -144,6 +191,8 @@ pub struct PlanSampleOutput {
     pub time_s: f64,
     /// Cable length L (m).
     pub length_m: f64,
+    /// Altitude of the aerostat above the winch (m): L in calm air, lower in wind.
+    pub altitude_m: f64,
     /// Winch rate L̇ (m/s); negative hauls in.
     pub rate_m_s: f64,
     /// Winch acceleration L̈ (m/s²) from this instant on.
@@ -290,6 +339,30 @@ pub struct PlanLimitsOutput {
     pub min_safety_factor_nondim: Option<f64>,
 }
 
+/// The plan in wind.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct PlanWindOutput {
+    /// Tether length that flies the aerostat at `target_elevation_m` in this wind (m); null when unreachable.
+    pub target_length_m: Option<f64>,
+    /// Static lift limit in this wind with the reserve (m of tether).
+    pub lift_limit_m: f64,
+    /// Altitude at the lift limit with full buoyancy (m): the highest reachable.
+    pub reachable_altitude_m: f64,
+    /// The stability criterion applied to the equilibrium.
+    pub stability_criterion: String,
+}
+
+/// The jerk limit.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct JerkOutput {
+    /// The limit asked for (m/s³).
+    pub max_jerk_m_s3: f64,
+    /// Largest |d L̈/dt| of the schedule (m/s³).
+    pub peak_jerk_m_s3: f64,
+    /// Width of the velocity average that made the S-curve (s): the time it adds.
+    pub averaging_window_s: f64,
+}
+
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
 pub struct PlanResponse {
     /// Whether a schedule exists within every limit.
@@ -315,6 +388,12 @@ pub struct PlanResponse {
     pub retrieval: Option<RetrievalOutput>,
     pub haul_down: Option<HaulDownOutput>,
     pub limits: PlanLimitsOutput,
+    /// In wind only.
+    #[serde(default)]
+    pub wind: Option<PlanWindOutput>,
+    /// With a jerk limit only.
+    #[serde(default)]
+    pub jerk: Option<JerkOutput>,
     /// How the schedule was found and checked.
     pub method: String,
     /// Computation time of the plan (s).

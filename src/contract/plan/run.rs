@@ -9,12 +9,14 @@ use crate::contract::dto::SystemInput;
 use crate::contract::plan::dto::*;
 use crate::contract::run::{Progress, RequestError, groups};
 use crate::numerics::params::{InvalidInput, require_finite, require_positive};
+use crate::numerics::plan::air::{Air, SteadyWind};
 use crate::numerics::plan::deadline::{self, Forecast};
 use crate::numerics::plan::retrieval::{self, TransientCheck};
-use crate::numerics::plan::schedule::{self, PlanOutcome, Schedule};
-use crate::numerics::plan::{BindingLimit, PlanProblem, STABILITY_MARGIN, Winch};
+use crate::numerics::plan::schedule::{self, PlanOptions, PlanOutcome, Schedule};
+use crate::numerics::plan::{BindingLimit, PlanProblem, STABILITY_MARGIN, Winch, validate_jerk};
 use crate::numerics::string::StringModel;
 use crate::numerics::string::transient::{Observer, RunOutcome, TransientError};
+use crate::numerics::tether::{Body, Cable};
 
 /// Progress of the contract seen as a numerics observer.
 struct ProgressObserver<'a>(&'a dyn Progress);
@@ -45,6 +47,65 @@ struct Validated {
     forecast: Option<(Forecast, f64)>,
     amplification_limit: Option<f64>,
     breaking_strength_n: Option<f64>,
+    options: PlanOptions,
+    /// In wind: the lift limit (m), the altitude there (m), and the target
+    /// altitude when it is out of reach.
+    wind: Option<WindTarget>,
+}
+
+struct WindTarget {
+    lift_limit_m: f64,
+    reachable_altitude_m: f64,
+    unreachable: Option<BindingLimit>,
+}
+
+/// The steady wind of the request.
+fn steady_wind(w: &PlanWindInput) -> Result<SteadyWind, InvalidInput> {
+    let profile = w.flow.profile("wind.flow")?;
+    let rho = bounded("wind.air_density_kg_m3", w.air_density_kg_m3, 0.0, 5.0)?;
+    require_positive("wind.air_density_kg_m3", rho)?;
+    let d = require_positive("wind.cable_diameter_m", w.cable_diameter_m)?;
+    bounded("wind.cable_diameter_m", d, 0.0, 1.0)?;
+    let cn = bounded(
+        "wind.cable_normal_drag_coefficient_nondim",
+        w.cable_normal_drag_coefficient_nondim,
+        0.0,
+        10.0,
+    )?;
+    let cd = bounded(
+        "wind.aerostat_drag_coefficient_nondim",
+        w.aerostat_drag_coefficient_nondim,
+        0.0,
+        10.0,
+    )?;
+    let area = require_positive(
+        "wind.aerostat_reference_area_m2",
+        w.aerostat_reference_area_m2,
+    )?;
+    bounded("wind.aerostat_reference_area_m2", area, 0.0, 1e5)?;
+    let cl = bounded(
+        "wind.aerostat_lift_coefficient_nondim",
+        w.aerostat_lift_coefficient_nondim,
+        -10.0,
+        10.0,
+    )?;
+    Ok(SteadyWind::new(
+        Cable {
+            mass_per_length_kg_m: 1.0,
+            diameter_m: d,
+            normal_drag_coefficient: cn,
+            axial_stiffness_n: None,
+            breaking_strength_n: None,
+        },
+        Body {
+            net_buoyancy_n: 1.0,
+            drag_coefficient: cd,
+            lift_coefficient: cl,
+            reference_area_m2: area,
+        },
+        profile,
+        rho,
+    ))
 }
 
 fn bounded(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64, InvalidInput> {
@@ -69,6 +130,11 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
     };
     let model = system_input.model()?;
     let winch = Winch::new(req.winch.max_rate_m_s, req.winch.max_acceleration_m_s2)?;
+    let max_jerk_m_s3 = req.winch.max_jerk_m_s3.map(validate_jerk).transpose()?;
+    let air = match &req.wind {
+        Some(w) => Air::Wind(Box::new(steady_wind(w)?)),
+        None => Air::Calm,
+    };
     let (allowable, breaking) = match &req.tether {
         Some(t) => {
             let b = require_positive("tether.breaking_strength_n", t.breaking_strength_n)?;
@@ -84,9 +150,54 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
         None => (None, None),
     };
     require_finite("target_elevation_m", req.target_elevation_m)?;
+    // In wind the target is an altitude: the length that flies there.
+    let (target_length, wind) = if air.is_calm() {
+        (req.target_elevation_m, None)
+    } else {
+        bounded("target_elevation_m", req.target_elevation_m, 0.0, 1e6)?;
+        require_positive("target_elevation_m", req.target_elevation_m)?;
+        let probe = PlanProblem {
+            system: model.system,
+            target_length_m: req.target_elevation_m,
+            winch,
+            lift_reserve: req.lift_reserve_nondim,
+            allowable_tension_n: allowable,
+            grid_segments: crate::numerics::plan::DEFAULT_GRID_SEGMENTS,
+        };
+        bounded(
+            "lift_reserve_nondim",
+            req.lift_reserve_nondim,
+            0.0,
+            crate::numerics::plan::MAX_LIFT_RESERVE,
+        )?;
+        let lift = air.lift_limit_m(&probe);
+        let reachable = air.rest_loads(&probe, lift).altitude_m;
+        match air.length_for_altitude(&model.system, req.target_elevation_m, lift) {
+            Ok(l) => (
+                l,
+                Some(WindTarget {
+                    lift_limit_m: lift,
+                    reachable_altitude_m: reachable,
+                    unreachable: None,
+                }),
+            ),
+            Err(top) => (
+                // Planned to the limit only to report; the answer is infeasible.
+                lift,
+                Some(WindTarget {
+                    lift_limit_m: lift,
+                    reachable_altitude_m: top,
+                    unreachable: Some(BindingLimit::WindAltitude {
+                        altitude_m: req.target_elevation_m,
+                        reachable_m: top,
+                    }),
+                }),
+            ),
+        }
+    };
     let problem = PlanProblem::new(
         model.system,
-        req.target_elevation_m,
+        target_length,
         winch,
         req.lift_reserve_nondim,
         allowable,
@@ -154,6 +265,8 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
         forecast,
         amplification_limit,
         breaking_strength_n: breaking,
+        options: PlanOptions { air, max_jerk_m_s3 },
+        wind,
     })
 }
 
@@ -186,7 +299,10 @@ fn check_output(c: &TransientCheck) -> TransientCheckOutput {
     }
 }
 
-fn samples_output(p: &PlanProblem, s: &Schedule, count: usize) -> Vec<PlanSampleOutput> {
+fn samples_output(p: &PlanProblem, air: &Air, s: &Schedule, count: usize) -> Vec<PlanSampleOutput> {
+    if !air.is_calm() {
+        return wind_samples_output(p, air, s, count);
+    }
     s.samples(count)
         .into_iter()
         .map(|(t, k)| {
@@ -194,6 +310,7 @@ fn samples_output(p: &PlanProblem, s: &Schedule, count: usize) -> Vec<PlanSample
             PlanSampleOutput {
                 time_s: t,
                 length_m: k.length_m,
+                altitude_m: k.length_m,
                 rate_m_s: k.rate_m_s,
                 acceleration_m_s2: k.acceleration_m_s2,
                 winch_tension_n: p.winch_tension_n(k.length_m, k.acceleration_m_s2),
@@ -208,6 +325,45 @@ fn samples_output(p: &PlanProblem, s: &Schedule, count: usize) -> Vec<PlanSample
             }
         })
         .collect()
+}
+
+/// Samples with the loads of the steady-wind equilibrium at each length.
+fn wind_samples_output(
+    p: &PlanProblem,
+    air: &Air,
+    s: &Schedule,
+    count: usize,
+) -> Vec<PlanSampleOutput> {
+    use rayon::prelude::*;
+    let sy = &p.system;
+    s.samples(count)
+        .into_par_iter()
+        .map(|(t, k)| {
+            let (l, a) = (k.length_m, k.acceleration_m_s2);
+            let r = air.rest_loads(p, l);
+            let ceiling = r.rate_ceiling_m_s(sy, l, a);
+            PlanSampleOutput {
+                time_s: t,
+                length_m: l,
+                altitude_m: r.altitude_m,
+                rate_m_s: k.rate_m_s,
+                acceleration_m_s2: a,
+                winch_tension_n: r.winch_tension_at_n(sy, l, a),
+                max_tension_n: r.max_tension_at_n(sy, l, a),
+                rate_ceiling_m_s: ceiling,
+                stability_margin_m_s: ceiling - k.rate_m_s.abs(),
+                effective_tension_margin_n: r.effective_tension_n(sy, l, k.rate_m_s, a),
+            }
+        })
+        .collect()
+}
+
+/// Largest `|ΔL̈/Δt|` between consecutive knots and inside them (m/s³).
+fn peak_jerk(s: &Schedule) -> f64 {
+    s.knots
+        .iter()
+        .map(|k| k.jerk_m_s3.abs())
+        .fold(0.0, f64::max)
 }
 
 fn phases_output(s: &Schedule) -> Vec<PlanPhaseOutput> {
@@ -244,6 +400,30 @@ above, SPEC §5): effective roller tension (1−r)F − mL̈ − ρA(g+L̈)L −
 is then run on the FE string (Newmark, first-mode disturbance) and the oscillation growth compared with WKB \
 (thesis (3.12)).";
 
+/// The method, with the jerk limit and the wind criterion when they apply.
+fn method(opts: &PlanOptions) -> String {
+    let mut m = METHOD.to_string();
+    if opts.max_jerk_m_s3.is_some() {
+        m.push_str(
+            " Jerk limit: the schedule's velocity is averaged over a sliding window τ, the smallest with \
+             |L̈(t) − L̈(t−τ)| ≤ j τ (so |dL̈/dt| ≤ j; for the winch trapezoid this is the classical 7-segment \
+             S-curve, duration D/v + v/a + a/j), then checked against every limit at its knots and inside its \
+             intervals; while it falls short the pass is rerun with a larger stability margin (and a lower \
+             allowable tension).",
+        );
+    }
+    if let Air::Wind(w) = &opts.air {
+        m.push_str(&format!(
+            " Wind: target_elevation_m is the altitude in this wind (the tether length that flies there is found \
+             by bisection on the equilibrium altitude); the tensions are those of the steady-wind equilibrium \
+             (winch and aerostat, full buoyancy) less the inertia of the payout; stability: {}. The transient \
+             check runs the schedule on the calm-air string.",
+            w.criterion_name
+        ));
+    }
+    m
+}
+
 /// Answers a plan request.
 pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, RequestError> {
     let started = Instant::now();
@@ -257,9 +437,19 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         "deployment"
     };
     let inputs = serde_json::to_value(req).expect("requests serialise");
+    let opts = &v.options;
+    let wind_out = v.wind.as_ref().map(|w| PlanWindOutput {
+        target_length_m: w.unreachable.is_none().then_some(p.target_length_m),
+        lift_limit_m: w.lift_limit_m,
+        reachable_altitude_m: w.reachable_altitude_m,
+        stability_criterion: match &opts.air {
+            Air::Wind(sw) => sw.criterion_name.to_string(),
+            Air::Calm => String::new(),
+        },
+    });
     let limits_base = PlanLimitsOutput {
         reserve_buoyancy_n: p.reserve_buoyancy_n(),
-        lift_limit_m: p.lift_limit_m(),
+        lift_limit_m: v.wind.as_ref().map_or(p.lift_limit_m(), |w| w.lift_limit_m),
         allowable_tension_n: p.allowable_tension_n,
         stability_margin_n: STABILITY_MARGIN * p.reserve_buoyancy_n(),
         min_stability_margin_m_s: None,
@@ -283,35 +473,41 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         retrieval: None,
         haul_down: None,
         limits,
-        method: METHOD.into(),
+        wind: wind_out.clone(),
+        jerk: None,
+        method: method(opts),
         compute_time_s: started.elapsed().as_secs_f64(),
         inputs: inputs.clone(),
         groups: groups(&v.model.system),
     };
+    if let Some(b) = v.wind.as_ref().and_then(|w| w.unreachable.clone()) {
+        return Ok(infeasible(b, limits_base));
+    }
 
     // The schedule (slowed for an amplification limit when retrieving).
     let (sched, check, rate_used, slowed) = match (retrieving, v.amplification_limit) {
         (true, Some(limit)) => {
-            match retrieval::bounded_retrieval(
+            match retrieval::bounded_retrieval_with(
                 &p,
                 &v.model,
                 limit,
                 req.disturbance_tip_deflection_m,
                 &observer,
+                opts,
             )
             .map_err(from_transient)?
             {
                 Ok(b) => (b.schedule, b.check, b.rate_limit_m_s, b.slowed),
                 Err(binding) => {
                     // A static limit takes precedence over the amplification.
-                    if let PlanOutcome::Infeasible(b) = schedule::fastest(&p) {
+                    if let PlanOutcome::Infeasible(b) = schedule::fastest_with(&p, opts) {
                         return Ok(infeasible(b, limits_base));
                     }
                     return Ok(infeasible(binding, limits_base));
                 }
             }
         }
-        _ => match schedule::fastest(&p) {
+        _ => match schedule::fastest_with(&p, opts) {
             PlanOutcome::Infeasible(b) => return Ok(infeasible(b, limits_base)),
             PlanOutcome::Feasible(s) => {
                 let c = retrieval::check_transient(
@@ -328,7 +524,7 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
-    let schedule_out = samples_output(&p, &sched, req.samples);
+    let schedule_out = samples_output(&p, &opts.air, &sched, req.samples);
     let min_of =
         |f: fn(&PlanSampleOutput) -> f64| schedule_out.iter().map(f).fold(f64::INFINITY, f64::min);
     let peak_tension = schedule_out
@@ -346,14 +542,14 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
     let constant_rate = {
         let mut pc = p;
         pc.winch.max_rate_m_s = rate_used;
-        schedule::best_constant_rate(&pc).map(|c| ConstantRateOutput {
+        schedule::best_constant_rate_with(&pc, opts).map(|c| ConstantRateOutput {
             rate_m_s: c.rate_m_s,
             duration_s: c.duration_s,
             time_saved_s: c.duration_s - sched.duration_s,
             time_saved_fraction_nondim: (c.duration_s - sched.duration_s) / c.duration_s,
         })
     };
-    let bound = schedule::static_ceiling_bound_s(&p).map(|b| {
+    let bound = schedule::static_ceiling_bound_s_with(&p, &opts.air).map(|b| {
         let excess = sched.duration_s / b - 1.0;
         let explanation = if excess.abs() <= 1e-3 {
             "the plan meets the bound: the stability ceiling does not bind during the acceleration phases".to_string()
@@ -413,7 +609,7 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
             let duration = if retrieving {
                 Some(sched.duration_s)
             } else {
-                match schedule::fastest(&p.between(high, low)) {
+                match schedule::fastest_with(&p.between(high, low), opts) {
                     PlanOutcome::Feasible(s) => Some(s.duration_s),
                     PlanOutcome::Infeasible(_) => None,
                 }
@@ -463,7 +659,13 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         retrieval: retrieval_out,
         haul_down,
         limits,
-        method: METHOD.into(),
+        wind: wind_out,
+        jerk: opts.max_jerk_m_s3.map(|j| JerkOutput {
+            max_jerk_m_s3: j,
+            peak_jerk_m_s3: peak_jerk(&sched),
+            averaging_window_s: sched.averaging_window_s,
+        }),
+        method: method(opts),
         compute_time_s: started.elapsed().as_secs_f64(),
         inputs,
         groups: groups(&v.model.system),

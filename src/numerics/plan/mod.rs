@@ -27,7 +27,9 @@
 //! (WKB amplification, transient check of a schedule), [`deadline`] (wind
 //! forecast → latest haul-down start).
 
+pub mod air;
 pub mod deadline;
+pub mod jerk;
 pub mod retrieval;
 pub mod schedule;
 
@@ -40,6 +42,8 @@ pub const STABILITY_MARGIN: f64 = 1e-3;
 pub const MAX_WINCH_RATE_M_S: f64 = 1000.0;
 /// Largest winch acceleration accepted (m/s²).
 pub const MAX_WINCH_ACCELERATION_M_S2: f64 = 100.0;
+/// Largest winch jerk accepted (m/s³).
+pub const MAX_WINCH_JERK_M_S3: f64 = 1e4;
 /// Largest lift reserve accepted.
 pub const MAX_LIFT_RESERVE: f64 = 0.9;
 /// Segments of the length grid of the speed-profile pass.
@@ -77,6 +81,18 @@ impl Winch {
             max_acceleration_m_s2,
         })
     }
+}
+
+/// Checks a jerk limit (`winch.max_jerk_m_s3`).
+pub fn validate_jerk(max_jerk_m_s3: f64) -> Result<f64, InvalidInput> {
+    require_positive("winch.max_jerk_m_s3", max_jerk_m_s3)?;
+    if max_jerk_m_s3 > MAX_WINCH_JERK_M_S3 {
+        return Err(InvalidInput::new(
+            "winch.max_jerk_m_s3",
+            format!("must be at most {MAX_WINCH_JERK_M_S3} m/s³, got {max_jerk_m_s3}"),
+        ));
+    }
+    Ok(max_jerk_m_s3)
 }
 
 /// What a plan must respect.
@@ -228,6 +244,15 @@ pub enum BindingLimit {
     Tension { tension_n: f64, allowable_n: f64 },
     /// A retrieval's oscillation growth exceeds the limit at every rate tried.
     Amplification { amplification: f64, limit: f64 },
+    /// No jerk-limited schedule kept every limit after the tightenings.
+    Jerk {
+        max_jerk_m_s3: f64,
+        stability_shortfall_n: f64,
+        tension_excess_n: f64,
+    },
+    /// In wind the target altitude is above the highest the aerostat
+    /// reaches within the lift limit (the tether is blown down).
+    WindAltitude { altitude_m: f64, reachable_m: f64 },
 }
 
 impl BindingLimit {
@@ -237,6 +262,8 @@ impl BindingLimit {
             Self::StaticLift { .. } => "static_lift_limit",
             Self::Tension { .. } => "tension_limit",
             Self::Amplification { .. } => "amplification_limit",
+            Self::Jerk { .. } => "jerk_limit",
+            Self::WindAltitude { .. } => "wind_blowdown",
         }
     }
 
@@ -262,6 +289,23 @@ impl BindingLimit {
             } => format!(
                 "an oscillation grows by {amplification:.3}× over the retrieval, above the limit {limit:.3}×, \
                  even at the slowest rate tried; the WKB growth depends only on the start and end lengths"
+            ),
+            Self::Jerk {
+                max_jerk_m_s3,
+                stability_shortfall_n,
+                tension_excess_n,
+            } => format!(
+                "no schedule with the jerk limit {max_jerk_m_s3} m/s³ kept every limit: after tightening the \
+                 margins the S-curve still fell {stability_shortfall_n:.3} N short of the stability margin and \
+                 exceeded the allowable tension by {tension_excess_n:.3} N"
+            ),
+            Self::WindAltitude {
+                altitude_m,
+                reachable_m,
+            } => format!(
+                "in this wind the tether is blown down: {altitude_m:.1} m is above the highest altitude reached \
+                 within the lift limit with a {:.1} % lift reserve, {reachable_m:.1} m",
+                100.0 * reserve
             ),
         }
     }

@@ -213,10 +213,29 @@ pub fn bounded_retrieval(
     disturbance_m: f64,
     observer: &dyn Observer,
 ) -> Result<Result<BoundedRetrieval, BindingLimit>, TransientError> {
+    bounded_retrieval_with(
+        problem,
+        model,
+        limit,
+        disturbance_m,
+        observer,
+        &schedule::PlanOptions::default(),
+    )
+}
+
+/// [`bounded_retrieval`] with the air and jerk limit of `options`.
+pub fn bounded_retrieval_with(
+    problem: &PlanProblem,
+    model: &StringModel,
+    limit: f64,
+    disturbance_m: f64,
+    observer: &dyn Observer,
+    options: &schedule::PlanOptions,
+) -> Result<Result<BoundedRetrieval, BindingLimit>, TransientError> {
     let try_rate = |rate: f64| -> Result<Option<(Schedule, TransientCheck)>, TransientError> {
         let mut p = *problem;
         p.winch.max_rate_m_s = rate;
-        match schedule::fastest(&p) {
+        match schedule::fastest_with(&p, options) {
             PlanOutcome::Feasible(s) => {
                 let c = check_transient(model, &s, disturbance_m, observer)?;
                 Ok(Some((s, c)))

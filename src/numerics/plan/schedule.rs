@@ -28,8 +28,24 @@
 //! The grid error of the duration is `O(h)`; with 4000 segments it is far
 //! below the 3 % asked of the plan.
 
+use crate::numerics::params::AerostatSystem;
 use crate::numerics::params::Kinematics;
+use crate::numerics::plan::air::Air;
 use crate::numerics::plan::{BindingLimit, PlanProblem, STABILITY_MARGIN};
+
+/// Smallest `L̈` (m/s²) that keeps the top tension `T_t − m L̈` and the
+/// winch tension `T_w − (m + ρA L) L̈` within `allow`.
+pub(crate) fn tension_floor(s: &AerostatSystem, allow: f64, l: f64, winch: f64, top: f64) -> f64 {
+    let m = s.aerostat_mass_kg;
+    let top_floor = if m > 0.0 {
+        (top - allow) / m
+    } else if top > allow {
+        f64::INFINITY
+    } else {
+        f64::NEG_INFINITY
+    };
+    top_floor.max((winch - allow) / (m + s.mass_per_length_kg_m * l))
+}
 
 /// What limits a segment of the schedule.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -76,6 +92,9 @@ pub struct Knot {
     pub length_m: f64,
     pub rate_m_s: f64,
     pub acceleration_m_s2: f64,
+    /// Rate of change of the acceleration on the segment that starts here
+    /// (m/s³; 0 in a schedule without a jerk limit).
+    pub jerk_m_s3: f64,
     pub limit: SegmentLimit,
 }
 
@@ -95,6 +114,8 @@ pub struct Schedule {
     /// Largest shortfall of `T_eff` below `ε(1 − r)F` at any segment end
     /// (N; ≤ 0 when every instant keeps the margin).
     pub worst_violation_n: f64,
+    /// Width of the velocity average of a jerk-limited schedule (s; 0 without).
+    pub averaging_window_s: f64,
 }
 
 impl Schedule {
@@ -114,10 +135,14 @@ impl Schedule {
             };
         }
         let tau = t - kn.time_s;
+        let j = kn.jerk_m_s3;
         Kinematics {
-            length_m: kn.length_m + kn.rate_m_s * tau + 0.5 * kn.acceleration_m_s2 * tau * tau,
-            rate_m_s: kn.rate_m_s + kn.acceleration_m_s2 * tau,
-            acceleration_m_s2: kn.acceleration_m_s2,
+            length_m: kn.length_m
+                + kn.rate_m_s * tau
+                + 0.5 * kn.acceleration_m_s2 * tau * tau
+                + j * tau * tau * tau / 6.0,
+            rate_m_s: kn.rate_m_s + kn.acceleration_m_s2 * tau + 0.5 * j * tau * tau,
+            acceleration_m_s2: kn.acceleration_m_s2 + j * tau,
         }
     }
 
@@ -162,20 +187,24 @@ pub enum PlanOutcome {
 }
 
 /// The grid of a problem and the per-node data of the constraints.
-struct Grid {
-    sigma: f64,
-    h: f64,
-    lengths: Vec<f64>,
-    /// Stability right-hand side `((1 − r)(1 − ε)F − ρA g L)/ρA` (m²/s²).
-    cap: Vec<f64>,
+pub(crate) struct Grid {
+    pub(crate) sigma: f64,
+    pub(crate) h: f64,
+    pub(crate) lengths: Vec<f64>,
+    /// Stability right-hand side `(S(L) − ε(1 − r)F)/ρA` (m²/s²); calm
+    /// air: `((1 − r)(1 − ε)F − ρA g L)/ρA`.
+    pub(crate) cap: Vec<f64>,
     /// `m/ρA + L` (m).
-    x: Vec<f64>,
+    pub(crate) x: Vec<f64>,
     /// Smallest `L̈` the tension rating allows (m/s²).
-    floor: Vec<f64>,
+    pub(crate) floor: Vec<f64>,
+    /// Winch and top tension at rest, full buoyancy (N), when rated.
+    pub(crate) rest_tensions: Option<Vec<(f64, f64)>>,
 }
 
 impl Grid {
-    fn new(p: &PlanProblem, margin: f64) -> Self {
+    /// The grid with the loads of `air` at every node.
+    pub(crate) fn with_air(p: &PlanProblem, margin: f64, air: &Air) -> Self {
         let s = &p.system;
         let l0 = s.initial_length_m;
         let sigma = p.direction();
@@ -192,17 +221,41 @@ impl Grid {
                 }
             })
             .collect();
-        let cap = lengths
-            .iter()
-            .map(|&l| {
-                (p.reserve_buoyancy_n() * (1.0 - margin) - rho_a * s.gravity_m_s2 * l) / rho_a
-            })
-            .collect();
+        let (cap, floor, rest_tensions) = if air.is_calm() {
+            let cap = lengths
+                .iter()
+                .map(|&l| {
+                    (p.reserve_buoyancy_n() * (1.0 - margin) - rho_a * s.gravity_m_s2 * l) / rho_a
+                })
+                .collect();
+            let floor = lengths.iter().map(|&l| p.tension_accel_floor(l)).collect();
+            let rest = p
+                .allowable_tension_n
+                .map(|_| air.operating_tensions_n(p, &lengths));
+            (cap, floor, rest)
+        } else {
+            let cap = air
+                .stability_tensions_n(p, &lengths)
+                .into_iter()
+                .map(|st| (st - margin * p.reserve_buoyancy_n()) / rho_a)
+                .collect();
+            let rest = p
+                .allowable_tension_n
+                .map(|_| air.operating_tensions_n(p, &lengths));
+            let floor = match (&rest, p.allowable_tension_n) {
+                (Some(r), Some(allow)) => lengths
+                    .iter()
+                    .zip(r)
+                    .map(|(&l, &(w, t))| tension_floor(s, allow, l, w, t))
+                    .collect(),
+                _ => vec![f64::NEG_INFINITY; lengths.len()],
+            };
+            (cap, floor, rest)
+        };
         let x = lengths
             .iter()
             .map(|&l| s.aerostat_mass_kg / rho_a + l)
             .collect();
-        let floor = lengths.iter().map(|&l| p.tension_accel_floor(l)).collect();
         Self {
             sigma,
             h,
@@ -210,16 +263,54 @@ impl Grid {
             cap,
             x,
             floor,
+            rest_tensions,
         }
     }
 
-    fn segments(&self) -> usize {
+    /// The same grid with the stability margin moved from `from` to `to`
+    /// and the tension floor recomputed for `p`'s allowable tension (no
+    /// new loads are computed).
+    pub(crate) fn remargined(&self, p: &PlanProblem, from: f64, to: f64) -> Self {
+        let shift = (to - from) * p.reserve_buoyancy_n() / p.system.mass_per_length_kg_m;
+        let floor = match (p.allowable_tension_n, &self.rest_tensions) {
+            (Some(allow), Some(r)) => self
+                .lengths
+                .iter()
+                .zip(r)
+                .map(|(&l, &(w, t))| tension_floor(&p.system, allow, l, w, t))
+                .collect(),
+            _ => self.floor.clone(),
+        };
+        Self {
+            sigma: self.sigma,
+            h: self.h,
+            lengths: self.lengths.clone(),
+            cap: self.cap.iter().map(|c| c - shift).collect(),
+            x: self.x.clone(),
+            floor,
+            rest_tensions: self.rest_tensions.clone(),
+        }
+    }
+
+    /// Linear interpolation of per-node data at length `l`.
+    pub(crate) fn interpolate(&self, data: &[f64], l: f64) -> f64 {
+        let n = self.segments();
+        if self.h <= 0.0 {
+            return data[0];
+        }
+        let u = ((l - self.lengths[0]) * self.sigma / self.h).clamp(0.0, n as f64);
+        let i = (u.floor() as usize).min(n - 1);
+        let f = u - i as f64;
+        data[i] + (data[i + 1] - data[i]) * f
+    }
+
+    pub(crate) fn segments(&self) -> usize {
         self.lengths.len() - 1
     }
 
     /// Bounds on the path acceleration `α` of segment `i` from the winch
     /// and the tension rating at both ends.
-    fn alpha_bounds(&self, i: usize, a_max: f64) -> (f64, f64) {
+    pub(crate) fn alpha_bounds(&self, i: usize, a_max: f64) -> (f64, f64) {
         let floor = self.floor[i].max(self.floor[i + 1]);
         if self.sigma > 0.0 {
             ((-a_max).max(floor), a_max)
@@ -280,9 +371,9 @@ fn max_u(upper: &[Line], lower: &[Line], lo: f64, hi: f64) -> Option<(f64, f64)>
 }
 
 /// Checks the end states (at rest) against the lift limit and the rating.
-fn static_check(p: &PlanProblem) -> Option<BindingLimit> {
+pub(crate) fn static_check(p: &PlanProblem, air: &Air) -> Option<BindingLimit> {
     let high = p.target_length_m.max(p.system.initial_length_m);
-    let limit = p.lift_limit_m();
+    let limit = air.lift_limit_m(p);
     if high > limit {
         return Some(BindingLimit::StaticLift {
             length_m: high,
@@ -290,8 +381,15 @@ fn static_check(p: &PlanProblem) -> Option<BindingLimit> {
         });
     }
     if let Some(allow) = p.allowable_tension_n {
-        let low = p.target_length_m.min(p.system.initial_length_m);
-        let t = p.max_tension_n(low, 0.0);
+        let t = if air.is_calm() {
+            let low = p.target_length_m.min(p.system.initial_length_m);
+            p.max_tension_n(low, 0.0)
+        } else {
+            [p.system.initial_length_m, p.target_length_m]
+                .iter()
+                .map(|&l| air.rest_loads(p, l).max_tension_at_n(&p.system, l, 0.0))
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
         if t > allow {
             return Some(BindingLimit::Tension {
                 tension_n: t,
@@ -302,12 +400,40 @@ fn static_check(p: &PlanProblem) -> Option<BindingLimit> {
     None
 }
 
-/// The fastest schedule (see the module docs), or why none exists.
+/// How a plan is made beyond the problem: the air, and a jerk limit.
+#[derive(Clone, Debug, Default)]
+pub struct PlanOptions {
+    pub air: Air,
+    /// Largest rate of change of the winch acceleration (m/s³), if limited.
+    pub max_jerk_m_s3: Option<f64>,
+}
+
+/// The fastest schedule (see the module docs), or why none exists: calm
+/// air, no jerk limit.
 pub fn fastest(p: &PlanProblem) -> PlanOutcome {
-    if let Some(b) = static_check(p) {
+    fastest_with(p, &PlanOptions::default())
+}
+
+/// The fastest schedule in `options.air`; with a jerk limit, the S-curve
+/// schedule of [`super::jerk`].
+pub fn fastest_with(p: &PlanProblem, options: &PlanOptions) -> PlanOutcome {
+    if let Some(b) = static_check(p, &options.air) {
         return PlanOutcome::Infeasible(b);
     }
-    let g = Grid::new(p, STABILITY_MARGIN);
+    match options.max_jerk_m_s3 {
+        None => pass(p, STABILITY_MARGIN, &options.air),
+        Some(j) => super::jerk::jerk_limited(p, &options.air, j),
+    }
+}
+
+/// The forward/backward pass with the stability margin `margin` (fraction
+/// of `(1 − r)F`), after the static check.
+pub(crate) fn pass(p: &PlanProblem, margin: f64, air: &Air) -> PlanOutcome {
+    pass_on(p, &Grid::with_air(p, margin, air), margin, air)
+}
+
+/// The pass on a prepared grid (its margin `margin`).
+pub(crate) fn pass_on(p: &PlanProblem, g: &Grid, margin: f64, air: &Air) -> PlanOutcome {
     let n = g.segments();
     let a_max = p.winch.max_acceleration_m_s2;
     let w2 = p.winch.max_rate_m_s.powi(2);
@@ -367,29 +493,35 @@ pub fn fastest(p: &PlanProblem) -> PlanOutcome {
 
     // Times, labels, and the check of every segment end.
     let f_scale = p.reserve_buoyancy_n();
+    let rho_a = p.system.mass_per_length_kg_m;
     let mut knots = Vec::with_capacity(n + 1);
     let mut t = 0.0;
     let mut worst = f64::NEG_INFINITY;
     for i in 0..n {
         let a_phys = sigma * alpha[i];
         let (vi, vj) = (u[i].sqrt(), u[i + 1].sqrt());
-        for (l, vel) in [(g.lengths[i], vi), (g.lengths[i + 1], vj)] {
-            let short = STABILITY_MARGIN * f_scale - p.effective_tension_n(l, vel, a_phys);
+        for (k, vel) in [(i, vi), (i + 1, vj)] {
+            let short = if air.is_calm() {
+                margin * f_scale - p.effective_tension_n(g.lengths[k], vel, a_phys)
+            } else {
+                rho_a * (vel * vel + g.x[k] * a_phys - g.cap[k])
+            };
             worst = worst.max(short);
         }
-        let label = label(&g, p, i, u[i], u[i + 1], alpha[i], w2, a_max);
+        let label = label(g, p, i, u[i], u[i + 1], alpha[i], w2, a_max);
         knots.push(Knot {
             time_s: t,
             length_m: g.lengths[i],
             rate_m_s: sigma * vi,
             acceleration_m_s2: a_phys,
+            jerk_m_s3: 0.0,
             limit: label,
         });
         let speed = vi + vj;
         if speed <= 0.0 {
             return PlanOutcome::Infeasible(BindingLimit::StaticLift {
                 length_m: g.lengths[i],
-                limit_m: p.lift_limit_m(),
+                limit_m: air.lift_limit_m(p),
             });
         }
         t += 2.0 * h / speed;
@@ -399,12 +531,14 @@ pub fn fastest(p: &PlanProblem) -> PlanOutcome {
         length_m: p.target_length_m,
         rate_m_s: 0.0,
         acceleration_m_s2: 0.0,
+        jerk_m_s3: 0.0,
         limit: knots.last().map_or(SegmentLimit::Brake, |k| k.limit),
     });
     PlanOutcome::Feasible(Schedule {
         knots: compress(knots),
         duration_s: t,
         worst_violation_n: worst,
+        averaging_window_s: 0.0,
     })
 }
 
@@ -463,6 +597,7 @@ fn compress(knots: Vec<Knot>) -> Vec<Knot> {
         if let Some(prev) = out.last()
             && i != last
             && prev.limit == k.limit
+            && prev.jerk_m_s3 == k.jerk_m_s3
             && (prev.acceleration_m_s2 - k.acceleration_m_s2).abs()
                 <= 1e-9 * prev.acceleration_m_s2.abs().max(1e-12)
         {
@@ -488,7 +623,13 @@ fn compress(knots: Vec<Knot>) -> Vec<Knot> {
 /// do not bind either: at the end of the ramp (401 m, 40 m/s, +2 m/s²)
 /// `T_eff = 950 − 20 − 0.078·11.81·401 − 0.078·1600 = 436 N > 0`.
 pub fn static_ceiling_bound_s(p: &PlanProblem) -> Option<f64> {
-    let g = Grid::new(p, 0.0);
+    static_ceiling_bound_s_with(p, &Air::Calm)
+}
+
+/// [`static_ceiling_bound_s`] with the static ceiling `√(S(L)/ρA)` of
+/// `air` (in wind: the stability criterion at rest on the equilibrium).
+pub fn static_ceiling_bound_s_with(p: &PlanProblem, air: &Air) -> Option<f64> {
+    let g = Grid::with_air(p, 0.0, air);
     let n = g.segments();
     let a_max = p.winch.max_acceleration_m_s2;
     let w2 = p.winch.max_rate_m_s.powi(2);
@@ -526,8 +667,9 @@ pub struct ConstantRatePlan {
     pub duration_s: f64,
 }
 
-/// Whether the trapezoid at path speed `v` keeps every constraint.
-fn trapezoid_ok(p: &PlanProblem, v: f64) -> bool {
+/// Whether the trapezoid at path speed `v` keeps every constraint; in
+/// wind with the loads of `grid` interpolated between its nodes.
+fn trapezoid_ok(p: &PlanProblem, v: f64, grid: Option<&Grid>) -> bool {
     let a = p.winch.max_acceleration_m_s2;
     let sigma = p.direction();
     let l0 = p.system.initial_length_m;
@@ -550,7 +692,30 @@ fn trapezoid_ok(p: &PlanProblem, v: f64) -> bool {
         let acc = sigma * alpha;
         [(s0, u0), (s1, u1)].iter().all(|&(s, u)| {
             let l = at(s);
-            p.effective_tension_n(l, u.sqrt(), acc) >= f - 1e-9 * p.system.net_buoyancy_n
+            let tol = 1e-9 * p.system.net_buoyancy_n;
+            if let Some(g) = grid {
+                let sy = &p.system;
+                let rho_a = sy.mass_per_length_kg_m;
+                // T_eff − εR = ρA (cap − v² − x L̈)
+                let cap = g.interpolate(&g.cap, l);
+                let ok = rho_a * (cap - u - (sy.aerostat_mass_kg / rho_a + l) * acc) >= -tol;
+                let rated = match (p.allowable_tension_n, &g.rest_tensions) {
+                    (Some(allow), Some(r)) => {
+                        let w: Vec<f64> = r.iter().map(|x| x.0).collect();
+                        let t: Vec<f64> = r.iter().map(|x| x.1).collect();
+                        let rest = crate::numerics::plan::air::RestLoads {
+                            stability_tension_n: 0.0,
+                            winch_tension_n: g.interpolate(&w, l),
+                            top_tension_n: g.interpolate(&t, l),
+                            altitude_m: l,
+                        };
+                        rest.max_tension_at_n(sy, l, acc) <= allow * (1.0 + 1e-12)
+                    }
+                    _ => true,
+                };
+                return ok && rated;
+            }
+            p.effective_tension_n(l, u.sqrt(), acc) >= f - tol
                 && p.allowable_tension_n
                     .is_none_or(|allow| p.max_tension_n(l, acc) <= allow * (1.0 + 1e-12))
         })
@@ -563,9 +728,33 @@ fn trapezoid_ok(p: &PlanProblem, v: f64) -> bool {
 /// the acceleration limit are admissible,
 /// found by bisection (60 halvings). `None` when no rate is.
 pub fn best_constant_rate(p: &PlanProblem) -> Option<ConstantRatePlan> {
-    if static_check(p).is_some() {
+    best_constant_rate_with(p, &PlanOptions::default())
+}
+
+/// Duration of a rest-to-rest move over `distance` cruising at `v` with
+/// ramps limited by acceleration `a` and, if given, jerk `j`: the
+/// trapezoid `D/v + v/a`, or the classical 7-segment S-curve
+/// `D/v + v/a + a/j` when `v ≥ a²/j` and `D/v + 2√(v/j)` below
+/// (the ramps then never reach `a`).
+pub fn rest_to_rest_time_s(distance: f64, v: f64, a: f64, j: Option<f64>) -> f64 {
+    match j {
+        None => distance / v + v / a,
+        Some(j) if v >= a * a / j => distance / v + v / a + a / j,
+        Some(j) => distance / v + 2.0 * (v / j).sqrt(),
+    }
+}
+
+/// [`best_constant_rate`] in `options.air` (loads interpolated on the
+/// pass's grid) and, with a jerk limit, S-curve ramps
+/// ([`rest_to_rest_time_s`]; their states lie between those of the
+/// trapezoid's, which are the ones checked).
+pub fn best_constant_rate_with(p: &PlanProblem, options: &PlanOptions) -> Option<ConstantRatePlan> {
+    if static_check(p, &options.air).is_some() {
         return None;
     }
+    let grid = (!options.air.is_calm()).then(|| Grid::with_air(p, STABILITY_MARGIN, &options.air));
+    let grid = grid.as_ref();
+    let trapezoid_ok = |p: &PlanProblem, v: f64| trapezoid_ok(p, v, grid);
     let a = p.winch.max_acceleration_m_s2;
     let total = (p.target_length_m - p.system.initial_length_m).abs();
     let top = p.winch.max_rate_m_s.min((a * total).sqrt());
@@ -583,9 +772,37 @@ pub fn best_constant_rate(p: &PlanProblem) -> Option<ConstantRatePlan> {
         }
         lo
     };
+    // With a jerk limit the two S-curve ramps must fit in the distance:
+    // each covers `v·(v/a + a/j)/2` (or `v√(v/j)` below `a²/j`).
+    let v = match options.max_jerk_m_s3 {
+        None => v,
+        Some(j) => {
+            let ramps = |v: f64| {
+                if v >= a * a / j {
+                    v * (v / a + a / j)
+                } else {
+                    2.0 * v * (v / j).sqrt()
+                }
+            };
+            if ramps(v) <= total {
+                v
+            } else {
+                let (mut lo, mut hi) = (0.0, v);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    if ramps(mid) <= total {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                lo
+            }
+        }
+    };
     (v > 0.0).then(|| ConstantRatePlan {
         rate_m_s: v,
-        duration_s: total / v + v / a,
+        duration_s: rest_to_rest_time_s(total, v, a, options.max_jerk_m_s3),
     })
 }
 

@@ -1,0 +1,326 @@
+//! What the air does to a plan: the static loads at one tether length, at
+//! rest, that the speed-profile pass ([`super::schedule`]) needs, in calm
+//! air (closed forms) or in a steady wind (the tether equilibrium of
+//! [`crate::numerics::tether::equilibrium`]).
+//!
+//! The pass adds the kinematic terms to the loads at rest (quasi-static:
+//! the tether pays out along its own shape, so every point of it has the
+//! tangential acceleration `L̈`):
+//!
+//! ```text
+//! T_eff(L, L̇, L̈)   = S(L) − (m + ρA L) L̈ − ρA L̇²     ≥ ε(1 − r)F   (stability)
+//! T_winch(L, L̈)    = T_w(L) − (m + ρA L) L̈
+//! T_top(L, L̈)      = T_t(L) − m L̈                      (largest: ≤ allowable)
+//! ```
+//!
+//! In calm air `S = (1 − r)F − ρA g L`, `T_w = F − ρA g L`, `T_t = F`
+//! (SPEC §1, §7). In wind `T_w`, `T_t` are the equilibrium tensions at the
+//! winch and at the aerostat with the full buoyancy `F` (with normal drag
+//! only, `dT/ds = ρA g sin θ ≥ 0`: the tension grows monotonically from
+//! the winch up, so these two bound it), and `S` is the **stability
+//! criterion** [`StabilityCriterion`] evaluated on the equilibrium with the
+//! reserve buoyancy `(1 − r)F`. The default, [`string_tension_criterion`],
+//! is the one the operating envelope uses (SPEC §6, `envelope::judge`):
+//! the continuum string criterion on the smallest tension of the
+//! blown-down tether, unstable when the tether goes slack (touches the
+//! ground). It is one function of `(problem, equilibrium)`, so a
+//! quasi-static geometrically exact check can replace it.
+//!
+//! Aerodynamic forces of the aerostat's own motion (payout speed against
+//! the wind) are neglected: the loads are those of the steady wind.
+
+use rayon::prelude::*;
+
+use crate::numerics::params::AerostatSystem;
+use crate::numerics::plan::{PlanProblem, STABILITY_MARGIN};
+use crate::numerics::tether::{
+    Body, Cable, Equilibrium, EquilibriumConfig, EquilibriumProblem, WindProfile,
+};
+
+/// Static loads at one length, at rest.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RestLoads {
+    /// `S(L)`: effective tension at rest with the reserve buoyancy, by the
+    /// stability criterion (N); below `ε(1 − r)F` the state is not
+    /// admissible.
+    pub stability_tension_n: f64,
+    /// Axial tension at the winch, full buoyancy (N).
+    pub winch_tension_n: f64,
+    /// Axial tension at the aerostat, full buoyancy (N).
+    pub top_tension_n: f64,
+    /// Altitude of the aerostat above the winch, full buoyancy (m).
+    pub altitude_m: f64,
+}
+
+impl RestLoads {
+    /// `T_eff = S − (m + ρA L) L̈ − ρA L̇²` (N).
+    pub fn effective_tension_n(
+        &self,
+        s: &AerostatSystem,
+        length_m: f64,
+        rate: f64,
+        acc: f64,
+    ) -> f64 {
+        let rho_a = s.mass_per_length_kg_m;
+        self.stability_tension_n
+            - (s.aerostat_mass_kg + rho_a * length_m) * acc
+            - rho_a * rate * rate
+    }
+
+    /// Winch tension with the acceleration (N).
+    pub fn winch_tension_at_n(&self, s: &AerostatSystem, length_m: f64, acc: f64) -> f64 {
+        self.winch_tension_n - (s.aerostat_mass_kg + s.mass_per_length_kg_m * length_m) * acc
+    }
+
+    /// Largest tension along the tether with the acceleration (N).
+    pub fn max_tension_at_n(&self, s: &AerostatSystem, length_m: f64, acc: f64) -> f64 {
+        (self.top_tension_n - s.aerostat_mass_kg * acc)
+            .max(self.winch_tension_at_n(s, length_m, acc))
+    }
+
+    /// Largest stable rate at this length and acceleration (m/s); 0 when
+    /// even rest is unstable.
+    pub fn rate_ceiling_m_s(&self, s: &AerostatSystem, length_m: f64, acc: f64) -> f64 {
+        (self.effective_tension_n(s, length_m, 0.0, acc) / s.mass_per_length_kg_m)
+            .max(0.0)
+            .sqrt()
+    }
+}
+
+/// The stability criterion at rest: `S(L)` (N) from the equilibrium with
+/// the reserve buoyancy and its problem. This is the one function a
+/// quasi-static geometrically exact stability check replaces: it must
+/// return the effective tension at rest that the kinematic terms
+/// `(m + ρA L) L̈ + ρA L̇²` are then taken from (negative when unstable).
+pub type StabilityCriterion = fn(&EquilibriumProblem, &Equilibrium) -> f64;
+
+/// The envelope's criterion (SPEC §6): the smallest tension of the
+/// blown-down tether, and unstable (`−(1 − r)F`) when it is slack or the
+/// equilibrium did not converge.
+pub fn string_tension_criterion(problem: &EquilibriumProblem, eq: &Equilibrium) -> f64 {
+    if eq.slack || !eq.converged || eq.min_tension_n <= 0.0 {
+        -problem.body.net_buoyancy_n
+    } else {
+        eq.min_tension_n
+    }
+}
+
+/// What [`string_tension_criterion`] is, for the answer.
+pub const STRING_TENSION_CRITERION: &str = "string tension criterion on the steady-wind equilibrium \
+(as the operating envelope): the smallest tension of the blown-down tether with the reserve buoyancy, less \
+(m + ρA L)L̈ + ρA L̇², must stay ≥ ε(1−r)F; a slack tether (touching the ground) is unstable";
+
+/// A steady wind and the aerodynamic data of the tether and the aerostat.
+#[derive(Clone, Debug)]
+pub struct SteadyWind {
+    /// The tether (its `mass_per_length_kg_m` is replaced by the system's).
+    pub cable: Cable,
+    /// The aerostat (its `net_buoyancy_n` is replaced by the system's).
+    pub body: Body,
+    pub wind: WindProfile,
+    pub air_density_kg_m3: f64,
+    pub config: EquilibriumConfig,
+    pub criterion: StabilityCriterion,
+    /// Its description.
+    pub criterion_name: &'static str,
+}
+
+impl SteadyWind {
+    /// With the envelope's criterion and 100 RK4 steps.
+    pub fn new(cable: Cable, body: Body, wind: WindProfile, air_density_kg_m3: f64) -> Self {
+        Self {
+            cable,
+            body,
+            wind,
+            air_density_kg_m3,
+            config: EquilibriumConfig {
+                keep_shape: false,
+                ..EquilibriumConfig::default()
+            },
+            criterion: string_tension_criterion,
+            criterion_name: STRING_TENSION_CRITERION,
+        }
+    }
+
+    /// The equilibrium problem at a length with a net buoyancy.
+    pub fn problem(
+        &self,
+        s: &AerostatSystem,
+        buoyancy_n: f64,
+        length_m: f64,
+    ) -> EquilibriumProblem {
+        let mut cable = self.cable.clone();
+        cable.mass_per_length_kg_m = s.mass_per_length_kg_m;
+        cable.axial_stiffness_n = None;
+        let mut body = self.body.clone();
+        body.net_buoyancy_n = buoyancy_n;
+        EquilibriumProblem {
+            cable,
+            body,
+            wind: self.wind.clone(),
+            air_density_kg_m3: self.air_density_kg_m3,
+            tether_length_m: length_m,
+            gravity_m_s2: s.gravity_m_s2,
+        }
+    }
+
+    fn solve(&self, problem: &EquilibriumProblem) -> Option<Equilibrium> {
+        problem.solve(&self.config).ok()
+    }
+
+    /// `S(L)` with the reserve buoyancy (N).
+    pub fn stability_tension_n(&self, p: &PlanProblem, length_m: f64) -> f64 {
+        let pr = self.problem(&p.system, p.reserve_buoyancy_n(), length_m);
+        match self.solve(&pr) {
+            Some(eq) => (self.criterion)(&pr, &eq),
+            None => -p.reserve_buoyancy_n(),
+        }
+    }
+
+    /// Winch tension, top tension and altitude with the full buoyancy.
+    pub fn operating(&self, s: &AerostatSystem, length_m: f64) -> (f64, f64, f64) {
+        let pr = self.problem(s, s.net_buoyancy_n, length_m);
+        match self.solve(&pr) {
+            Some(eq) => (eq.winch_tension_n, eq.top_tension_n, eq.altitude_m),
+            None => (f64::NAN, f64::NAN, f64::NAN),
+        }
+    }
+}
+
+/// The air of a plan.
+#[derive(Clone, Debug, Default)]
+pub enum Air {
+    #[default]
+    Calm,
+    Wind(Box<SteadyWind>),
+}
+
+/// Bisection steps of the lift limit and of the length for an altitude.
+pub const LENGTH_BISECTIONS: usize = 48;
+
+impl Air {
+    pub fn is_calm(&self) -> bool {
+        matches!(self, Self::Calm)
+    }
+
+    /// The loads at rest at one length.
+    pub fn rest_loads(&self, p: &PlanProblem, length_m: f64) -> RestLoads {
+        let s = &p.system;
+        match self {
+            Self::Calm => {
+                let w = s.mass_per_length_kg_m * s.gravity_m_s2 * length_m;
+                RestLoads {
+                    stability_tension_n: p.reserve_buoyancy_n() - w,
+                    winch_tension_n: s.net_buoyancy_n - w,
+                    top_tension_n: s.net_buoyancy_n,
+                    altitude_m: length_m,
+                }
+            }
+            Self::Wind(w) => {
+                let (winch, top, alt) = w.operating(s, length_m);
+                RestLoads {
+                    stability_tension_n: w.stability_tension_n(p, length_m),
+                    winch_tension_n: winch,
+                    top_tension_n: top,
+                    altitude_m: alt,
+                }
+            }
+        }
+    }
+
+    /// `S(L)` at every length (on rayon in wind).
+    pub fn stability_tensions_n(&self, p: &PlanProblem, lengths: &[f64]) -> Vec<f64> {
+        match self {
+            Self::Calm => lengths
+                .iter()
+                .map(|&l| self.rest_loads(p, l).stability_tension_n)
+                .collect(),
+            Self::Wind(w) => lengths
+                .par_iter()
+                .map(|&l| w.stability_tension_n(p, l))
+                .collect(),
+        }
+    }
+
+    /// `(T_w, T_t)` with the full buoyancy at every length (on rayon in wind).
+    pub fn operating_tensions_n(&self, p: &PlanProblem, lengths: &[f64]) -> Vec<(f64, f64)> {
+        match self {
+            Self::Calm => lengths
+                .iter()
+                .map(|&l| {
+                    let r = self.rest_loads(p, l);
+                    (r.winch_tension_n, r.top_tension_n)
+                })
+                .collect(),
+            Self::Wind(w) => lengths
+                .par_iter()
+                .map(|&l| {
+                    let (wt, tt, _) = w.operating(&p.system, l);
+                    (wt, tt)
+                })
+                .collect(),
+        }
+    }
+
+    /// The longest length whose rest state keeps the margin, `S(L) ≥
+    /// ε(1 − r)F` (m): the static lift limit. Calm air: the closed form
+    /// [`PlanProblem::lift_limit_m`]; wind: bisection
+    /// ([`LENGTH_BISECTIONS`] steps) below the calm-air limit (the wind
+    /// only shortens it for this criterion when the tether goes slack;
+    /// `S` is taken as decreasing in `L`).
+    pub fn lift_limit_m(&self, p: &PlanProblem) -> f64 {
+        let calm = p.lift_limit_m();
+        let Self::Wind(w) = self else {
+            return calm;
+        };
+        let need = STABILITY_MARGIN * p.reserve_buoyancy_n();
+        let ok = |l: f64| w.stability_tension_n(p, l) >= need;
+        if ok(calm) {
+            return calm;
+        }
+        let (mut lo, mut hi) = (0.0, calm);
+        for _ in 0..LENGTH_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if ok(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    }
+
+    /// The tether length at which the aerostat (full buoyancy) flies at
+    /// `altitude_m`, searched up to `max_length_m` by bisection on the
+    /// equilibrium altitude ([`LENGTH_BISECTIONS`] steps, taken as
+    /// increasing in `L`). Calm air: the altitude itself. `Err(reachable)`
+    /// with the altitude at `max_length_m` when it is lower.
+    pub fn length_for_altitude(
+        &self,
+        s: &AerostatSystem,
+        altitude_m: f64,
+        max_length_m: f64,
+    ) -> Result<f64, f64> {
+        let Self::Wind(w) = self else {
+            return Ok(altitude_m);
+        };
+        let alt = |l: f64| w.operating(s, l).2;
+        let top = alt(max_length_m);
+        if !(top >= altitude_m) {
+            return Err(if top.is_finite() { top } else { 0.0 });
+        }
+        let (mut lo, mut hi) = (altitude_m.min(max_length_m), max_length_m);
+        if alt(lo) >= altitude_m {
+            return Ok(lo);
+        }
+        for _ in 0..LENGTH_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if alt(mid) >= altitude_m {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Ok(hi)
+    }
+}
