@@ -1,7 +1,8 @@
 //! The calm-air plan (SPEC §7, issue target ≤ 100 ms; awebox takes about
 //! 4 s per solve of its problem): the speed-profile pass alone, and the
 //! whole request (pass, bound, constant-rate comparison, FE transient check
-//! of the schedule at 50 elements, haul-down deadline).
+//! of the schedule at 50 elements, haul-down deadline), and a plan in a
+//! log-law wind with a jerk limit (issue target ≤ 5 s).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use serde_json::json;
@@ -37,6 +38,31 @@ fn bench(c: &mut Criterion) {
     c.bench_function("plan_request_thesis_1200m_calm", |b| {
         b.iter(|| plan(std::hint::black_box(&req), &NoProgress).unwrap())
     });
+    // Wind (issue target ≤ 5 s): log-law wind 3 m/s at 10 m (about 5.4 m/s
+    // at 1000 m), equilibria at every node of the pass, with a jerk limit
+    // and a tension rating.
+    let windy: PlanRequest = serde_json::from_value(json!({
+        "cable": {"mass_per_length_kg_m": 0.078},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+        "initial_length_m": 1.0,
+        "target_elevation_m": 1000.0,
+        "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0, "max_jerk_m_s3": 1.0},
+        "lift_reserve_nondim": 0.05,
+        "tether": {"breaking_strength_n": 20000.0, "safety_factor_nondim": 5.0},
+        "wind": {"flow": {"kind": "log_law", "reference_speed_m_s": 3.0, "roughness_length_m": 0.03},
+                 "cable_diameter_m": 0.006, "aerostat_drag_coefficient_nondim": 0.47,
+                 "aerostat_reference_area_m2": 3.0},
+        "haul_down": {"forecast": [{"time_s": 0.0, "wind_speed_m_s": 5.0}, {"time_s": 3600.0, "wind_speed_m_s": 15.0}],
+                      "max_operating_wind_m_s": 12.0}
+    }))
+    .unwrap();
+    assert!(plan(&windy, &NoProgress).unwrap().feasible);
+    let mut group = c.benchmark_group("plan_wind");
+    group.sample_size(10);
+    group.bench_function("plan_request_1000m_log_law_wind_jerk_rated", |b| {
+        b.iter(|| plan(std::hint::black_box(&windy), &NoProgress).unwrap())
+    });
+    group.finish();
 }
 
 criterion_group!(benches, bench);

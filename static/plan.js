@@ -30,6 +30,25 @@
   const inputs = () => Array.from(form.querySelectorAll("[data-plan-field]"));
   const byField = (f) => form.querySelector(`[data-plan-field="${f}"]`);
 
+  // Optional jerk limit, placed after the winch acceleration (empty: none).
+  (function addJerkField() {
+    const acc = byField("winch.max_acceleration_m_s2");
+    if (!acc || byField("winch.max_jerk_m_s3")) return;
+    const field = document.createElement("div");
+    field.className = "field";
+    const label = document.createElement("label");
+    label.htmlFor = "plan-jerk";
+    label.textContent = "Winch max jerk (m/s³, optional)";
+    const input = document.createElement("input");
+    input.id = "plan-jerk";
+    input.dataset.planField = "winch.max_jerk_m_s3";
+    input.inputMode = "decimal";
+    input.placeholder = "none";
+    input.value = "";
+    field.append(label, input);
+    acc.closest(".field").after(field);
+  })();
+
   function num(field) {
     const el = byField(field);
     const text = el.value.trim();
@@ -59,6 +78,8 @@
       lift_reserve_nondim: num("lift_reserve_nondim"),
       samples: 61,
     };
+    const jerk = num("winch.max_jerk_m_s3");
+    if (jerk !== null) body.winch.max_jerk_m_s3 = jerk;
     const breaking = num("tether.breaking_strength_n");
     if (breaking !== null) body.tether = { breaking_strength_n: breaking, safety_factor_nondim: num("tether.safety_factor_nondim") ?? 5 };
     const forecast = byField("haul_down.forecast").value.trim();

@@ -592,3 +592,65 @@ fn wind_lowers_the_reachable_altitude_and_lengthens_the_plan() {
         r.reason
     );
 }
+
+// ------------------------------------------------------- transient check
+
+#[test]
+fn the_transient_check_is_converged_in_its_table_and_its_step() {
+    // The check drives the FE run with a rate table on the schedule's own
+    // knots (exact for constant-acceleration pieces). Reference: a uniform
+    // table of 2000 intervals and half the time step. Peak tip deflection
+    // within 1 %.
+    use tetherplan::numerics::plan::retrieval;
+    use tetherplan::numerics::profile::Profile;
+    use tetherplan::numerics::string::transient::{self, InitialState, Silent, TransientConfig};
+    for (reserve, acc) in [(0.05, 2.0), (0.075, 6.0)] {
+        let p = PlanProblem::new(
+            AerostatSystem::thesis(),
+            1200.0,
+            Winch::new(40.0, acc).unwrap(),
+            reserve,
+            None,
+        )
+        .unwrap();
+        let PlanOutcome::Feasible(s) = schedule::fastest(&p) else {
+            panic!("feasible")
+        };
+        let model = StringModel::new(p.system, 50).unwrap();
+        let check = retrieval::check_transient(&model, &s, 0.1, &Silent).unwrap();
+        let k = 2000;
+        let points: Vec<(f64, f64)> = (0..=k)
+            .map(|j| {
+                let t = s.duration_s * j as f64 / k as f64;
+                (t, if j == k { 0.0 } else { s.at(t).rate_m_s })
+            })
+            .collect();
+        let profile = Profile::piecewise_linear_rate(1.0, &points, None).unwrap();
+        let config = TransientConfig {
+            duration_s: s.duration_s,
+            time_step_s: Some(0.5 * check.time_step_s),
+            samples: 2000,
+            initial: InitialState::Mode {
+                mode: 1,
+                tip_deflection_m: 0.1,
+            },
+            aero: None,
+            eigen: None,
+        };
+        let run = transient::simulate(&model, &profile, &config, &Silent).unwrap();
+        let peak = run
+            .samples
+            .iter()
+            .map(|x| x.tip_envelope_m.max(x.tip_deflection_m.abs()))
+            .fold(0.0, f64::max);
+        let rel = check.peak_tip_deflection_m / peak - 1.0;
+        eprintln!(
+            "r = {reserve}, a = {acc}: check peak {:.5} m ({} steps), reference {peak:.5} m ({} steps): {:+.3} %",
+            check.peak_tip_deflection_m,
+            check.steps,
+            run.steps,
+            100.0 * rel
+        );
+        assert!(rel.abs() < 0.01, "{rel}");
+    }
+}

@@ -29,6 +29,9 @@
 //! Aerodynamic forces of the aerostat's own motion (payout speed against
 //! the wind) are neglected: the loads are those of the steady wind.
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
 use rayon::prelude::*;
 
 use crate::numerics::params::AerostatSystem;
@@ -123,6 +126,10 @@ pub struct SteadyWind {
     pub criterion: StabilityCriterion,
     /// Its description.
     pub criterion_name: &'static str,
+    /// Answers already computed, by (length, buoyancy, kind) bits: the
+    /// pass, the bound, the constant-rate plan and the jerk check of one
+    /// request share their grid's lengths.
+    cache: Arc<Mutex<HashMap<CacheKey, [f64; 3]>>>,
 }
 
 impl SteadyWind {
@@ -139,7 +146,19 @@ impl SteadyWind {
             },
             criterion: string_tension_criterion,
             criterion_name: STRING_TENSION_CRITERION,
+            cache: Arc::default(),
         }
+    }
+
+    fn cached(&self, key: CacheKey, f: impl FnOnce() -> [f64; 3]) -> [f64; 3] {
+        if let Some(v) = self.cache.lock().ok().and_then(|c| c.get(&key).copied()) {
+            return v;
+        }
+        let v = f();
+        if let Ok(mut c) = self.cache.lock() {
+            c.insert(key, v);
+        }
+        v
     }
 
     /// The equilibrium problem at a length with a net buoyancy.
@@ -170,21 +189,44 @@ impl SteadyWind {
 
     /// `S(L)` with the reserve buoyancy (N).
     pub fn stability_tension_n(&self, p: &PlanProblem, length_m: f64) -> f64 {
-        let pr = self.problem(&p.system, p.reserve_buoyancy_n(), length_m);
-        match self.solve(&pr) {
-            Some(eq) => (self.criterion)(&pr, &eq),
-            None => -p.reserve_buoyancy_n(),
-        }
+        let b = p.reserve_buoyancy_n();
+        let key = key(&p.system, length_m, b, self.criterion as usize, 0);
+        self.cached(key, || {
+            let pr = self.problem(&p.system, b, length_m);
+            let st = match self.solve(&pr) {
+                Some(eq) => (self.criterion)(&pr, &eq),
+                None => -b,
+            };
+            [st, 0.0, 0.0]
+        })[0]
     }
 
     /// Winch tension, top tension and altitude with the full buoyancy.
     pub fn operating(&self, s: &AerostatSystem, length_m: f64) -> (f64, f64, f64) {
-        let pr = self.problem(s, s.net_buoyancy_n, length_m);
-        match self.solve(&pr) {
-            Some(eq) => (eq.winch_tension_n, eq.top_tension_n, eq.altitude_m),
-            None => (f64::NAN, f64::NAN, f64::NAN),
-        }
+        let key = key(s, length_m, s.net_buoyancy_n, 0, 1);
+        let [w, t, a] = self.cached(key, || {
+            let pr = self.problem(s, s.net_buoyancy_n, length_m);
+            match self.solve(&pr) {
+                Some(eq) => [eq.winch_tension_n, eq.top_tension_n, eq.altitude_m],
+                None => [f64::NAN; 3],
+            }
+        });
+        (w, t, a)
     }
+}
+
+/// (length, buoyancy, ρA, g, criterion) bits and the kind of answer.
+type CacheKey = (u64, u64, u64, u64, usize, u8);
+
+fn key(s: &AerostatSystem, length_m: f64, buoyancy_n: f64, criterion: usize, kind: u8) -> CacheKey {
+    (
+        length_m.to_bits(),
+        buoyancy_n.to_bits(),
+        s.mass_per_length_kg_m.to_bits(),
+        s.gravity_m_s2.to_bits(),
+        criterion,
+        kind,
+    )
 }
 
 /// The air of a plan.

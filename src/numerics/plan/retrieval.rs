@@ -101,17 +101,41 @@ pub struct TransientCheck {
     pub outcome: RunOutcome,
 }
 
-/// The schedule as a piecewise-linear rate table on a uniform time grid
-/// (exact where the rate is linear; the corners are cut by at most one
-/// interval), holding at rest after the end.
+/// The schedule as a piecewise-linear rate table: the schedule's own knots
+/// (exact for a piecewise constant-acceleration schedule, whose rate is
+/// piecewise linear), each interval with a jerk split into pieces of about
+/// `h = duration / TRANSIENT_TABLE_INTERVALS`, and knots closer than `h`
+/// to the last one kept dropped (a schedule riding the stability ceiling
+/// has one knot per grid segment: its corners are then cut by at most
+/// `h`, as on a uniform table). Holding at rest after the end. Few points
+/// keep the run cheap: the profile's evaluation at every time step is
+/// linear in the table's length.
 pub fn rate_table(s: &Schedule, initial_length_m: f64) -> Result<Profile, TransientError> {
-    let k = TRANSIENT_TABLE_INTERVALS;
-    let mut points: Vec<(f64, f64)> = (0..=k)
-        .map(|j| {
-            let t = s.duration_s * j as f64 / k as f64;
-            (t, s.at(t).rate_m_s)
-        })
-        .collect();
+    let h = s.duration_s / TRANSIENT_TABLE_INTERVALS as f64;
+    let mut candidates: Vec<f64> = Vec::with_capacity(s.knots.len() + 16);
+    for w in s.knots.windows(2) {
+        let (t0, t1) = (w[0].time_s, w[1].time_s);
+        candidates.push(t0);
+        if w[0].jerk_m_s3 != 0.0 && t1 - t0 > h {
+            let pieces = ((t1 - t0) / h).ceil() as usize;
+            candidates.extend((1..pieces).map(|q| t0 + (t1 - t0) * q as f64 / pieces as f64));
+        }
+    }
+    let mut times: Vec<f64> = vec![0.0];
+    for t in candidates {
+        if t - times[times.len() - 1] >= h * (1.0 - 1e-9) {
+            times.push(t);
+        }
+    }
+    let end = s.duration_s;
+    if end - times[times.len() - 1] < h * (1.0 - 1e-9) && times.len() > 1 {
+        times.pop();
+    }
+    times.push(end);
+    let mut points: Vec<(f64, f64)> = times.iter().map(|&t| (t, s.at(t).rate_m_s)).collect();
+    if let Some(first) = points.first_mut() {
+        first.1 = 0.0;
+    }
     if let Some(last) = points.last_mut() {
         last.1 = 0.0;
     }
