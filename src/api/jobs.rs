@@ -65,6 +65,8 @@ pub const JOB_RESULT_SCHEMAS: &[&str] = &[
     "EquilibriumResponse",
     "EnvelopeResponse",
     "BandsResponse",
+    "PlanBandsResponse",
+    "EnvelopeBandsResponse",
     "BatchOutcome",
 ];
 

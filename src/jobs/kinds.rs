@@ -571,6 +571,10 @@ job_kinds!(
     Envelope(crate::contract::envelope::dto::EnvelopeRequest),
     /// `POST /api/v1/bands`, up to 2 000 000 chart points (samples × rates).
     Bands(crate::contract::bands::BandsRequest),
+    /// `POST /api/v1/plan/bands`.
+    PlanBands(crate::contract::bands::PlanBandsRequest),
+    /// `POST /api/v1/envelope/bands`, up to 2 000 000 equilibria (samples × cells).
+    EnvelopeBands(crate::contract::bands::EnvelopeBandsRequest),
 );
 
 impl JobItem {
@@ -697,6 +701,8 @@ pub const ITEM_RESULT_SCHEMAS: &[&str] = &[
     "EquilibriumResponse",
     "EnvelopeResponse",
     "BandsResponse",
+    "PlanBandsResponse",
+    "EnvelopeBandsResponse",
 ];
 
 fn item_result_schema() -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {
@@ -847,6 +853,9 @@ mod tests {
 
     fn valid(kind: &str) -> Value {
         if let Some(v) = crate::jobs::tether::example_request(kind) {
+            return v;
+        }
+        if let Some(v) = crate::jobs::bands::example_request(kind) {
             return v;
         }
         let mut v = json!({"cable": {"mass_per_length_kg_m": 0.078}, "aerostat": {"net_buoyancy_n": 1000.0}});
