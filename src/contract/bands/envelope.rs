@@ -282,11 +282,8 @@ pub fn envelope_bands(
 ) -> Result<EnvelopeBandsResponse, RequestError> {
     let prep = prepare_envelope_bands(req)?;
     let (problem, config) = req.envelope.problem()?;
-    let nominal = crate::contract::envelope::envelope(
-        &req.envelope,
-        parallelism,
-        &common::Silent(progress),
-    )?;
+    let nominal =
+        crate::contract::envelope::envelope(&req.envelope, parallelism, &common::Silent(progress))?;
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
@@ -313,7 +310,10 @@ pub fn envelope_bands(
                     .iter()
                     .map(|pt| CellValue {
                         max_tension_n: pt.equilibrium.max_tension_n,
-                        tension_exceeded: pt.equilibrium.safety_factor.is_some_and(|f| f < required),
+                        tension_exceeded: pt
+                            .equilibrium
+                            .safety_factor
+                            .is_some_and(|f| f < required),
                         unstable: pt.verdict.stable == Some(false),
                         outside: pt.verdict.limit.is_some(),
                     })
@@ -408,8 +408,10 @@ mod tests {
             "uncertainty.inputs[0]"
         );
         assert_eq!(
-            field_of(body(json!({"uncertainty": {"seed": 9007199254740992_u64, "inputs": [
-                {"field": "cable.diameter_m", "distribution": "normal", "mean": 0.006, "std_dev": 0.0001}]}}))),
+            field_of(body(
+                json!({"uncertainty": {"seed": 9007199254740992_u64, "inputs": [
+                {"field": "cable.diameter_m", "distribution": "normal", "mean": 0.006, "std_dev": 0.0001}]}})
+            )),
             "uncertainty.seed"
         );
     }
@@ -429,7 +431,11 @@ mod tests {
         for (c, p) in r.cells.iter().zip(&r.envelope.points) {
             let t = p.max_tension_n;
             assert_eq!(
-                (c.max_tension_n.p05, c.max_tension_n.p50, c.max_tension_n.p95),
+                (
+                    c.max_tension_n.p05,
+                    c.max_tension_n.p50,
+                    c.max_tension_n.p95
+                ),
                 (t, t, t)
             );
             let outside = c.probability_outside.probability_nondim;

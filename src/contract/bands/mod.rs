@@ -27,6 +27,8 @@ pub mod plan;
 pub mod run;
 
 pub use dto::{BandsRequest, BandsResponse};
-pub use envelope::{EnvelopeBandsRequest, EnvelopeBandsResponse, envelope_bands, parse_envelope_bands};
+pub use envelope::{
+    EnvelopeBandsRequest, EnvelopeBandsResponse, envelope_bands, parse_envelope_bands,
+};
 pub use plan::{PlanBandsRequest, PlanBandsResponse, parse_plan_bands, plan_bands};
 pub use run::{bands, evaluations, parse_bands, prepare};

@@ -320,9 +320,8 @@ fn trace(
         let d_winch = d_f - d_m * a - d_weight * l;
         let winch = k.winch + d_winch;
         let top = |sys: &AerostatSystem| sys.net_buoyancy_n - sys.aerostat_mass_kg * a;
-        let calm_winch = |sys: &AerostatSystem| {
-            top(sys) - sys.mass_per_length_kg_m * (sys.gravity_m_s2 + a) * l
-        };
+        let calm_winch =
+            |sys: &AerostatSystem| top(sys) - sys.mass_per_length_kg_m * (sys.gravity_m_s2 + a) * l;
         let max = k.max + (top(s).max(calm_winch(s)) - top(n).max(calm_winch(n)));
         let effective_reserve =
             k.effective_reserve + ((1.0 - reserve) * d_f - d_m * a - d_weight * l - d_kinematic);
@@ -488,7 +487,9 @@ mod tests {
             "uncertainty.inputs[0].field"
         );
         assert_eq!(
-            field_of(body(json!({"uncertainty": {"samples": 10, "extra": 1, "inputs": []}}))),
+            field_of(body(
+                json!({"uncertainty": {"samples": 10, "extra": 1, "inputs": []}})
+            )),
             "uncertainty.extra"
         );
         assert_eq!(
@@ -497,7 +498,9 @@ mod tests {
             "uncertainty.inputs[0]"
         );
         assert_eq!(
-            field_of(body(json!({"winch": {"max_rate_m_s": -1.0, "max_acceleration_m_s2": 2.0}}))),
+            field_of(body(
+                json!({"winch": {"max_rate_m_s": -1.0, "max_acceleration_m_s2": 2.0}})
+            )),
             "winch.max_rate_m_s"
         );
     }
