@@ -379,3 +379,26 @@ async fn plan_and_envelope_bands_jobs_run_to_the_synchronous_answer() {
         assert_eq!(without_timing(v["result"].clone()), without_timing(sync));
     }
 }
+
+/// The size estimates of the two job kinds bound their real answers.
+#[test]
+fn plan_and_envelope_bands_estimates_bound_the_answers() {
+    use tetherplan::jobs::kinds::JobSubmission;
+    let limits = Limits::default();
+    for (kind, b) in [
+        ("plan_bands", plan_body(50)),
+        ("envelope_bands", envelope_body(20)),
+    ] {
+        let body = serde_json::to_vec(&json!({"kind": kind, "request": b})).unwrap();
+        let JobSubmission::One(item) = JobSubmission::parse(&body, &limits).unwrap() else {
+            panic!()
+        };
+        let estimate = item.estimate().result_bytes;
+        let real = JobSubmission::parse(&body, &limits)
+            .unwrap()
+            .run(&NoProgress)
+            .unwrap()
+            .len() as u64;
+        assert!(real <= estimate, "{kind}: {real} > {estimate}");
+    }
+}
