@@ -57,6 +57,42 @@ fn timed_runs_at(tolerance: f64) {
     );
 }
 
+/// Plan bands (the nominal plan once, 1000 samples over its schedule) and
+/// envelope bands (200 samples × the 42-cell example envelope), median of 3.
+fn plan_and_envelope_runs() {
+    let median = |f: &dyn Fn()| {
+        let mut t: Vec<f64> = (0..3)
+            .map(|_| {
+                let start = Instant::now();
+                f();
+                start.elapsed().as_secs_f64()
+            })
+            .collect();
+        t.sort_by(f64::total_cmp);
+        t[1]
+    };
+    let example = |schema: utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>| {
+        serde_json::to_value(&schema).unwrap()["example"].clone()
+    };
+    use utoipa::PartialSchema;
+    let plan = bands::parse_plan_bands(
+        &serde_json::to_vec(&example(bands::PlanBandsRequest::schema())).unwrap(),
+    )
+    .unwrap();
+    let t = median(&|| {
+        bands::plan_bands(&plan, Parallelism::Rayon, &NoProgress).unwrap();
+    });
+    println!("bands/plan_bands_example (1000 samples, 101 schedule samples): median {t:.3} s");
+    let env = bands::parse_envelope_bands(
+        &serde_json::to_vec(&example(bands::EnvelopeBandsRequest::schema())).unwrap(),
+    )
+    .unwrap();
+    let t = median(&|| {
+        bands::envelope_bands(&env, Parallelism::Rayon, &NoProgress).unwrap();
+    });
+    println!("bands/envelope_bands_example (200 samples × 42 cells): median {t:.3} s");
+}
+
 fn small(c: &mut Criterion) {
     let req = request(100, 100);
     let mut group = c.benchmark_group("bands");
@@ -72,5 +108,6 @@ fn main() {
     let mut c = Criterion::default().configure_from_args();
     small(&mut c);
     timed_runs();
+    plan_and_envelope_runs();
     c.final_summary();
 }

@@ -27,6 +27,30 @@
       lift_reserve_nondim: "0.075" },
   };
 
+  // Uncertainty bands (issue 14): a fieldset added by this script. When
+  // checked, the plan goes to /api/v1/plan/bands and the tension and margin
+  // plots shade the 5–95 % band of the samples around the plan's traces.
+  const bandsBox = document.createElement("fieldset");
+  bandsBox.id = "plan-bands";
+  bandsBox.innerHTML = `<legend>Uncertainty (5–95 % bands, optional)</legend>
+    <div class="field"><label for="plan-bands-on"><input type="checkbox" id="plan-bands-on"> Shade the 5–95 % band</label></div>
+    <div class="field"><label for="plan-bands-lift-sd">σ of F (N)</label><input id="plan-bands-lift-sd" inputmode="decimal" value="50"></div>
+    <div class="field"><label for="plan-bands-rhoa-sd">σ of ρA (kg/m)</label><input id="plan-bands-rhoa-sd" inputmode="decimal" value="0.002"></div>
+    <div class="field"><label for="plan-bands-samples">Samples</label><input id="plan-bands-samples" inputmode="numeric" value="500"></div>
+    <div class="field"><label for="plan-bands-seed">Seed</label><input id="plan-bands-seed" inputmode="numeric" value="1"></div>
+    <p id="plan-bands-summary" class="note" hidden></p>`;
+  form.insertBefore(bandsBox, form.querySelector(".actions"));
+  const bandsOn = () => $("plan-bands-on").checked;
+
+  function uncertainty(body) {
+    const inputs = [];
+    const liftSd = Number($("plan-bands-lift-sd").value);
+    const rhoSd = Number($("plan-bands-rhoa-sd").value);
+    if (liftSd > 0) inputs.push({ field: "aerostat.net_buoyancy_n", distribution: "normal", mean: body.aerostat.net_buoyancy_n, std_dev: liftSd });
+    if (rhoSd > 0) inputs.push({ field: "cable.mass_per_length_kg_m", distribution: "normal", mean: body.cable.mass_per_length_kg_m, std_dev: rhoSd });
+    return { samples: Number($("plan-bands-samples").value), seed: Number($("plan-bands-seed").value), inputs };
+  }
+
   const inputs = () => Array.from(form.querySelectorAll("[data-plan-field]"));
   const byField = (f) => form.querySelector(`[data-plan-field="${f}"]`);
 
@@ -130,7 +154,7 @@
     return { width, height: Math.round(Math.min(260, Math.max(180, width * 0.55))) };
   }
 
-  function makePlot(el, yLabel, series, data) {
+  function makePlot(el, yLabel, series, data, bands) {
     el.textContent = "";
     const axis = { stroke: "#333", grid: { stroke: "#e5e5e5" }, ticks: { stroke: "#ccc" } };
     return new uPlot(
@@ -144,6 +168,7 @@
         ],
         legend: { live: true },
         cursor: { drag: { x: true, y: false } },
+        ...(bands ? { bands } : {}),
       },
       data,
       el,
@@ -168,10 +193,20 @@
       tension.push({ label: "allowable (N)", stroke: "#b00020", width: 1.5, dash: [6, 4], value: lv(1) });
       tdata.push(s.map(() => r.limits.allowable_tension_n));
     }
-    plots.tension = makePlot($("plan-plot-tension"), "Tension (N)", tension, tdata);
-    plots.margin = makePlot($("plan-plot-margin"), "Margin (m/s)",
-      [{ label: "stability margin (m/s)", stroke: "#1a7f37", width: 2, value: lv(2) }],
-      [t, col("stability_margin_m_s")]);
+    const b = lastBands && lastBands.instants.length === s.length ? lastBands.instants : null;
+    const shade = (series, data, key, color, d) => {
+      if (!b) return null;
+      const hi = series.length + 1;
+      series.push({ label: "95 %", stroke: color, width: 0.5, value: lv(d) }, { label: "5 %", stroke: color, width: 0.5, value: lv(d) });
+      data.push(b.map((x) => x[key].p95), b.map((x) => x[key].p05));
+      return [{ series: [hi, hi + 1], fill: "rgba(11,92,173,0.15)" }];
+    };
+    const tBands = shade(tension, tdata, "winch_tension_n", "#6b9bd1", 1);
+    plots.tension = makePlot($("plan-plot-tension"), "Tension (N)", tension, tdata, tBands);
+    const mseries = [{ label: "stability margin (m/s)", stroke: "#1a7f37", width: 2, value: lv(2) }];
+    const mdata = [t, col("stability_margin_m_s")];
+    const mBands = shade(mseries, mdata, "stability_margin_m_s", "#6fbf86", 2);
+    plots.margin = makePlot($("plan-plot-margin"), "Margin (m/s)", mseries, mdata, mBands);
   }
 
   // ---- tables ----
@@ -279,6 +314,7 @@
   }
 
   let last = null;
+  let lastBands = null;
 
   async function runPlan() {
     for (const el of inputs()) clearFieldError(el);
@@ -286,7 +322,10 @@
     status.dataset.state = "busy";
     status.textContent = "Planning…";
     writeUrl();
-    const res = await api("POST", "api/v1/plan", request());
+    const body = request();
+    const withBands = bandsOn();
+    if (withBands) body.uncertainty = uncertainty(body);
+    const res = await api("POST", withBands ? "api/v1/plan/bands" : "api/v1/plan", body);
     if (!res.ok) {
       const err = res.body?.error;
       status.dataset.state = "error";
@@ -306,8 +345,17 @@
       }
       return;
     }
-    last = res.body;
+    lastBands = withBands ? res.body : null;
+    last = withBands ? res.body.plan : res.body;
+    const summary = $("plan-bands-summary");
+    summary.hidden = !lastBands || !lastBands.probability_unstable;
+    if (!summary.hidden) {
+      const pc = (p) => (p ? `${fmt(100 * p.probability_nondim, 1)} % (95 %: ${fmt(100 * p.low_nondim, 1)}–${fmt(100 * p.high_nondim, 1)} %)` : "–");
+      summary.textContent = `${lastBands.valid_samples} samples: P(unstable somewhere) ${pc(lastBands.probability_unstable)}; ` +
+        `P(below the lift reserve) ${pc(lastBands.probability_below_reserve)}; P(over the rating) ${pc(lastBands.probability_over_rating)}.`;
+    }
     window.tetherplan = window.tetherplan || {};
+    window.tetherplan.planBands = lastBands;
     window.tetherplan.plan = last;
     window.tetherplan.planPlots = plots;
     showResult(last);
@@ -336,17 +384,33 @@
     const lines = ["# tetherplan deployment plan", `# verdict,${r.go ? "go" : "no-go"}`, `# reason,"${r.reason.replaceAll('"', "'")}"`];
     for (const [k, v] of flatten(r.inputs)) lines.push(`# input ${k},${v}`);
     lines.push(`# duration_s,${round(r.duration_s, 3)}`);
-    lines.push("time_s,length_m,rate_m_s,acceleration_m_s2,winch_tension_n,max_tension_n,rate_ceiling_m_s,stability_margin_m_s,effective_tension_margin_n");
-    for (const s of r.schedule) {
-      lines.push([round(s.time_s, 3), round(s.length_m, 3), round(s.rate_m_s, 4), round(s.acceleration_m_s2, 4),
-        round(s.winch_tension_n, 2), round(s.max_tension_n, 2), round(s.rate_ceiling_m_s, 4), round(s.stability_margin_m_s, 4),
-        round(s.effective_tension_margin_n, 2)].join(","));
+    const b = lastBands && lastBands.instants.length === r.schedule.length ? lastBands : null;
+    if (b) {
+      lines.push(`# uncertainty samples,${b.samples}`, `# uncertainty valid_samples,${b.valid_samples}`, `# uncertainty seed,${b.seed}`);
+      for (const [k, v] of flatten({ inputs: b.inputs })) lines.push(`# uncertainty ${k},${v}`);
+      for (const k of ["probability_unstable", "probability_below_reserve", "probability_over_rating"]) {
+        if (b[k]) lines.push(`# ${k},${b[k].probability_nondim},${b[k].low_nondim},${b[k].high_nondim}`);
+      }
     }
+    lines.push("time_s,length_m,rate_m_s,acceleration_m_s2,winch_tension_n,max_tension_n,rate_ceiling_m_s,stability_margin_m_s,effective_tension_margin_n" +
+      (b ? ",winch_tension_p05_n,winch_tension_p50_n,winch_tension_p95_n,max_tension_p05_n,max_tension_p95_n,stability_margin_p05_m_s,stability_margin_p50_m_s,stability_margin_p95_m_s" : ""));
+    r.schedule.forEach((s, i) => {
+      const row = [round(s.time_s, 3), round(s.length_m, 3), round(s.rate_m_s, 4), round(s.acceleration_m_s2, 4),
+        round(s.winch_tension_n, 2), round(s.max_tension_n, 2), round(s.rate_ceiling_m_s, 4), round(s.stability_margin_m_s, 4),
+        round(s.effective_tension_margin_n, 2)];
+      if (b) {
+        const x = b.instants[i];
+        row.push(round(x.winch_tension_n.p05, 2), round(x.winch_tension_n.p50, 2), round(x.winch_tension_n.p95, 2),
+          round(x.max_tension_n.p05, 2), round(x.max_tension_n.p95, 2),
+          round(x.stability_margin_m_s.p05, 4), round(x.stability_margin_m_s.p50, 4), round(x.stability_margin_m_s.p95, 4));
+      }
+      lines.push(row.join(","));
+    });
     return `${lines.join("\n")}\n`;
   }
 
   $("plan-csv").addEventListener("click", () => last && download("tetherplan-plan.csv", "text/csv", csv(last)));
-  $("plan-json").addEventListener("click", () => last && download("tetherplan-plan.json", "application/json", JSON.stringify(last, null, 2)));
+  $("plan-json").addEventListener("click", () => last && download("tetherplan-plan.json", "application/json", JSON.stringify(lastBands ?? last, null, 2)));
   $("plan-print").addEventListener("click", () => window.print());
   $("plan-preset").addEventListener("change", (e) => {
     applyPreset(e.target.value);

@@ -239,3 +239,166 @@ fn the_cli_prints_the_same_answer() {
     assert_eq!(code, 2);
     assert_eq!(v["error"]["field"], "uncertainty.inputs[0].field");
 }
+
+// ------------------------------------------- plan and envelope bands
+
+fn plan_body(samples: usize) -> Value {
+    json!({
+        "cable": {"mass_per_length_kg_m": 0.078},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+        "target_elevation_m": 1200.0,
+        "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0},
+        "tether": {"breaking_strength_n": 5200.0},
+        "samples": 41,
+        "uncertainty": {"samples": samples, "seed": 5, "inputs": [
+            {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 50.0}
+        ]}
+    })
+}
+
+fn envelope_body(samples: usize) -> Value {
+    json!({
+        "cable": {"preset": "dyneema", "diameter_m": 0.006},
+        "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
+                     "reference_area_m2": 20.0},
+        "wind": {"shape": {"kind": "uniform"}},
+        "wind_speeds_m_s": {"min": 0.0, "max": 20.0, "count": 3},
+        "tether_lengths_m": {"min": 100.0, "max": 2000.0, "count": 4},
+        "payout_rate_m_s": 5.0,
+        "uncertainty": {"samples": samples, "seed": 5, "inputs": [
+            {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 2000.0, "std_dev": 100.0},
+            {"field": "cable.breaking_strength_n", "distribution": "lognormal", "mean": 9000.0, "std_dev": 900.0}
+        ]}
+    })
+}
+
+fn without_timing(mut v: Value) -> Value {
+    if v["plan"].is_object() {
+        v["plan"]["compute_time_s"] = json!(0.0);
+    }
+    v
+}
+
+#[tokio::test]
+async fn plan_and_envelope_bands_routes_answer_like_the_contract() {
+    let (app, _) = app();
+    let b = plan_body(300);
+    let (status, text) = send(&app, "POST", "/api/v1/plan/bands", Some(&b)).await;
+    assert_eq!(status, StatusCode::OK, "{text}");
+    let req = bands::parse_plan_bands(&serde_json::to_vec(&b).unwrap()).unwrap();
+    let direct = bands::plan_bands(&req, Parallelism::Rayon, &NoProgress).unwrap();
+    let got: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(
+        without_timing(got.clone()),
+        without_timing(serde_json::to_value(&direct).unwrap())
+    );
+    assert_eq!(
+        got["instants"].as_array().unwrap().len(),
+        got["plan"]["schedule"].as_array().unwrap().len()
+    );
+    assert!(got["probability_over_rating"]["probability_nondim"].is_number());
+
+    let b = envelope_body(50);
+    let (status, text) = send(&app, "POST", "/api/v1/envelope/bands", Some(&b)).await;
+    assert_eq!(status, StatusCode::OK, "{text}");
+    let req = bands::parse_envelope_bands(&serde_json::to_vec(&b).unwrap()).unwrap();
+    let direct = bands::envelope_bands(&req, Parallelism::Rayon, &NoProgress).unwrap();
+    assert_eq!(text, serde_json::to_string(&direct).unwrap());
+    let got: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(got["cells"].as_array().unwrap().len(), 12);
+    assert!(got["cells"][0]["probability_tension_exceeded"]["probability_nondim"].is_number());
+}
+
+#[tokio::test]
+async fn plan_and_envelope_bands_refuse_bad_input_naming_the_field() {
+    let (app, _) = app();
+    let mut b = plan_body(10);
+    b["uncertainty"]["inputs"][0]["field"] = json!("initial_length_m");
+    let (status, text) = send(&app, "POST", "/api/v1/plan/bands", Some(&b)).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{text}");
+    assert_eq!(
+        error(&text).1.as_deref(),
+        Some("uncertainty.inputs[0].field")
+    );
+    let mut b = plan_body(10);
+    b["jerk"] = json!(1.0);
+    let (status, text) = send(&app, "POST", "/api/v1/plan/bands", Some(&b)).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{text}");
+    assert_eq!(error(&text).1.as_deref(), Some("jerk"));
+    let mut b = envelope_body(10);
+    b["uncertainty"]["inputs"][1]["field"] = json!("cable.axial_stiffness_n");
+    b["cable"] =
+        json!({"mass_per_length_kg_m": 0.02, "diameter_m": 0.006, "breaking_strength_n": 9000.0});
+    let (status, text) = send(&app, "POST", "/api/v1/envelope/bands", Some(&b)).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{text}");
+    assert_eq!(
+        error(&text).1.as_deref(),
+        Some("uncertainty.inputs[1].field")
+    );
+    // too large to answer synchronously: a job
+    let b = envelope_body(5000);
+    let (status, text) = send(&app, "POST", "/api/v1/envelope/bands", Some(&b)).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{text}");
+    assert_eq!(
+        error(&text),
+        ("too_large".into(), Some("uncertainty.samples".into()))
+    );
+    assert!(text.contains("envelope_bands"), "{text}");
+}
+
+#[tokio::test]
+async fn plan_and_envelope_bands_jobs_run_to_the_synchronous_answer() {
+    let (app, queue) = app();
+    for (kind, b, path) in [
+        ("plan_bands", plan_body(200), "/api/v1/plan/bands"),
+        (
+            "envelope_bands",
+            envelope_body(30),
+            "/api/v1/envelope/bands",
+        ),
+    ] {
+        let (status, text) = send(
+            &app,
+            "POST",
+            "/api/v1/jobs",
+            Some(&json!({"kind": kind, "request": b})),
+        )
+        .await;
+        assert_eq!(status, StatusCode::ACCEPTED, "{text}");
+        let id = serde_json::from_str::<Value>(&text).unwrap()["id"]
+            .as_i64()
+            .unwrap();
+        let ran = try_execute_next(&queue).unwrap().unwrap();
+        assert_eq!((ran.id, ran.status), (id, JobStatus::Done));
+        let (_, text) = send(&app, "GET", &format!("/api/v1/jobs/{id}"), None).await;
+        let v: Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(v["kind"], kind);
+        assert_eq!(v["progress"], 1.0);
+        let (_, sync) = send(&app, "POST", path, Some(&b)).await;
+        let sync: Value = serde_json::from_str(&sync).unwrap();
+        assert_eq!(without_timing(v["result"].clone()), without_timing(sync));
+    }
+}
+
+/// The size estimates of the two job kinds bound their real answers.
+#[test]
+fn plan_and_envelope_bands_estimates_bound_the_answers() {
+    use tetherplan::jobs::kinds::JobSubmission;
+    let limits = Limits::default();
+    for (kind, b) in [
+        ("plan_bands", plan_body(50)),
+        ("envelope_bands", envelope_body(20)),
+    ] {
+        let body = serde_json::to_vec(&json!({"kind": kind, "request": b})).unwrap();
+        let JobSubmission::One(item) = JobSubmission::parse(&body, &limits).unwrap() else {
+            panic!()
+        };
+        let estimate = item.estimate().result_bytes;
+        let real = JobSubmission::parse(&body, &limits)
+            .unwrap()
+            .run(&NoProgress)
+            .unwrap()
+            .len() as u64;
+        assert!(real <= estimate, "{kind}: {real} > {estimate}");
+    }
+}

@@ -105,6 +105,22 @@ fn every_route_is_documented_with_its_statuses() {
         ),
         (
             "post",
+            "/api/v1/plan/bands",
+            "compute_plan_bands",
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
+        ),
+        (
+            "post",
+            "/api/v1/envelope/bands",
+            "compute_envelope_bands",
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
+        ),
+        (
+            "post",
             "/api/v1/jobs",
             "create_job",
             &[

@@ -66,6 +66,8 @@ pub const JOB_RESULT_SCHEMAS: &[&str] = &[
     "EnvelopeResponse",
     "BandsResponse",
     "PlanResponse",
+    "PlanBandsResponse",
+    "EnvelopeBandsResponse",
     "BatchOutcome",
 ];
 

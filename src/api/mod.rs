@@ -12,6 +12,7 @@
 pub mod assets;
 pub mod auth;
 pub mod auth_doc;
+pub mod bands;
 pub mod error;
 pub mod guard;
 pub mod jobs;
@@ -136,6 +137,8 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
         .route("/api/v1/envelope", post(tether::compute_envelope))
         .route("/api/v1/plan", post(solve::compute_plan))
         .route("/api/v1/bands", post(solve::compute_bands))
+        .route("/api/v1/plan/bands", post(bands::compute_plan_bands))
+        .route("/api/v1/envelope/bands", post(bands::compute_envelope_bands))
         .route("/api/v1/jobs", post(jobs::create_job).get(jobs::list_jobs))
         .route(
             "/api/v1/jobs/{id}",

@@ -37,6 +37,8 @@ use crate::jobs::store::JobStatus;
         crate::api::tether::compute_envelope,
         solve::compute_plan,
         solve::compute_bands,
+        crate::api::bands::compute_plan_bands,
+        crate::api::bands::compute_envelope_bands,
         jobs::create_job,
         jobs::list_jobs,
         jobs::get_job,
@@ -50,6 +52,7 @@ use crate::jobs::store::JobStatus;
         Health,
         crate::contract::ge_critical::GeCriticalResponse, crate::contract::ge_critical::GeStabilityResponse,
         Health, crate::contract::bands::BandsResponse,
+        crate::contract::bands::PlanBandsResponse, crate::contract::bands::EnvelopeBandsResponse,
     )),
     modifiers(&BearerTokens),
     tags(

@@ -573,6 +573,10 @@ job_kinds!(
     Bands(crate::contract::bands::BandsRequest),
     /// `POST /api/v1/plan`: the deployment plan (progress of its transient check).
     Plan(crate::contract::plan::PlanRequest),
+    /// `POST /api/v1/plan/bands`.
+    PlanBands(crate::contract::bands::PlanBandsRequest),
+    /// `POST /api/v1/envelope/bands`, up to 2 000 000 equilibria (samples × cells).
+    EnvelopeBands(crate::contract::bands::EnvelopeBandsRequest),
 );
 
 impl JobItem {
@@ -700,6 +704,8 @@ pub const ITEM_RESULT_SCHEMAS: &[&str] = &[
     "EnvelopeResponse",
     "BandsResponse",
     "PlanResponse",
+    "PlanBandsResponse",
+    "EnvelopeBandsResponse",
 ];
 
 fn item_result_schema() -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {
@@ -850,6 +856,9 @@ mod tests {
 
     fn valid(kind: &str) -> Value {
         if let Some(v) = crate::jobs::tether::example_request(kind) {
+            return v;
+        }
+        if let Some(v) = crate::jobs::bands::example_request(kind) {
             return v;
         }
         let mut v = json!({"cable": {"mass_per_length_kg_m": 0.078}, "aerostat": {"net_buoyancy_n": 1000.0}});

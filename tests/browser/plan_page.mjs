@@ -109,6 +109,40 @@ try {
   check((await again.inputValue("#plan-target")) === "1000", "the shared URL restores the form");
   await again.close();
 
+  phase = "bands";
+  await page.check("#plan-bands-on");
+  await page.fill("#plan-bands-samples", "300");
+  await page.click("#plan-button");
+  await page.waitForFunction(() => window.tetherplan?.planBands?.instants?.length > 0, null, { timeout: 60_000 });
+  const withBands = await page.evaluate(() => {
+    const b = window.tetherplan.planBands;
+    const plan = window.tetherplan.plan;
+    const plots = window.tetherplan.planPlots;
+    return {
+      aligned: b.instants.length === plan.schedule.length,
+      ordered: b.instants.every((x) => x.winch_tension_n.p05 <= x.winch_tension_n.p50 && x.winch_tension_n.p50 <= x.winch_tension_n.p95),
+      around: b.instants.every((x, i) => x.winch_tension_n.p05 <= plan.schedule[i].winch_tension_n + 1e-6 && plan.schedule[i].winch_tension_n <= x.winch_tension_n.p95 + 1e-6),
+      tensionSeries: plots.tension.series.length,
+      marginSeries: plots.margin.series.length,
+      bandsOpt: (plots.tension.bands ?? []).length,
+      summary: document.getElementById("plan-bands-summary").textContent,
+      valid: b.valid_samples,
+    };
+  });
+  check(withBands.aligned && withBands.ordered, "bands: one 5/50/95 % band per schedule instant, ordered");
+  check(withBands.around, "bands: the 5–95 % band of the winch tension brackets the plan's trace");
+  check(withBands.tensionSeries >= 5 && withBands.marginSeries === 4 && withBands.bandsOpt === 1,
+    `bands: shaded 5–95 % series on the tension and margin plots (${withBands.tensionSeries}, ${withBands.marginSeries}, ${withBands.bandsOpt})`);
+  check(/P\(unstable somewhere\)/.test(withBands.summary) && withBands.valid === 300, `bands: probabilities summarised (${withBands.summary})`);
+  const bandsCsvDownload = page.waitForEvent("download");
+  await page.click("#plan-csv");
+  const bandsCsvPath = await (await bandsCsvDownload).path();
+  const bandsCsv = bandsCsvPath ? (await import("node:fs")).readFileSync(bandsCsvPath, "utf8") : "";
+  check(bandsCsv.includes("winch_tension_p05_n") && bandsCsv.includes("# uncertainty inputs[0].field,aerostat.net_buoyancy_n"),
+    "bands: the CSV carries the percentiles and the uncertainty inputs");
+  await page.screenshot({ path: path.join(artifacts, "plan_page_bands.png"), fullPage: false });
+  await page.uncheck("#plan-bands-on");
+
   phase = "infeasible";
   await page.fill("#plan-target", "1290");
   await page.fill("#plan-reserve", "0.05");

@@ -9,12 +9,26 @@
 //!   (`aerostat.net_buoyancy_n`, …) resolved to a direct numeric setter
 //!   (no JSON round trip per sample), the ensemble on rayon
 //!   ([`crate::numerics::uncertainty`]) and the summaries.
+//! * [`plan`]: `POST /api/v1/plan/bands`, the nominal schedule under
+//!   uncertain inputs (probabilities of instability and of exceeding the
+//!   tether rating, bands of the plan's traces).
+//! * [`envelope`]: `POST /api/v1/envelope/bands`, per-cell probabilities
+//!   of exceeding the tension limit, of instability and of leaving the
+//!   envelope.
+//! * [`common`]: what the three share.
 //!
 //! The sampling layer is request-agnostic: a plan or envelope band needs
 //! only its own field table and per-sample evaluation.
 
+pub mod common;
 pub mod dto;
+pub mod envelope;
+pub mod plan;
 pub mod run;
 
 pub use dto::{BandsRequest, BandsResponse};
+pub use envelope::{
+    EnvelopeBandsRequest, EnvelopeBandsResponse, envelope_bands, parse_envelope_bands,
+};
+pub use plan::{PlanBandsRequest, PlanBandsResponse, parse_plan_bands, plan_bands};
 pub use run::{bands, evaluations, parse_bands, prepare};

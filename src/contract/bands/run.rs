@@ -82,11 +82,11 @@ impl SystemField {
     }
 
     /// Is zero allowed (`≥ 0`) or not (`> 0`)?
-    fn zero_allowed(self) -> bool {
+    pub(crate) fn zero_allowed(self) -> bool {
         matches!(self, Self::AerostatMass)
     }
 
-    fn in_range(self, v: f64) -> bool {
+    pub(crate) fn in_range(self, v: f64) -> bool {
         v.is_finite()
             && if self.zero_allowed() {
                 v >= 0.0
@@ -95,7 +95,7 @@ impl SystemField {
             }
     }
 
-    fn range_words(self) -> &'static str {
+    pub(crate) fn range_words(self) -> &'static str {
         if self.zero_allowed() {
             "must not be negative"
         } else {
@@ -106,7 +106,7 @@ impl SystemField {
 
 /// The system's numbers as the request gives them.
 #[derive(Clone, Copy, Debug)]
-struct RawSystem {
+pub(crate) struct RawSystem {
     mass_per_length: Option<f64>,
     density: Option<f64>,
     area: Option<f64>,
@@ -117,7 +117,7 @@ struct RawSystem {
 }
 
 impl RawSystem {
-    fn of(s: &SystemInput) -> Self {
+    pub(crate) fn of(s: &SystemInput) -> Self {
         Self {
             mass_per_length: s.cable.mass_per_length_kg_m,
             density: s.cable.density_kg_m3,
@@ -129,7 +129,7 @@ impl RawSystem {
         }
     }
 
-    fn has(&self, f: SystemField) -> bool {
+    pub(crate) fn has(&self, f: SystemField) -> bool {
         match f {
             SystemField::MassPerLength => self.mass_per_length.is_some(),
             SystemField::Density => self.density.is_some(),
@@ -138,7 +138,7 @@ impl RawSystem {
         }
     }
 
-    fn set(&mut self, f: SystemField, v: f64) {
+    pub(crate) fn set(&mut self, f: SystemField, v: f64) {
         match f {
             SystemField::NetBuoyancy => self.net_buoyancy = v,
             SystemField::AerostatMass => self.mass = v,
@@ -151,7 +151,7 @@ impl RawSystem {
     }
 
     /// The validated system (the same arithmetic as `SystemInput::system`).
-    fn system(&self) -> Result<AerostatSystem, InvalidInput> {
+    pub(crate) fn system(&self) -> Result<AerostatSystem, InvalidInput> {
         let rho_a = match (self.mass_per_length, self.density, self.area) {
             (Some(m), _, _) => m,
             (None, Some(rho), Some(a)) => rho * a,
@@ -187,7 +187,7 @@ pub fn evaluations(req: &BandsRequest) -> usize {
     rates.saturating_mul(req.params.uncertainty.samples)
 }
 
-fn distribution(input: &UncertainInput) -> Distribution {
+pub(crate) fn distribution(input: &UncertainInput) -> Distribution {
     match *input {
         UncertainInput::Normal { mean, std_dev, .. } => Distribution::Normal { mean, std_dev },
         UncertainInput::Uniform { low, high, .. } => Distribution::Uniform { low, high },
@@ -502,7 +502,7 @@ pub fn bands(
     })
 }
 
-fn percentile_band(b: uncertainty::Band) -> PercentileBand {
+pub(crate) fn percentile_band(b: uncertainty::Band) -> PercentileBand {
     let [q05, q50, q95] = b.quantiles;
     PercentileBand {
         p05: q05.value,
