@@ -17,4 +17,4 @@ pub mod dto;
 pub mod run;
 
 pub use dto::{BandsRequest, BandsResponse};
-pub use run::{bands, evaluations, parse_bands, prepare};
+pub use run::{bands, bands_chunk, bands_from_chunks, evaluations, parse_bands, prepare};
