@@ -313,31 +313,3 @@ pub fn execute_chunk(
     );
     Ok(Some((lease, ended)))
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn plans_cover_every_item_once() {
-        for items in [1usize, 2, 7, 100, 4097, 10_000] {
-            for cost in [1e-6, 0.01, 0.8, 5.0] {
-                let plan = ChunkPlan::for_cost(items, cost);
-                let mut next = 0;
-                for c in 0..plan.count() {
-                    let r = plan.range(c);
-                    assert_eq!(r.start, next);
-                    assert!(!r.is_empty());
-                    next = r.end;
-                }
-                assert_eq!(next, items, "{items} items at {cost} s");
-                if items as f64 * cost >= MIN_SPLIT_JOB_S {
-                    assert!(plan.per_chunk as f64 * cost <= CHUNK_TARGET_S.max(cost) + 1e-9);
-                    assert!(plan.count() >= MIN_CHUNKS.min(items), "{plan:?}");
-                } else {
-                    assert_eq!(plan.count(), 1);
-                }
-            }
-        }
-    }
-}
