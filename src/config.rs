@@ -18,6 +18,10 @@ pub struct ServeArgs {
     /// SQLite database of batch jobs (created if missing; WAL mode).
     #[arg(long, env = "TETHERPLAN_DB", default_value = "./tetherplan.db")]
     pub db: PathBuf,
+    /// PostgreSQL job store shared by API and worker processes
+    /// (`postgres://user:password@host:5432/db`); replaces `--db`.
+    #[arg(long, env = "TETHERPLAN_DATABASE_URL", hide_env_values = true)]
+    pub database_url: Option<String>,
     /// Directory served at `GET /` instead of the chart page built into the binary.
     #[arg(long, env = "TETHERPLAN_STATIC_DIR")]
     pub static_dir: Option<PathBuf>,
@@ -33,9 +37,10 @@ pub struct ServeArgs {
     /// Jobs queued or running at once; beyond: 429 with Retry-After.
     #[arg(long, env = "TETHERPLAN_MAX_PENDING_JOBS", default_value_t = Limits::default().max_pending_jobs)]
     pub max_pending_jobs: usize,
-    /// Threads of the job pool (0: one per core).
-    #[arg(long, env = "TETHERPLAN_JOB_THREADS", default_value_t = 0)]
-    pub job_threads: usize,
+    /// Threads of the job pool (default: one per core; 0: this process runs
+    /// no jobs, leaving them to `tetherplan worker` processes).
+    #[arg(long, env = "TETHERPLAN_JOB_THREADS")]
+    pub job_threads: Option<usize>,
     /// Host names requests may address besides loopback and the bind
     /// address (comma-separated; `*`: any). Others get 421.
     #[arg(long, env = "TETHERPLAN_ALLOWED_HOSTS")]
@@ -128,13 +133,104 @@ impl Default for Limits {
     }
 }
 
+/// `tetherplan worker` flags: the job store and the job limits.
+#[derive(Clone, Debug, clap::Args)]
+pub struct WorkerArgs {
+    /// SQLite database of batch jobs (shared with `serve` on this host).
+    #[arg(long, env = "TETHERPLAN_DB", default_value = "./tetherplan.db")]
+    pub db: PathBuf,
+    /// PostgreSQL job store (`postgres://…`); replaces `--db`.
+    #[arg(long, env = "TETHERPLAN_DATABASE_URL", hide_env_values = true)]
+    pub database_url: Option<String>,
+    /// Threads of the job pool (default and 0: one per core).
+    #[arg(long, env = "TETHERPLAN_JOB_THREADS")]
+    pub job_threads: Option<usize>,
+    #[command(flatten)]
+    pub jobs: JobArgs,
+}
+
+/// The job store a process opens: SQLite at a path, or PostgreSQL.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum StoreConfig {
+    Sqlite(PathBuf),
+    Postgres(String),
+}
+
+impl StoreConfig {
+    pub fn new(db: PathBuf, database_url: Option<String>) -> Self {
+        match database_url.filter(|u| !u.trim().is_empty()) {
+            Some(url) => Self::Postgres(url),
+            None => Self::Sqlite(db),
+        }
+    }
+
+    /// Where the jobs are, for logs (no password).
+    pub fn describe(&self) -> String {
+        match self {
+            Self::Sqlite(p) => format!("sqlite:{}", p.display()),
+            Self::Postgres(u) => crate::jobs::postgres::redact(u),
+        }
+    }
+
+    /// Opens (and migrates) the store.
+    pub fn open(
+        &self,
+    ) -> Result<Box<dyn crate::jobs::store::JobBackend>, crate::jobs::store::StoreError> {
+        Ok(match self {
+            Self::Sqlite(p) => Box::new(crate::jobs::store::JobStore::open(p)?),
+            Self::Postgres(u) => Box::new(crate::jobs::postgres::PgStore::open(u)?),
+        })
+    }
+}
+
+fn cores() -> usize {
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(2)
+}
+
+impl JobArgs {
+    /// The limits these flags set (the others at their defaults).
+    pub fn limits(&self) -> Limits {
+        Limits {
+            max_pending_jobs_per_token: self.token_max_pending_jobs,
+            job_lease: Duration::from_secs_f64(self.job_lease_s.clamp(0.1, 86_400.0)),
+            max_job_attempts: self.job_max_attempts.max(1),
+            max_job_run_time: Duration::from_secs_f64(self.job_max_run_s.clamp(0.01, 1e7)),
+            max_job_result_bytes: self.job_max_result_bytes,
+            ..Limits::default()
+        }
+    }
+}
+
+/// Everything `worker` needs.
+#[derive(Clone, Debug)]
+pub struct WorkerConfig {
+    pub store: StoreConfig,
+    pub job_threads: usize,
+    pub limits: Limits,
+}
+
+impl From<WorkerArgs> for WorkerConfig {
+    fn from(a: WorkerArgs) -> Self {
+        Self {
+            store: StoreConfig::new(a.db, a.database_url),
+            job_threads: a.job_threads.filter(|&n| n > 0).unwrap_or_else(cores),
+            limits: a.jobs.limits(),
+        }
+    }
+}
+
 /// Everything `serve` needs.
 #[derive(Clone, Debug)]
 pub struct Config {
     pub addr: SocketAddr,
     pub db: PathBuf,
+    /// The job store (SQLite at `db` unless a PostgreSQL URL is given).
+    pub store: StoreConfig,
     /// `None`: the page built into the binary.
     pub static_dir: Option<PathBuf>,
+    /// Threads of the job pool; 0: no job worker in this process.
     pub job_threads: usize,
     pub limits: Limits,
     pub connections: ConnectionLimits,
@@ -145,15 +241,10 @@ pub struct Config {
 
 impl From<ServeArgs> for Config {
     fn from(a: ServeArgs) -> Self {
-        let job_threads = if a.job_threads == 0 {
-            std::thread::available_parallelism()
-                .map(|n| n.get())
-                .unwrap_or(2)
-        } else {
-            a.job_threads
-        };
+        let job_threads = a.job_threads.unwrap_or_else(cores);
         Self {
             addr: a.addr,
+            store: StoreConfig::new(a.db.clone(), a.database_url),
             db: a.db,
             static_dir: a.static_dir,
             job_threads,

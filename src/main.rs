@@ -42,6 +42,9 @@ struct InputArg {
 enum Command {
     /// Run the HTTP service (the default).
     Serve(ServeArgs),
+    /// Run jobs only, from the same job store as `serve` (SQLite on this
+    /// host, or `--database-url postgres://…` on any host), until SIGTERM.
+    Worker(tetherplan::config::WorkerArgs),
     /// Eigenvalues and stability verdict at one state.
     Stability(InputArg),
     /// Critical time and maximum safe elevation of a deployment profile.
@@ -188,6 +191,25 @@ fn serve(args: ServeArgs) -> ExitCode {
     }
 }
 
+/// Runs `tetherplan worker` (logs on standard error).
+fn worker(args: tetherplan::config::WorkerArgs) -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
+        )
+        .with_writer(std::io::stderr)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        .init();
+    match tetherplan::jobs::worker::run(args.into()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            tracing::error!("{e}");
+            eprintln!("tetherplan worker: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let Some(command) = cli.command else {
@@ -201,6 +223,7 @@ fn main() -> ExitCode {
             out
         }),
         Command::Serve(args) => serve(args.clone()),
+        Command::Worker(args) => worker(args.clone()),
         Command::Stability(arg) => answer_with(
             arg,
             ge_critical::parse_stability,

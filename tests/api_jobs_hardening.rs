@@ -623,6 +623,7 @@ fn the_store_keeps_one_job_per_key() {
         request_hash: hash,
         max_pending: 10,
         max_pending_per_owner: 10,
+        priority: 0,
     };
     let first = store.insert(&job("h1")).unwrap();
     let again = store.insert(&job("h1")).unwrap();

@@ -39,7 +39,6 @@ use utoipa_swagger_ui::SwaggerUi;
 
 use crate::config::{Config, Limits};
 use crate::jobs::JobQueue;
-use crate::jobs::store::JobStore;
 use error::ApiError;
 
 /// Shared state of the handlers.
@@ -78,17 +77,39 @@ pub struct Health {
     pub status: String,
     /// Version of the server.
     pub version: String,
+    /// The job store: `sqlite` or `postgres`.
+    pub store: String,
+    /// Job workers (API processes with job threads and `tetherplan worker`
+    /// processes) whose heartbeat is recent; absent when the store did not
+    /// answer within a second.
+    #[schema(minimum = 0)]
+    pub live_workers: Option<usize>,
 }
 
-/// Liveness: answers without touching the solver or the database.
+/// Liveness, the job store and its live workers (the solver is not touched;
+/// the store is asked at most one second).
 #[utoipa::path(
     get, path = "/healthz", operation_id = "get_health", tag = "meta",
     responses((status = 200, description = "The server is up", body = Health))
 )]
-pub async fn get_health() -> Response {
+pub async fn get_health(axum::extract::State(app): axum::extract::State<AppState>) -> Response {
+    let queue = app.queue.clone();
+    let live = tokio::task::spawn_blocking(move || {
+        queue
+            .store
+            .live_workers(crate::jobs::PRESENCE_TIMEOUT)
+            .ok()
+    });
+    let live_workers = tokio::time::timeout(std::time::Duration::from_secs(1), live)
+        .await
+        .ok()
+        .and_then(Result::ok)
+        .flatten();
     let body = Health {
         status: "ok".into(),
         version: env!("CARGO_PKG_VERSION").into(),
+        store: app.queue.store.store_kind().into(),
+        live_workers,
     };
     (
         [(header::CONTENT_TYPE, "application/json")],
@@ -167,14 +188,17 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
 /// then stops accepting, lets requests in flight finish, and puts the
 /// running job back in the queue.
 pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
-    let store = JobStore::open(&config.db)
-        .map_err(|e| format!("cannot open job database {}: {e}", config.db.display()))?;
-    let queue = Arc::new(JobQueue::new(
+    let store = config
+        .store
+        .open()
+        .map_err(|e| format!("cannot open job database {}: {e}", config.store.describe()))?;
+    let queue = Arc::new(JobQueue::with_store(
         store,
         config.job_threads,
         config.limits.clone(),
     ));
-    let worker = queue.spawn_worker();
+    // TETHERPLAN_JOB_THREADS=0: jobs are left to `tetherplan worker` processes.
+    let worker = (config.job_threads > 0).then(|| queue.spawn_worker());
     let state = AppState::new(queue.clone()).with_tokens(&config.api_tokens);
     let listener = tokio::net::TcpListener::bind(config.addr)
         .await
@@ -197,7 +221,7 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
         .static_dir
         .as_ref()
         .map_or("(built in)".to_string(), |d| d.display().to_string());
-    tracing::info!(%addr, db = %config.db.display(), %static_dir, "listening");
+    tracing::info!(%addr, db = %config.store.describe(), %static_dir, "listening");
     tracing::info!(
         max_connections = cap,
         fd_limit = fd_limit.unwrap_or(0),
@@ -223,7 +247,7 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
     .await;
     tracing::info!("shutting down: stopping the job worker");
     queue.shutdown();
-    let joined = tokio::task::spawn_blocking(move || worker.join().is_ok());
+    let joined = tokio::task::spawn_blocking(move || worker.is_none_or(|w| w.join().is_ok()));
     if tokio::time::timeout(std::time::Duration::from_secs(10), joined)
         .await
         .is_err()
@@ -254,7 +278,8 @@ fn warn_if_exposed(addr: std::net::SocketAddr) {
     }
 }
 
-async fn shutdown_signal() {
+/// Resolves at SIGINT or SIGTERM.
+pub async fn shutdown_signal() {
     let ctrl_c = async {
         let _ = tokio::signal::ctrl_c().await;
     };

@@ -547,60 +547,91 @@ pub fn ge_chart(
     parallelism: Parallelism,
     progress: &dyn Progress,
 ) -> Result<GeChartResponse, RequestError> {
+    let total = prepare_chart(req)?.point_count();
+    let points = ge_chart_points(req, 0..total, parallelism, progress)?;
+    ge_chart_assemble(req, points)
+}
+
+/// The points `range` of a GE chart (numbered series-major, as
+/// [`ge_chart_core::chart_points_range`]): one chunk of a distributed job.
+pub fn ge_chart_points(
+    req: &GeChartRequest,
+    range: std::ops::Range<usize>,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<Vec<GeChartPointOutput>, RequestError> {
     let core = prepare_chart(req)?;
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
     let cancel = || progress.cancelled();
     let report = |done: usize, total: usize| progress.report(done, total);
-    let series = ge_chart_core::deployment_chart(&core, parallelism, &report, &cancel)?;
+    let flat =
+        ge_chart_core::chart_points_range(&core, range, parallelism, &report, &cancel)?;
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
     let model = core.system.model(core.stiffness_ratios[0])?;
     let scale = model.section.time_scale_s(core.system.initial_length_m);
-    let out = series
+    Ok(flat
         .into_iter()
-        .map(|s| GeChartSeriesOutput {
-            stiffness_ratio: s.stiffness_ratio,
-            perturbation_force_n: s.perturbation_force_n,
-            net_buoyancy_n: s.net_buoyancy_n,
-            wind_amplitude_nondim: s.wind_amplitude,
-            points: s
-                .points
-                .into_iter()
-                .map(|p| {
-                    let (onset, ended_at_s) = match p.onset {
-                        GeOnset::Immediate { .. } => (GeOnsetKind::Immediate, None),
-                        GeOnset::During { .. } => (GeOnsetKind::During, None),
-                        GeOnset::Never { until_s } => (GeOnsetKind::Never, Some(until_s)),
-                        GeOnset::NewtonFailed(f) => (GeOnsetKind::NewtonFailed, Some(f.time_s)),
-                        GeOnset::SpectrumFailed { time_s } => {
-                            (GeOnsetKind::SpectrumFailed, Some(time_s))
-                        }
-                        GeOnset::Cancelled { time_s } => (GeOnsetKind::Cancelled, Some(time_s)),
-                    };
-                    GeChartPointOutput {
-                        rate_m_s: p.rate_m_s,
-                        rate_nondim: p.rate_m_s * scale / core.system.initial_length_m,
-                        onset,
-                        critical_time_s: p.critical_time_s,
-                        max_elevation_m: p.max_elevation_m,
-                        string_closed_form_elevation_m: p.string_closed_form_m,
-                        extensible_closed_form_elevation_m: p.extensible_closed_form_m,
-                        ended_at_s,
-                        steps: p.steps,
-                        qep_solves: p.qep_solves,
-                        step_cuts: p.step_cuts,
-                        closed_form_applies: p.closed_form.applies(),
-                        closed_form_note: p.closed_form.reason(),
-                    }
-                })
-                .collect(),
+        .map(|p| {
+            let (onset, ended_at_s) = match p.onset {
+                GeOnset::Immediate { .. } => (GeOnsetKind::Immediate, None),
+                GeOnset::During { .. } => (GeOnsetKind::During, None),
+                GeOnset::Never { until_s } => (GeOnsetKind::Never, Some(until_s)),
+                GeOnset::NewtonFailed(f) => (GeOnsetKind::NewtonFailed, Some(f.time_s)),
+                GeOnset::SpectrumFailed { time_s } => (GeOnsetKind::SpectrumFailed, Some(time_s)),
+                GeOnset::Cancelled { time_s } => (GeOnsetKind::Cancelled, Some(time_s)),
+            };
+            GeChartPointOutput {
+                rate_m_s: p.rate_m_s,
+                rate_nondim: p.rate_m_s * scale / core.system.initial_length_m,
+                onset,
+                critical_time_s: p.critical_time_s,
+                max_elevation_m: p.max_elevation_m,
+                string_closed_form_elevation_m: p.string_closed_form_m,
+                extensible_closed_form_elevation_m: p.extensible_closed_form_m,
+                ended_at_s,
+                steps: p.steps,
+                qep_solves: p.qep_solves,
+                step_cuts: p.step_cuts,
+                closed_form_applies: p.closed_form.applies(),
+                closed_form_note: p.closed_form.reason(),
+            }
         })
-        .collect();
+        .collect())
+}
+
+/// The GE chart from its points `0..chart_points(req)` in order (those of
+/// one process, or the chunks of a distributed job put together).
+pub fn ge_chart_assemble(
+    req: &GeChartRequest,
+    points: Vec<GeChartPointOutput>,
+) -> Result<GeChartResponse, RequestError> {
+    let core = prepare_chart(req)?;
+    let model = core.system.model(core.stiffness_ratios[0])?;
+    let scale = model.section.time_scale_s(core.system.initial_length_m);
+    let rates = core.rates_m_s.len().max(1);
+    let mut points = points.into_iter();
+    let mut series = Vec::new();
+    for &es in &core.stiffness_ratios {
+        for &f0 in &core.perturbation_forces_n {
+            for &fb in &core.net_buoyancies_n {
+                for a0 in core.wind_amplitudes() {
+                    series.push(GeChartSeriesOutput {
+                        stiffness_ratio: es,
+                        perturbation_force_n: f0,
+                        net_buoyancy_n: fb,
+                        wind_amplitude_nondim: a0,
+                        points: points.by_ref().take(rates).collect(),
+                    });
+                }
+            }
+        }
+    }
     Ok(GeChartResponse {
-        series: out,
+        series,
         elements: core.system.elements,
         time_scale_s: scale,
         wave_speed_m_s: (core.net_buoyancies_n[0] / core.system.mass_per_length_kg_m).sqrt(),

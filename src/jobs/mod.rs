@@ -15,13 +15,16 @@
 //! `max_job_attempts` such claims.
 
 pub mod bands;
+pub mod chunks;
 pub mod estimate;
 pub mod kinds;
 pub mod lease;
 pub mod plan;
+pub mod postgres;
 pub mod sqlite;
 pub mod store;
 pub mod tether;
+pub mod worker;
 
 use std::collections::HashMap;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -79,6 +82,8 @@ pub struct JobQueue {
     running: Mutex<HashMap<i64, Arc<RunningJob>>>,
     /// Least time between two progress writes of one job.
     pub progress_interval: Duration,
+    /// Wakes the presence heartbeat at shutdown.
+    stopping: (Mutex<()>, Condvar),
 }
 
 /// Lowercase hex SHA-256 of `bytes`.
@@ -95,6 +100,11 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 impl JobQueue {
     /// A queue over `store` with a pool of `threads` for the jobs.
     pub fn new(store: impl JobBackend + 'static, threads: usize, limits: Limits) -> Self {
+        Self::with_store(Box::new(store), threads, limits)
+    }
+
+    /// [`JobQueue::new`] over a store chosen at run time (SQLite or PostgreSQL).
+    pub fn with_store(store: Box<dyn JobBackend>, threads: usize, limits: Limits) -> Self {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.max(1))
             .thread_name(|i| format!("job-{i}"))
@@ -102,13 +112,14 @@ impl JobQueue {
             .build()
             .expect("the job pool starts");
         Self {
-            store: Box::new(store),
+            store,
             pool,
             limits,
             shutdown: AtomicBool::new(false),
             wake: (Mutex::new(false), Condvar::new()),
             running: Mutex::new(HashMap::new()),
             progress_interval: Duration::from_millis(200),
+            stopping: (Mutex::new(()), Condvar::new()),
         }
     }
 
@@ -165,6 +176,7 @@ impl JobQueue {
             request_hash: &request_hash,
             max_pending: self.limits.max_pending_jobs,
             max_pending_per_owner: self.limits.max_pending_jobs_per_token,
+            priority: submission.chunk_plan().map_or(0, |p| i64::from(p.count() > 1)),
         };
         let submitted = match self.store.insert(&new)? {
             Inserted::New(id) => {
@@ -217,6 +229,9 @@ impl JobQueue {
     pub fn shutdown(&self) {
         self.shutdown.store(true, Ordering::Relaxed);
         self.notify();
+        let (lock, cvar) = &self.stopping;
+        let _guard = lock.lock().unwrap_or_else(|e| e.into_inner());
+        cvar.notify_all();
     }
 
     pub fn is_shut_down(&self) -> bool {
@@ -245,23 +260,73 @@ impl JobQueue {
     /// An idle worker looks for work at least every second (jobs submitted
     /// by other processes, expired leases).
     pub fn spawn_worker(self: &Arc<Self>) -> std::thread::JoinHandle<()> {
+        self.spawn_worker_as("serve")
+    }
+
+    /// [`JobQueue::spawn_worker`], registered in the store's live workers
+    /// under `role` (`serve`, `worker`) with a heartbeat every
+    /// [`PRESENCE_INTERVAL`]; it leaves the list when it stops. Each step
+    /// takes a queued job first (short jobs before chunked ones), else a
+    /// pending chunk of a running job.
+    pub fn spawn_worker_as(self: &Arc<Self>, role: &'static str) -> std::thread::JoinHandle<()> {
         let queue = Arc::clone(self);
         std::thread::Builder::new()
             .name("job-worker".into())
             .spawn(move || {
-                while !queue.is_shut_down() {
-                    match try_execute_next(&queue) {
-                        Ok(Some(_)) => {}
-                        Ok(None) => queue.wait_for_work(Duration::from_secs(1)),
-                        Err(e) => {
-                            tracing::error!(error = %e, "job worker");
-                            std::thread::sleep(Duration::from_secs(1));
+                std::thread::scope(|scope| {
+                    scope.spawn(|| presence(&queue, role));
+                    while !queue.is_shut_down() {
+                        match work_once(&queue) {
+                            Ok(true) => {}
+                            Ok(false) => queue.wait_for_work(IDLE_POLL),
+                            Err(e) => {
+                                tracing::error!(error = %e, "job worker");
+                                std::thread::sleep(Duration::from_secs(1));
+                            }
                         }
                     }
-                }
+                    queue.notify();
+                });
             })
             .expect("the job worker starts")
     }
+}
+
+/// How long an idle worker waits before looking for work again (jobs and
+/// chunks submitted by other processes, expired leases).
+const IDLE_POLL: Duration = Duration::from_millis(250);
+
+/// How often a worker records that it is alive.
+pub const PRESENCE_INTERVAL: Duration = Duration::from_secs(1);
+
+/// A worker is counted live while its last heartbeat is this recent.
+pub const PRESENCE_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// Heartbeats this worker into the store's live workers until shutdown,
+/// then leaves the list.
+fn presence(queue: &JobQueue, role: &str) {
+    while !queue.is_shut_down() {
+        if let Err(e) = queue.store.worker_heartbeat(role) {
+            tracing::warn!(error = %e, "worker heartbeat not recorded");
+        }
+        let (lock, cvar) = &queue.stopping;
+        let guard = lock.lock().unwrap_or_else(|e| e.into_inner());
+        if !queue.is_shut_down() {
+            let _ = cvar.wait_timeout(guard, PRESENCE_INTERVAL);
+        }
+    }
+    if let Err(e) = queue.store.worker_leave() {
+        tracing::warn!(error = %e, "worker not removed from the live workers");
+    }
+}
+
+/// One step of a worker: a queued job, else a pending chunk; false when
+/// there was nothing to do.
+pub fn work_once(queue: &JobQueue) -> Result<bool, StoreError> {
+    if try_execute_next(queue)?.is_some() {
+        return Ok(true);
+    }
+    Ok(chunks::execute_chunk(queue, None)?.is_some())
 }
 
 /// Niceness of the job threads: batch work yields the CPU to the threads
@@ -403,6 +468,7 @@ pub fn try_execute_next(queue: &JobQueue) -> Result<Option<Executed>, StoreError
         started,
         last_write: Mutex::new(Instant::now()),
     };
+    let chunk_failure = Mutex::new(None);
     let outcome = std::thread::scope(|scope| {
         let (stop, stopped) = std::sync::mpsc::channel::<()>();
         let ctl = &ctl;
@@ -410,7 +476,17 @@ pub fn try_execute_next(queue: &JobQueue) -> Result<Option<Executed>, StoreError
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             queue.pool.install(|| {
                 let submission = JobSubmission::parse(job.request.as_bytes(), &queue.limits)?;
-                submission.run(ctl)
+                match submission.chunk_plan() {
+                    Some(plan) if plan.count() > 1 => chunks::coordinate(
+                        queue,
+                        &job.lease,
+                        &submission,
+                        plan,
+                        ctl,
+                        &chunk_failure,
+                    ),
+                    _ => submission.run(ctl),
+                }
             })
         }));
         drop(stop);
@@ -433,7 +509,18 @@ pub fn try_execute_next(queue: &JobQueue) -> Result<Option<Executed>, StoreError
             now(queue)
         }
     };
+    let chunk_failure = chunk_failure
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner());
     let status = match outcome {
+        _ if chunk_failure.is_some() && !lost => {
+            let body = chunk_failure.unwrap_or_default();
+            if queue.store.finish_failed(lease, &body)? {
+                JobStatus::Failed
+            } else {
+                now(queue)?
+            }
+        }
         Ok(Ok(result)) if result.len() as u64 > limits.max_job_result_bytes => {
             fail(ErrorBody::new(
                 "result_too_large",

@@ -3,9 +3,12 @@
 //! serialises writers, claims run in `BEGIN IMMEDIATE` transactions, and
 //! leases (owner, expiry in ms since the Unix epoch, epoch) fence writes.
 //!
-//! Schema versions (`PRAGMA user_version`), applied at open:
+//! Schema versions (`PRAGMA user_version`, and one row each in
+//! `schema_version` from version 3 on), applied at open:
 //! 1. the `jobs` table;
-//! 2. owner, idempotency key and body hash, lease owner/expiry/epoch.
+//! 2. owner, idempotency key and body hash, lease owner/expiry/epoch;
+//! 3. job priority, `job_chunks` (leased chunks of large jobs), `workers`
+//!    (live workers), `schema_version`.
 
 use std::path::Path;
 use std::sync::Mutex;
@@ -15,7 +18,7 @@ use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
 
 use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
 use super::store::{
-    ClaimPolicy, ClaimedJob, InsertError, Inserted, JobBackend, JobRecord, JobStatus, KeyedJob,
+    ChunkLease, ChunkState, ClaimPolicy, ClaimedChunk, ClaimedJob, InsertError, Inserted, JobBackend, JobRecord, JobStatus, KeyedJob,
     NewJob, StoreError,
 };
 
@@ -48,8 +51,38 @@ CREATE UNIQUE INDEX jobs_by_idempotency_key ON jobs (ifnull(owner, ''), idempote
 CREATE INDEX jobs_by_owner ON jobs (owner, status);
 ";
 
+const SCHEMA_V3: &str = "
+ALTER TABLE jobs ADD COLUMN priority INTEGER NOT NULL DEFAULT 0;
+CREATE INDEX jobs_by_claim ON jobs (status, priority, id);
+CREATE TABLE job_chunks (
+    job_id           INTEGER NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,
+    idx              INTEGER NOT NULL,
+    status           TEXT NOT NULL CHECK (status IN ('pending', 'running', 'done', 'failed')),
+    attempts         INTEGER NOT NULL DEFAULT 0,
+    lease_owner      TEXT,
+    lease_expires_ms INTEGER,
+    lease_epoch      INTEGER NOT NULL DEFAULT 0,
+    result           TEXT,
+    error            TEXT,
+    finished_by      TEXT,
+    PRIMARY KEY (job_id, idx)
+);
+CREATE INDEX job_chunks_by_status ON job_chunks (status, job_id, idx);
+CREATE TABLE workers (
+    id           TEXT PRIMARY KEY,
+    role         TEXT NOT NULL,
+    started_ms   INTEGER NOT NULL,
+    heartbeat_ms INTEGER NOT NULL
+);
+CREATE TABLE IF NOT EXISTS schema_version (
+    version    INTEGER PRIMARY KEY,
+    applied_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now'))
+);
+INSERT OR IGNORE INTO schema_version (version) VALUES (1), (2), (3);
+";
+
 /// The current schema version.
-pub const SCHEMA_VERSION: i64 = 2;
+pub const SCHEMA_VERSION: i64 = 3;
 
 const NOW: &str = "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')";
 
@@ -121,6 +154,7 @@ impl JobStore {
             request_hash: "",
             max_pending: limit,
             max_pending_per_owner: limit,
+            priority: 0,
         };
         match self.insert(&job)? {
             Inserted::New(id) | Inserted::Existing { id, .. } => Ok(id),
@@ -175,6 +209,29 @@ impl JobStore {
     }
 }
 
+/// The fence of a chunk write: the chunk is still running under this
+/// lease and its job is still running.
+const CHUNK_FENCE: &str = "job_id = ?1 AND idx = ?2 AND status = 'running' AND lease_owner = ?3
+    AND lease_epoch = ?5 AND (SELECT status FROM jobs WHERE id = job_id) = 'running'";
+
+impl JobStore {
+    fn chunk_fenced(
+        &self,
+        sql_set: &str,
+        lease: &ChunkLease,
+        extra: Option<&dyn rusqlite::ToSql>,
+    ) -> Result<bool, StoreError> {
+        let sql = format!("UPDATE job_chunks SET {sql_set} WHERE {CHUNK_FENCE}");
+        let none: Option<i64> = None;
+        let x: &dyn rusqlite::ToSql = extra.unwrap_or(&none);
+        let n = self.conn().execute(
+            &sql,
+            params![lease.job_id, lease.index as i64, lease.owner, x, lease.epoch],
+        )?;
+        Ok(n == 1)
+    }
+}
+
 fn migrate(conn: &mut Connection) -> Result<(), StoreError> {
     let version: i64 = conn.query_row("PRAGMA user_version", [], |r| r.get(0))?;
     if version >= SCHEMA_VERSION {
@@ -188,6 +245,9 @@ fn migrate(conn: &mut Connection) -> Result<(), StoreError> {
     }
     if version < 2 {
         tx.execute_batch(SCHEMA_V2)?;
+    }
+    if version < 3 {
+        tx.execute_batch(SCHEMA_V3)?;
     }
     tx.pragma_update(None, "user_version", SCHEMA_VERSION)?;
     tx.commit()?;
@@ -273,14 +333,15 @@ impl JobBackend for JobStore {
             }
         }
         tx.execute(
-            "INSERT INTO jobs (kind, request, status, owner, idempotency_key, request_hash)
-             VALUES (?1, ?2, 'queued', ?3, ?4, ?5)",
+            "INSERT INTO jobs (kind, request, status, owner, idempotency_key, request_hash, priority)
+             VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6)",
             params![
                 job.kind,
                 job.request,
                 job.owner,
                 job.idempotency_key,
-                job.request_hash
+                job.request_hash,
+                job.priority
             ],
         )
         .map_err(StoreError::from)?;
@@ -318,7 +379,7 @@ impl JobBackend for JobStore {
                      WHERE id = (SELECT id FROM jobs
                                  WHERE status = 'queued'
                                     OR (status = 'running' AND ifnull(lease_expires_ms, 0) < ?3)
-                                 ORDER BY id LIMIT 1)
+                                 ORDER BY priority, id LIMIT 1)
                      RETURNING id, kind, request, attempts, lease_epoch"
                 ),
                 params![self.worker.as_str(), expires, now],
@@ -376,7 +437,13 @@ impl JobBackend for JobStore {
     }
 
     fn release_all(&self) -> Result<usize, StoreError> {
-        Ok(self.conn().execute(
+        let conn = self.conn();
+        conn.execute(
+            "UPDATE job_chunks SET status = 'pending', lease_expires_ms = NULL
+             WHERE status = 'running' AND lease_owner = ?1",
+            [self.worker.as_str()],
+        )?;
+        Ok(conn.execute(
             "UPDATE jobs SET status = 'queued', lease_expires_ms = NULL
              WHERE status = 'running' AND lease_owner = ?1",
             [self.worker.as_str()],
@@ -397,6 +464,20 @@ impl JobBackend for JobStore {
         for owner in owners.iter().filter(|o| self.worker.is_dead_local(o)) {
             n += conn.execute(
                 "UPDATE jobs SET lease_expires_ms = 0 WHERE status = 'running' AND lease_owner = ?1",
+                [owner],
+            )?;
+        }
+        let chunk_owners: Vec<String> = {
+            let mut stmt = conn.prepare(
+                "SELECT DISTINCT lease_owner FROM job_chunks
+                 WHERE status = 'running' AND lease_owner IS NOT NULL",
+            )?;
+            stmt.query_map([], |r| r.get(0))?
+                .collect::<Result<_, _>>()?
+        };
+        for owner in chunk_owners.iter().filter(|o| self.worker.is_dead_local(o)) {
+            conn.execute(
+                "UPDATE job_chunks SET lease_expires_ms = 0 WHERE status = 'running' AND lease_owner = ?1",
                 [owner],
             )?;
         }
@@ -485,6 +566,175 @@ impl JobBackend for JobStore {
             )
             .optional()?;
         Ok(s.map(|s| JobStatus::parse(&s)))
+    }
+
+    fn store_kind(&self) -> &'static str {
+        "sqlite"
+    }
+
+    fn create_chunks(&self, lease: &Lease, count: usize) -> Result<bool, StoreError> {
+        let mut conn = self.conn();
+        let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
+        let held: Option<i64> = tx
+            .query_row(
+                &format!("SELECT id FROM jobs WHERE {FENCE}"),
+                params![lease.job_id, lease.owner, lease.epoch],
+                |r| r.get(0),
+            )
+            .optional()?;
+        if held.is_none() {
+            return Ok(false);
+        }
+        {
+            let mut stmt = tx.prepare(
+                "INSERT OR IGNORE INTO job_chunks (job_id, idx, status) VALUES (?1, ?2, 'pending')",
+            )?;
+            for i in 0..count {
+                stmt.execute(params![lease.job_id, i as i64])?;
+            }
+        }
+        tx.commit()?;
+        Ok(true)
+    }
+
+    fn claim_chunk(
+        &self,
+        job: Option<i64>,
+        policy: &ClaimPolicy<'_>,
+    ) -> Result<Option<ClaimedChunk>, StoreError> {
+        let mut conn = self.conn();
+        let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
+        let now = now_ms();
+        tx.execute(
+            "UPDATE job_chunks SET status = 'failed', error = ?1, lease_expires_ms = NULL
+             WHERE status = 'running' AND ifnull(lease_expires_ms, 0) < ?2 AND attempts >= ?3",
+            params![policy.exhausted_error, now, policy.max_attempts],
+        )?;
+        let expires = now.saturating_add(policy.lease.as_millis().min(i64::MAX as u128) as i64);
+        let claimed = tx
+            .query_row(
+                "UPDATE job_chunks SET status = 'running', attempts = attempts + 1,
+                    lease_owner = ?1, lease_expires_ms = ?2, lease_epoch = lease_epoch + 1
+                 WHERE (job_id, idx) = (
+                     SELECT c.job_id, c.idx FROM job_chunks c JOIN jobs j ON j.id = c.job_id
+                     WHERE j.status = 'running' AND (?4 IS NULL OR c.job_id = ?4)
+                       AND (c.status = 'pending'
+                            OR (c.status = 'running' AND ifnull(c.lease_expires_ms, 0) < ?3))
+                     ORDER BY j.priority, c.job_id, c.idx LIMIT 1)
+                 RETURNING job_id, idx, attempts, lease_epoch",
+                params![self.worker.as_str(), expires, now, job],
+                |r| {
+                    Ok((
+                        r.get::<_, i64>(0)?,
+                        r.get::<_, i64>(1)?,
+                        r.get::<_, u32>(2)?,
+                        r.get::<_, i64>(3)?,
+                    ))
+                },
+            )
+            .optional()?;
+        let Some((job_id, idx, attempts, epoch)) = claimed else {
+            tx.commit()?;
+            return Ok(None);
+        };
+        let request: String =
+            tx.query_row("SELECT request FROM jobs WHERE id = ?1", [job_id], |r| {
+                r.get(0)
+            })?;
+        tx.commit()?;
+        Ok(Some(ClaimedChunk {
+            lease: ChunkLease {
+                job_id,
+                index: idx as usize,
+                owner: self.worker.as_str().to_string(),
+                epoch,
+            },
+            request,
+            attempts,
+        }))
+    }
+
+    fn renew_chunk(&self, lease: &ChunkLease, duration: Duration) -> Result<bool, StoreError> {
+        self.chunk_fenced("lease_expires_ms = ?4", lease, Some(&expiry_ms(duration)))
+    }
+
+    fn finish_chunk(&self, lease: &ChunkLease, result: &str) -> Result<bool, StoreError> {
+        self.chunk_fenced(
+            "status = 'done', result = ?4, lease_expires_ms = NULL, finished_by = lease_owner",
+            lease,
+            Some(&result),
+        )
+    }
+
+    fn fail_chunk(&self, lease: &ChunkLease, error: &str) -> Result<bool, StoreError> {
+        self.chunk_fenced(
+            "status = 'failed', error = ?4, lease_expires_ms = NULL",
+            lease,
+            Some(&error),
+        )
+    }
+
+    fn release_chunk(&self, lease: &ChunkLease) -> Result<bool, StoreError> {
+        self.chunk_fenced("status = 'pending', lease_expires_ms = NULL", lease, None)
+    }
+
+    fn chunk_state(&self, job_id: i64) -> Result<ChunkState, StoreError> {
+        let conn = self.conn();
+        let (total, done): (i64, i64) = conn.query_row(
+            "SELECT count(*), ifnull(sum(status = 'done'), 0) FROM job_chunks WHERE job_id = ?1",
+            [job_id],
+            |r| Ok((r.get(0)?, r.get(1)?)),
+        )?;
+        let failed: Option<String> = conn
+            .query_row(
+                "SELECT error FROM job_chunks WHERE job_id = ?1 AND status = 'failed'
+                 ORDER BY idx LIMIT 1",
+                [job_id],
+                |r| r.get(0),
+            )
+            .optional()?;
+        Ok(ChunkState {
+            total: total as usize,
+            done: done as usize,
+            failed,
+        })
+    }
+
+    fn chunk_results(&self, job_id: i64) -> Result<Vec<(usize, String)>, StoreError> {
+        let conn = self.conn();
+        let mut stmt = conn.prepare(
+            "SELECT idx, result FROM job_chunks WHERE job_id = ?1 AND status = 'done' ORDER BY idx",
+        )?;
+        let rows = stmt.query_map([job_id], |r| {
+            Ok((r.get::<_, i64>(0)? as usize, r.get::<_, String>(1)?))
+        })?;
+        Ok(rows.collect::<Result<_, _>>()?)
+    }
+
+    fn worker_heartbeat(&self, role: &str) -> Result<(), StoreError> {
+        let now = now_ms();
+        self.conn().execute(
+            "INSERT INTO workers (id, role, started_ms, heartbeat_ms) VALUES (?1, ?2, ?3, ?3)
+             ON CONFLICT (id) DO UPDATE SET heartbeat_ms = excluded.heartbeat_ms",
+            params![self.worker.as_str(), role, now],
+        )?;
+        Ok(())
+    }
+
+    fn worker_leave(&self) -> Result<(), StoreError> {
+        self.conn()
+            .execute("DELETE FROM workers WHERE id = ?1", [self.worker.as_str()])?;
+        Ok(())
+    }
+
+    fn live_workers(&self, within: Duration) -> Result<usize, StoreError> {
+        let since = now_ms() - within.as_millis().min(i64::MAX as u128) as i64;
+        let n: i64 = self.conn().query_row(
+            "SELECT count(*) FROM workers WHERE heartbeat_ms >= ?1",
+            [since],
+            |r| r.get(0),
+        )?;
+        Ok(n as usize)
     }
 
     fn pending(&self) -> Result<usize, StoreError> {

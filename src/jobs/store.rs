@@ -19,6 +19,7 @@ use std::time::Duration;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+pub use super::chunks::{ChunkLease, ChunkState, ClaimedChunk};
 pub use super::lease::{Lease, WorkerId};
 pub use super::sqlite::JobStore;
 
@@ -109,6 +110,9 @@ pub struct NewJob<'a> {
     pub max_pending: usize,
     /// Jobs queued or running at once, this owner (with an owner).
     pub max_pending_per_owner: usize,
+    /// Claim order: lower first (0: one piece of work, 1: a chunked job),
+    /// then oldest first; short jobs pass long ones.
+    pub priority: i64,
 }
 
 /// What an insert did.
@@ -224,6 +228,39 @@ pub trait JobBackend: Send + Sync {
     fn status_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobStatus>, StoreError>;
     /// Jobs queued or running (all owners).
     fn pending(&self) -> Result<usize, StoreError>;
+
+    /// `sqlite` or `postgres`.
+    fn store_kind(&self) -> &'static str;
+    /// Creates the chunks `0..count` of the job held under `lease` (those
+    /// that exist are kept, with their results); false when the lease was lost.
+    fn create_chunks(&self, lease: &Lease, count: usize) -> Result<bool, StoreError>;
+    /// Fails the expired chunks out of attempts, then claims a pending (or
+    /// expired running) chunk of a running job (of `job` only, when given),
+    /// lowest job priority, oldest job, lowest index first.
+    fn claim_chunk(
+        &self,
+        job: Option<i64>,
+        policy: &ClaimPolicy<'_>,
+    ) -> Result<Option<ClaimedChunk>, StoreError>;
+    /// Extends a chunk lease; false when it was lost (taken over, or the job
+    /// is no longer running: cancelled, failed).
+    fn renew_chunk(&self, lease: &ChunkLease, duration: Duration) -> Result<bool, StoreError>;
+    /// The chunk is done with `result` (JSON text); false when the lease was lost.
+    fn finish_chunk(&self, lease: &ChunkLease, result: &str) -> Result<bool, StoreError>;
+    /// The chunk failed with `error` (JSON error body); false when the lease was lost.
+    fn fail_chunk(&self, lease: &ChunkLease, error: &str) -> Result<bool, StoreError>;
+    /// Hands a running chunk back (shutdown); false when the lease was lost.
+    fn release_chunk(&self, lease: &ChunkLease) -> Result<bool, StoreError>;
+    /// How far the chunks of a job are.
+    fn chunk_state(&self, job_id: i64) -> Result<ChunkState, StoreError>;
+    /// The results of the done chunks of a job, by index.
+    fn chunk_results(&self, job_id: i64) -> Result<Vec<(usize, String)>, StoreError>;
+    /// Records (or refreshes) this store's worker as alive, with its role.
+    fn worker_heartbeat(&self, role: &str) -> Result<(), StoreError>;
+    /// Removes this store's worker from the live workers (clean exit).
+    fn worker_leave(&self) -> Result<(), StoreError>;
+    /// Workers whose last heartbeat is at most `within` old.
+    fn live_workers(&self, within: Duration) -> Result<usize, StoreError>;
 
     /// One job, any owner.
     fn get(&self, id: i64) -> Result<Option<JobRecord>, StoreError> {

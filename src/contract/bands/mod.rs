@@ -31,4 +31,4 @@ pub use envelope::{
     EnvelopeBandsRequest, EnvelopeBandsResponse, envelope_bands, parse_envelope_bands,
 };
 pub use plan::{PlanBandsRequest, PlanBandsResponse, parse_plan_bands, plan_bands};
-pub use run::{bands, evaluations, parse_bands, prepare};
+pub use run::{bands, bands_chunk, bands_from_chunks, evaluations, parse_bands, prepare};

@@ -391,13 +391,24 @@ pub fn bands(
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
+    let results = sample_results(&prep, 0..prep.ensemble.samples, parallelism, progress)?;
+    summarise(req, &prep, results)
+}
+
+/// Ok(points) or Err(index of the first input whose draw is out of range).
+type SampleResult = Result<Vec<PointValue>, usize>;
+
+/// The chart of each sample of `range`, in sample order.
+fn sample_results(
+    prep: &Prepared,
+    range: std::ops::Range<usize>,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<Vec<SampleResult>, RequestError> {
     let evaluator = ChartEvaluator::new(prep.discretisation);
-    let converged = matches!(prep.discretisation, Discretisation::Converged { .. });
-    let nominal = evaluator.chart(prep.nominal, &prep.rates);
-    // Ok(points) or Err(index of the first input whose draw is out of range)
-    let results: Vec<Result<Vec<PointValue>, usize>> = prep
-        .ensemble
-        .run(
+    prep.ensemble
+        .run_range(
+            range,
             parallelism,
             &|done, total| progress.report(done, total),
             &|| progress.cancelled(),
@@ -415,7 +426,94 @@ pub fn bands(
                 Ok(evaluator.chart(sys, &prep.rates))
             },
         )
-        .ok_or(RequestError::Cancelled)?;
+        .ok_or(RequestError::Cancelled)
+}
+
+/// The samples `range` of a bands request as JSON text (one chunk of a
+/// distributed job; the numbers as their IEEE-754 bits, so that the
+/// answer put together from chunks is the single-process one exactly).
+pub fn bands_chunk(
+    req: &BandsRequest,
+    range: std::ops::Range<usize>,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<String, RequestError> {
+    let prep = prepare(req)?;
+    let results = sample_results(&prep, range, parallelism, progress)?;
+    let wire: Vec<WireSample> = results
+        .iter()
+        .map(|r| match r {
+            Ok(points) => WireSample::Ok(
+                points
+                    .iter()
+                    .map(|p| {
+                        (
+                            p.elevation_m.to_bits(),
+                            p.time_s.to_bits(),
+                            p.elevation_error_m.to_bits(),
+                            p.time_error_s.to_bits(),
+                            p.immediate,
+                        )
+                    })
+                    .collect(),
+            ),
+            Err(k) => WireSample::Rejected(*k),
+        })
+        .collect();
+    Ok(serde_json::to_string(&wire).expect("samples serialise"))
+}
+
+/// The bands answer from its chunks ([`bands_chunk`] of consecutive
+/// ranges covering every sample, in order).
+pub fn bands_from_chunks(
+    req: &BandsRequest,
+    parts: &[String],
+) -> Result<BandsResponse, RequestError> {
+    let prep = prepare(req)?;
+    let mut results = Vec::with_capacity(prep.ensemble.samples);
+    for part in parts {
+        let wire: Vec<WireSample> = serde_json::from_str(part)
+            .map_err(|e| RequestError::Malformed(format!("a chunk of the bands job: {e}")))?;
+        results.extend(wire.into_iter().map(|w| match w {
+            WireSample::Ok(points) => Ok(points
+                .into_iter()
+                .map(|(h, t, he, te, immediate)| PointValue {
+                    elevation_m: f64::from_bits(h),
+                    time_s: f64::from_bits(t),
+                    elevation_error_m: f64::from_bits(he),
+                    time_error_s: f64::from_bits(te),
+                    immediate,
+                })
+                .collect()),
+            WireSample::Rejected(k) => Err(k),
+        }));
+    }
+    if results.len() != prep.ensemble.samples {
+        return Err(RequestError::Malformed(format!(
+            "the chunks of the bands job hold {} samples, not {}",
+            results.len(),
+            prep.ensemble.samples
+        )));
+    }
+    summarise(req, &prep, results)
+}
+
+/// One sample on the wire between a chunk and its job.
+#[derive(serde::Serialize, serde::Deserialize)]
+enum WireSample {
+    Ok(Vec<(u64, u64, u64, u64, bool)>),
+    Rejected(usize),
+}
+
+/// The answer from every sample's chart, in sample order.
+fn summarise(
+    req: &BandsRequest,
+    prep: &Prepared,
+    results: Vec<SampleResult>,
+) -> Result<BandsResponse, RequestError> {
+    let evaluator = ChartEvaluator::new(prep.discretisation);
+    let converged = matches!(prep.discretisation, Discretisation::Converged { .. });
+    let nominal = evaluator.chart(prep.nominal, &prep.rates);
     let valid: Vec<&Vec<PointValue>> = results.iter().filter_map(|r| r.as_ref().ok()).collect();
     let mut rejected = vec![0usize; prep.fields.len()];
     for r in &results {

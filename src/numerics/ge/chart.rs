@@ -293,7 +293,7 @@ impl GeChartRequest {
         }
     }
 
-    fn wind_amplitudes(&self) -> Vec<Option<f64>> {
+    pub fn wind_amplitudes(&self) -> Vec<Option<f64>> {
         match &self.wind {
             None => vec![None],
             Some(w) => w.amplitudes.iter().map(|&a| Some(a)).collect(),
@@ -470,12 +470,19 @@ pub fn deployment_chart(
     progress: &(dyn Fn(usize, usize) + Sync),
     cancel: &(dyn Fn() -> bool + Sync),
 ) -> Result<Vec<GeChartSeries>, InvalidInput> {
-    request.validate()?;
-    let models = request
-        .stiffness_ratios
-        .iter()
-        .map(|&es| request.system.model(es))
-        .collect::<Result<Vec<_>, _>>()?;
+    let flat = chart_points_range(
+        request,
+        0..request.point_count(),
+        parallelism,
+        progress,
+        cancel,
+    )?;
+    Ok(chart_series(request, flat))
+}
+
+/// The series of a chart (stiffness ratio, perturbation force, buoyancy,
+/// wind amplitude; index of the model), in the order of the flat points.
+fn series_keys(request: &GeChartRequest) -> Vec<(usize, f64, f64, f64, Option<f64>)> {
     let mut series_keys = Vec::new();
     for (m, &es) in request.stiffness_ratios.iter().enumerate() {
         for &f0 in &request.perturbation_forces_n {
@@ -486,8 +493,47 @@ pub fn deployment_chart(
             }
         }
     }
+    series_keys
+}
+
+/// Groups the flat points `0..point_count()` (series-major) into series.
+pub fn chart_series(request: &GeChartRequest, flat: Vec<GeChartPoint>) -> Vec<GeChartSeries> {
+    let rates = request.rates_m_s.len().max(1);
+    series_keys(request)
+        .iter()
+        .zip(flat.chunks(rates))
+        .map(|(&(_, es, f0, fb, a0), pts)| GeChartSeries {
+            stiffness_ratio: es,
+            perturbation_force_n: f0,
+            net_buoyancy_n: fb,
+            wind_amplitude: a0,
+            points: pts.to_vec(),
+        })
+        .collect()
+}
+
+/// The points `range` of the chart, numbered series-major (point `i` is
+/// rate `i % rates` of series `i / rates`): each point is independent of
+/// the others, so any split of `0..point_count()` gives the same points
+/// (the chunks of a distributed job). Progress counts thousandths of the
+/// range's points.
+pub fn chart_points_range(
+    request: &GeChartRequest,
+    range: std::ops::Range<usize>,
+    parallelism: Parallelism,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<GeChartPoint>, InvalidInput> {
+    request.validate()?;
+    let models = request
+        .stiffness_ratios
+        .iter()
+        .map(|&es| request.system.model(es))
+        .collect::<Result<Vec<_>, _>>()?;
+    let series_keys = series_keys(request);
     let rates = &request.rates_m_s;
-    let total = request.point_count();
+    let range = range.start.min(request.point_count())..range.end.min(request.point_count());
+    let total = range.len();
     let done = AtomicUsize::new(0);
     let units = PROGRESS_UNITS_PER_POINT;
     let total_units = total * units;
@@ -531,22 +577,8 @@ pub fn deployment_chart(
         advance(units);
         p
     };
-    let flat: Vec<GeChartPoint> = match parallelism {
-        Parallelism::Serial => (0..total).map(point).collect::<Result<_, _>>()?,
-        Parallelism::Rayon => (0..total)
-            .into_par_iter()
-            .map(point)
-            .collect::<Result<_, _>>()?,
-    };
-    Ok(series_keys
-        .iter()
-        .zip(flat.chunks(rates.len()))
-        .map(|(&(_, es, f0, fb, a0), pts)| GeChartSeries {
-            stiffness_ratio: es,
-            perturbation_force_n: f0,
-            net_buoyancy_n: fb,
-            wind_amplitude: a0,
-            points: pts.to_vec(),
-        })
-        .collect())
+    match parallelism {
+        Parallelism::Serial => range.map(point).collect(),
+        Parallelism::Rayon => range.into_par_iter().map(point).collect(),
+    }
 }

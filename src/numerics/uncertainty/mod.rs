@@ -97,18 +97,34 @@ impl Ensemble {
         cancelled: &(dyn Fn() -> bool + Sync),
         eval: impl Fn(&[f64]) -> T + Sync,
     ) -> Option<Vec<T>> {
+        self.run_range(0..self.samples, parallelism, progress, cancelled, eval)
+    }
+
+    /// [`Ensemble::run`] over the samples `range` only (one chunk of a
+    /// distributed job): sample `i` draws the same values whatever the
+    /// range, so the chunks put together are the whole run.
+    pub fn run_range<T: Send>(
+        &self,
+        range: std::ops::Range<usize>,
+        parallelism: Parallelism,
+        progress: &(dyn Fn(usize, usize) + Sync),
+        cancelled: &(dyn Fn() -> bool + Sync),
+        eval: impl Fn(&[f64]) -> T + Sync,
+    ) -> Option<Vec<T>> {
+        let range = range.start.min(self.samples)..range.end.min(self.samples);
+        let total = range.len();
         let done = AtomicUsize::new(0);
         let one = |i: usize| -> Option<T> {
             if cancelled() {
                 return None;
             }
             let out = eval(&self.values(i));
-            progress(done.fetch_add(1, Ordering::Relaxed) + 1, self.samples);
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             Some(out)
         };
         let out: Vec<Option<T>> = match parallelism {
-            Parallelism::Serial => (0..self.samples).map(one).collect(),
-            Parallelism::Rayon => (0..self.samples).into_par_iter().map(one).collect(),
+            Parallelism::Serial => range.map(one).collect(),
+            Parallelism::Rayon => range.into_par_iter().map(one).collect(),
         };
         out.into_iter().collect()
     }

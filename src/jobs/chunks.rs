@@ -1,0 +1,315 @@
+//! Chunked jobs: one engine for every store.
+//!
+//! A large job (a GE chart, a bands request) is a list of independent
+//! items (chart points, Monte Carlo samples). The worker that claims such a
+//! job (its *coordinator*) splits it into chunks of consecutive items
+//! ([`ChunkPlan`], a few seconds of work each), stored as rows keyed by
+//! (job, index). Any worker of any process claims a pending chunk under a
+//! lease of its own ([`ChunkLease`]: owner, expiry, epoch), renews it while
+//! the chunk runs and writes the chunk's result fenced by it: a result is
+//! written once per (job, index), by the holder of the current lease, and
+//! a chunk whose worker died is claimed again once its lease expired. The
+//! coordinator runs chunks of its job too; when every chunk is done it
+//! assembles their results, in index order, into the job's answer, the
+//! same JSON as the single-process run. Progress counts chunks;
+//! cancelling the job stops its pending chunks (only chunks of running
+//! jobs are claimed) and its running ones (their renewal fails).
+//!
+//! If the coordinator dies, its job lease expires and another worker
+//! becomes the coordinator; the chunks already done are kept.
+
+use std::ops::Range;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use super::kinds::JobSubmission;
+use super::store::{ClaimPolicy, StoreError};
+use super::{JobQueue, error_json};
+use crate::contract::dto::ErrorBody;
+use crate::contract::{Progress, RequestError};
+
+/// A claim on one chunk: fenced chunk writes carry it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ChunkLease {
+    pub job_id: i64,
+    pub index: usize,
+    pub owner: String,
+    pub epoch: i64,
+}
+
+/// A chunk taken by a worker, with its job's request.
+#[derive(Clone, Debug)]
+pub struct ClaimedChunk {
+    pub lease: ChunkLease,
+    /// The job's submitted body, JSON text.
+    pub request: String,
+    /// Claims of this chunk so far, this one included.
+    pub attempts: u32,
+}
+
+/// How far the chunks of one job are.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ChunkState {
+    pub total: usize,
+    pub done: usize,
+    /// The error body (JSON text) of the first failed chunk, if any.
+    pub failed: Option<String>,
+}
+
+/// How a job's items are cut: `items` in chunks of `per_chunk`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ChunkPlan {
+    pub items: usize,
+    pub per_chunk: usize,
+}
+
+impl ChunkPlan {
+    /// The plan of `items` items costing about `item_cost_s` seconds each:
+    /// chunks of about [`CHUNK_TARGET_S`] seconds, and at least
+    /// [`MIN_CHUNKS`] chunks (when there are as many items) once the whole
+    /// job is estimated above [`MIN_SPLIT_JOB_S`], so that several workers
+    /// share it; a shorter job is one chunk.
+    pub fn for_cost(items: usize, item_cost_s: f64) -> Self {
+        let cost = item_cost_s.max(1e-9);
+        if items as f64 * cost < MIN_SPLIT_JOB_S {
+            return Self {
+                items,
+                per_chunk: items.max(1),
+            };
+        }
+        let per = (CHUNK_TARGET_S / cost).floor();
+        let by_cost = if per.is_finite() {
+            (per as usize).clamp(1, MAX_ITEMS_PER_CHUNK)
+        } else {
+            MAX_ITEMS_PER_CHUNK
+        };
+        let by_count = items.div_ceil(MIN_CHUNKS).max(1);
+        Self {
+            items,
+            per_chunk: by_cost.min(by_count),
+        }
+    }
+
+    pub fn count(&self) -> usize {
+        self.items.div_ceil(self.per_chunk.max(1))
+    }
+
+    /// The items of chunk `index`.
+    pub fn range(&self, index: usize) -> Range<usize> {
+        let start = (index * self.per_chunk).min(self.items);
+        start..(start + self.per_chunk).min(self.items)
+    }
+}
+
+/// Seconds of work aimed at per chunk.
+pub const CHUNK_TARGET_S: f64 = 3.0;
+/// Chunks of a split job at least (when it has as many items).
+pub const MIN_CHUNKS: usize = 8;
+/// Jobs estimated below this many seconds are not split.
+pub const MIN_SPLIT_JOB_S: f64 = 0.5;
+/// Items of one chunk at most (bounds a chunk's result size).
+pub const MAX_ITEMS_PER_CHUNK: usize = 4096;
+/// How often an idle coordinator looks at its chunks.
+const COORDINATOR_POLL: Duration = Duration::from_millis(50);
+
+/// Runs a chunked job as its coordinator: creates its chunks, runs those
+/// it can claim, and assembles the answer when every chunk is done. When a
+/// chunk failed (or the store did), its error body goes to `failure` and
+/// the answer is `Err(Cancelled)`.
+pub(super) fn coordinate(
+    queue: &JobQueue,
+    lease: &super::store::Lease,
+    submission: &JobSubmission,
+    plan: ChunkPlan,
+    progress: &dyn Progress,
+    failure: &std::sync::Mutex<Option<String>>,
+) -> Result<String, RequestError> {
+    let fail = |body: String| {
+        *failure.lock().unwrap_or_else(|e| e.into_inner()) = Some(body);
+        RequestError::Cancelled
+    };
+    let store_err = |e: StoreError| {
+        fail(error_json(ErrorBody::new(
+            "internal",
+            None,
+            format!("the job store failed while the chunks of this job ran: {e}"),
+        )))
+    };
+    let store = &queue.store;
+    let total = plan.count();
+    if !store.create_chunks(lease, total).map_err(store_err)? {
+        return Err(RequestError::Cancelled);
+    }
+    let mut iterations: u64 = 0;
+    loop {
+        iterations += 1;
+        if iterations > MAX_COORDINATOR_LOOPS {
+            return Err(fail(error_json(ErrorBody::new(
+                "internal",
+                None,
+                "the chunks of this job did not finish within the coordinator's loop limit",
+            ))));
+        }
+        if progress.cancelled() {
+            return Err(RequestError::Cancelled);
+        }
+        let state = store.chunk_state(lease.job_id).map_err(store_err)?;
+        if let Some(error) = state.failed {
+            return Err(fail(error));
+        }
+        progress.report(state.done, total);
+        if state.done >= total {
+            let parts = store.chunk_results(lease.job_id).map_err(store_err)?;
+            let indices: Vec<usize> = parts.iter().map(|(i, _)| *i).collect();
+            if indices != (0..total).collect::<Vec<_>>() {
+                return Err(fail(error_json(ErrorBody::new(
+                    "internal",
+                    None,
+                    format!("chunk results {indices:?} are not exactly 0..{total}"),
+                ))));
+            }
+            let parts: Vec<String> = parts.into_iter().map(|(_, r)| r).collect();
+            return submission.assemble(plan, &parts);
+        }
+        match execute_chunk(queue, Some(lease.job_id)).map_err(store_err)? {
+            Some(_) => {}
+            None => std::thread::sleep(COORDINATOR_POLL),
+        }
+    }
+}
+
+/// Polls of one coordinator at most (at 50 ms, more than 50 days).
+const MAX_COORDINATOR_LOOPS: u64 = 100_000_000;
+
+/// Where a chunk ended, for the caller.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChunkOutcome {
+    Done,
+    Failed,
+    /// Lease lost (taken over, job cancelled) or handed back at shutdown.
+    Stopped,
+}
+
+/// Stop signals of one running chunk.
+struct ChunkControl<'a> {
+    queue: &'a JobQueue,
+    lost: AtomicBool,
+    started: Instant,
+}
+
+impl Progress for ChunkControl<'_> {
+    fn report(&self, _: usize, _: usize) {}
+    fn cancelled(&self) -> bool {
+        self.lost.load(Ordering::Relaxed)
+            || self.queue.is_shut_down()
+            || self.started.elapsed() > self.queue.limits.max_job_run_time
+    }
+}
+
+/// Claims one pending chunk (of `job` only, when given) and runs it to its
+/// end; None when there was none to claim.
+pub fn execute_chunk(
+    queue: &JobQueue,
+    job: Option<i64>,
+) -> Result<Option<(ChunkLease, ChunkOutcome)>, StoreError> {
+    let limits = &queue.limits;
+    let exhausted = error_json(ErrorBody::new(
+        "attempts_exhausted",
+        None,
+        format!(
+            "a chunk of the job was started {} times and each time the process running it \
+             stopped before it finished (crash, out of memory or kill); the job is failed",
+            limits.max_job_attempts
+        ),
+    ));
+    let policy = ClaimPolicy {
+        lease: limits.job_lease,
+        max_attempts: limits.max_job_attempts,
+        exhausted_error: &exhausted,
+    };
+    let Some(chunk) = queue.store.claim_chunk(job, &policy)? else {
+        return Ok(None);
+    };
+    let lease = chunk.lease.clone();
+    let span = tracing::info_span!(
+        "chunk",
+        job = lease.job_id,
+        index = lease.index,
+        attempt = chunk.attempts
+    );
+    let _enter = span.enter();
+    let ctl = ChunkControl {
+        queue,
+        lost: AtomicBool::new(false),
+        started: Instant::now(),
+    };
+    let outcome = std::thread::scope(|scope| {
+        let (stop, stopped) = std::sync::mpsc::channel::<()>();
+        let (ctl, lease) = (&ctl, &lease);
+        scope.spawn(move || {
+            let every = limits.job_lease / 3;
+            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = stopped.recv_timeout(every)
+            {
+                match queue.store.renew_chunk(lease, limits.job_lease) {
+                    Ok(true) => {}
+                    Ok(false) => {
+                        tracing::warn!("chunk lease lost: the chunk stops here");
+                        ctl.lost.store(true, Ordering::Relaxed);
+                        return;
+                    }
+                    Err(e) => tracing::warn!(error = %e, "chunk lease not renewed"),
+                }
+            }
+        });
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            queue.pool.install(|| {
+                let submission = JobSubmission::parse(chunk.request.as_bytes(), limits)?;
+                match submission.chunk_plan() {
+                    Some(plan) => submission.run_chunk(plan.range(lease.index), ctl),
+                    None => Err(crate::numerics::params::InvalidInput::new(
+                        "kind",
+                        "a chunk of a job whose kind is not chunked",
+                    )
+                    .into()),
+                }
+            })
+        }));
+        drop(stop);
+        outcome
+    });
+    let ended = match outcome {
+        Ok(Ok(result)) => {
+            if queue.store.finish_chunk(&lease, &result)? {
+                ChunkOutcome::Done
+            } else {
+                ChunkOutcome::Stopped
+            }
+        }
+        Ok(Err(RequestError::Cancelled)) => {
+            if queue.is_shut_down() {
+                queue.store.release_chunk(&lease)?;
+            }
+            ChunkOutcome::Stopped
+        }
+        Ok(Err(e)) => {
+            if queue.store.fail_chunk(&lease, &error_json(e.body()))? {
+                ChunkOutcome::Failed
+            } else {
+                ChunkOutcome::Stopped
+            }
+        }
+        Err(_) => {
+            tracing::error!("chunk panicked");
+            let body = ErrorBody::new("internal", None, "a chunk of the job panicked");
+            queue.store.fail_chunk(&lease, &error_json(body))?;
+            ChunkOutcome::Failed
+        }
+    };
+    tracing::info!(
+        outcome = ?ended,
+        elapsed_ms = ctl.started.elapsed().as_millis() as u64,
+        "chunk ended"
+    );
+    Ok(Some((lease, ended)))
+}

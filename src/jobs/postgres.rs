@@ -1,0 +1,770 @@
+//! The PostgreSQL job store ([`PgStore`]): the same [`JobBackend`] as
+//! SQLite, for an API and any number of worker processes on any hosts
+//! sharing one database (`TETHERPLAN_DATABASE_URL=postgres://…`).
+//!
+//! Claims are one statement each: `UPDATE … WHERE id = (SELECT … FOR
+//! UPDATE SKIP LOCKED)`, so concurrent workers never wait on each other's
+//! candidate rows, and the claim is a lease (owner, expiry in ms since the
+//! Unix epoch, epoch) exactly as in SQLite, not a row lock held by an open
+//! transaction: a worker that dies, or loses its network, loses its jobs
+//! and chunks when the lease expires, and its fenced writes change nothing
+//! afterwards. (Lease expiry compares the workers' clocks: keep them in
+//! sync, as NTP does.)
+//!
+//! Crate: the synchronous `postgres` client (rust-postgres, which is
+//! `tokio-postgres` driven by a private runtime). The store is used from
+//! plain threads (workers) and from `spawn_blocking` (handlers), like the
+//! SQLite one; the client panics if it is called on a thread that runs a
+//! tokio runtime, so such a call is moved to a scoped thread
+//! ([`PgStore::with`]). sqlx is not used: its `libsqlite3-sys` cannot be
+//! linked with the one `rusqlite` needs. Queue crates (apalis-postgres,
+//! graphile_worker) own their job model; ours needs fenced chunk writes
+//! and the existing job contract, a few statements over two tables.
+//!
+//! Schema versions, one row each in `schema_version`, applied at start
+//! under an advisory lock (idempotent; several processes may start at once):
+//! 1. `jobs` (as SQLite's versions 1–2, with `priority`);
+//! 2. `job_chunks` and `workers`.
+
+use std::sync::{Mutex, MutexGuard};
+use std::time::Duration;
+
+use postgres::{Client, NoTls, Row};
+
+use super::chunks::{ChunkLease, ChunkState, ClaimedChunk};
+use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
+use super::store::{
+    ClaimPolicy, ClaimedJob, InsertError, Inserted, JobBackend, JobRecord, JobStatus, KeyedJob,
+    NewJob, StoreError,
+};
+
+const MIGRATIONS: &[(i32, &str)] = &[
+    (
+        1,
+        "CREATE TABLE jobs (
+            id               BIGSERIAL PRIMARY KEY,
+            kind             TEXT NOT NULL,
+            request          TEXT NOT NULL,
+            status           TEXT NOT NULL
+                CHECK (status IN ('queued', 'running', 'done', 'failed', 'cancelled')),
+            progress         DOUBLE PRECISION NOT NULL DEFAULT 0,
+            attempts         INTEGER NOT NULL DEFAULT 0,
+            result           TEXT,
+            error            TEXT,
+            created_at       TEXT NOT NULL DEFAULT to_char(clock_timestamp() AT TIME ZONE 'UTC',
+                                 'YYYY-MM-DD\"T\"HH24:MI:SS.MS\"Z\"'),
+            started_at       TEXT,
+            finished_at      TEXT,
+            owner            TEXT,
+            idempotency_key  TEXT,
+            request_hash     TEXT,
+            lease_owner      TEXT,
+            lease_expires_ms BIGINT,
+            lease_epoch      BIGINT NOT NULL DEFAULT 0,
+            priority         INTEGER NOT NULL DEFAULT 0
+        );
+        CREATE INDEX jobs_by_claim ON jobs (status, priority, id);
+        CREATE INDEX jobs_by_owner ON jobs (owner, status);
+        CREATE UNIQUE INDEX jobs_by_idempotency_key ON jobs (coalesce(owner, ''), idempotency_key)
+            WHERE idempotency_key IS NOT NULL;",
+    ),
+    (
+        2,
+        "CREATE TABLE job_chunks (
+            job_id           BIGINT NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,
+            idx              INTEGER NOT NULL,
+            status           TEXT NOT NULL CHECK (status IN ('pending', 'running', 'done', 'failed')),
+            attempts         INTEGER NOT NULL DEFAULT 0,
+            lease_owner      TEXT,
+            lease_expires_ms BIGINT,
+            lease_epoch      BIGINT NOT NULL DEFAULT 0,
+            result           TEXT,
+            error            TEXT,
+            finished_by      TEXT,
+            PRIMARY KEY (job_id, idx)
+        );
+        CREATE INDEX job_chunks_by_status ON job_chunks (status, job_id, idx);
+        CREATE TABLE workers (
+            id           TEXT PRIMARY KEY,
+            role         TEXT NOT NULL,
+            started_ms   BIGINT NOT NULL,
+            heartbeat_ms BIGINT NOT NULL
+        );",
+    ),
+];
+
+/// The current schema version.
+pub const SCHEMA_VERSION: i32 = 2;
+
+/// Advisory lock key of migrations (and of inserts: quotas are counted
+/// and the row written under it).
+const MIGRATION_LOCK: i64 = 0x7465_7468_6572_0001;
+const INSERT_LOCK: i64 = 0x7465_7468_6572_0002;
+
+const NOW: &str =
+    "to_char(clock_timestamp() AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.MS\"Z\"')";
+
+const FENCE: &str = "id = $1 AND status = 'running' AND lease_owner = $2 AND lease_epoch = $3";
+
+const CHUNK_FENCE: &str = "job_id = $1 AND idx = $2 AND status = 'running' AND lease_owner = $3
+    AND lease_epoch = $4 AND (SELECT status FROM jobs WHERE id = $1) = 'running'";
+
+const COLUMNS: &str =
+    "id, kind, status, progress, attempts, created_at, started_at, finished_at, lease_owner";
+
+/// The job tables of one PostgreSQL database, claiming as one worker.
+pub struct PgStore {
+    url: String,
+    client: Mutex<Option<Client>>,
+    worker: WorkerId,
+}
+
+impl From<postgres::Error> for StoreError {
+    fn from(e: postgres::Error) -> Self {
+        Self(format!("postgres: {e}"))
+    }
+}
+
+/// `url` without its password, for logs and messages.
+pub fn redact(url: &str) -> String {
+    match (url.find("://"), url.rfind('@')) {
+        (Some(s), Some(at)) if at > s => {
+            let creds = &url[s + 3..at];
+            match creds.find(':') {
+                Some(c) => format!("{}{}:***{}", &url[..s + 3], &creds[..c], &url[at..]),
+                None => url.to_string(),
+            }
+        }
+        _ => url.to_string(),
+    }
+}
+
+impl PgStore {
+    /// Connects, migrates the schema and takes over the jobs of dead
+    /// processes on this host.
+    pub fn open(url: &str) -> Result<Self, StoreError> {
+        let store = Self {
+            url: url.to_string(),
+            client: Mutex::new(None),
+            worker: WorkerId::this_process(),
+        };
+        store.with(|c| migrate(c))?;
+        let recovered = store.recover_local()?;
+        if recovered > 0 {
+            tracing::info!(
+                recovered,
+                "jobs of a dead process on this host taken over at start-up"
+            );
+        }
+        Ok(store)
+    }
+
+    /// Runs `f` on the connection (reconnecting when it was lost), off any
+    /// tokio runtime thread.
+    fn with<R: Send>(
+        &self,
+        f: impl FnOnce(&mut Client) -> Result<R, StoreError> + Send,
+    ) -> Result<R, StoreError> {
+        let run = || -> Result<R, StoreError> {
+            let mut guard: MutexGuard<'_, Option<Client>> =
+                self.client.lock().unwrap_or_else(|e| e.into_inner());
+            if guard.as_ref().is_none_or(Client::is_closed) {
+                *guard = Some(connect(&self.url)?);
+            }
+            let client = guard.as_mut().expect("connected above");
+            let out = f(client);
+            if out.is_err() && client.is_closed() {
+                *guard = None;
+            }
+            out
+        };
+        if tokio::runtime::Handle::try_current().is_ok() {
+            std::thread::scope(|s| {
+                s.spawn(run)
+                    .join()
+                    .unwrap_or_else(|_| Err(StoreError("the database call panicked".into())))
+            })
+        } else {
+            run()
+        }
+    }
+
+    fn fenced(
+        &self,
+        set: &str,
+        lease: &Lease,
+        extra: Option<&(dyn postgres::types::ToSql + Sync)>,
+    ) -> Result<bool, StoreError> {
+        let n = self.with(|c| {
+            let n = match extra {
+                Some(x) => c.execute(
+                    &format!("UPDATE jobs SET {set} WHERE {FENCE}"),
+                    &[&lease.job_id, &lease.owner, &lease.epoch, x],
+                )?,
+                None => c.execute(
+                    &format!("UPDATE jobs SET {set} WHERE {FENCE}"),
+                    &[&lease.job_id, &lease.owner, &lease.epoch],
+                )?,
+            };
+            Ok(n)
+        })?;
+        Ok(n == 1)
+    }
+
+    fn chunk_fenced(
+        &self,
+        set: &str,
+        lease: &ChunkLease,
+        extra: Option<&(dyn postgres::types::ToSql + Sync)>,
+    ) -> Result<bool, StoreError> {
+        let idx = lease.index as i32;
+        let n = self.with(|c| {
+            let sql = format!("UPDATE job_chunks SET {set} WHERE {CHUNK_FENCE}");
+            let n = match extra {
+                Some(x) => {
+                    c.execute(&sql, &[&lease.job_id, &idx, &lease.owner, &lease.epoch, x])?
+                }
+                None => c.execute(&sql, &[&lease.job_id, &idx, &lease.owner, &lease.epoch])?,
+            };
+            Ok(n)
+        })?;
+        Ok(n == 1)
+    }
+}
+
+fn connect(url: &str) -> Result<Client, StoreError> {
+    Client::connect(url, NoTls)
+        .map_err(|e| StoreError(format!("cannot connect to {}: {e}", redact(url))))
+}
+
+fn migrate(c: &mut Client) -> Result<(), StoreError> {
+    let mut tx = c.transaction()?;
+    tx.execute("SELECT pg_advisory_xact_lock($1)", &[&MIGRATION_LOCK])?;
+    tx.batch_execute(
+        "CREATE TABLE IF NOT EXISTS schema_version (
+            version    INTEGER PRIMARY KEY,
+            applied_at TIMESTAMPTZ NOT NULL DEFAULT now()
+        )",
+    )?;
+    let current: i32 = tx
+        .query_one("SELECT coalesce(max(version), 0) FROM schema_version", &[])?
+        .get(0);
+    for (version, sql) in MIGRATIONS {
+        if *version > current {
+            tx.batch_execute(sql)?;
+            tx.execute(
+                "INSERT INTO schema_version (version) VALUES ($1)",
+                &[version],
+            )?;
+            tracing::info!(version, "job database migrated");
+        }
+    }
+    tx.commit()?;
+    Ok(())
+}
+
+fn record(r: &Row) -> JobRecord {
+    let status: String = r.get(2);
+    let attempts: i32 = r.get(4);
+    JobRecord {
+        id: r.get(0),
+        kind: r.get(1),
+        status: JobStatus::parse(&status),
+        progress: r.get(3),
+        attempts: attempts.max(0) as u32,
+        created_at: r.get(5),
+        started_at: r.get(6),
+        finished_at: r.get(7),
+        worker: r.get(8),
+        result: None,
+        error: None,
+    }
+}
+
+fn find_by_key(
+    c: &mut impl postgres::GenericClient,
+    owner: Option<&str>,
+    key: &str,
+) -> Result<Option<KeyedJob>, StoreError> {
+    Ok(c.query_opt(
+        "SELECT id, kind, status, request_hash FROM jobs
+         WHERE coalesce(owner, '') = coalesce($1, '') AND idempotency_key = $2",
+        &[&owner, &key],
+    )?
+    .map(|r| {
+        let status: String = r.get(2);
+        KeyedJob {
+            id: r.get(0),
+            kind: r.get(1),
+            status: JobStatus::parse(&status),
+            request_hash: r.get::<_, Option<String>>(3).unwrap_or_default(),
+        }
+    }))
+}
+
+fn millis(d: Duration) -> i64 {
+    d.as_millis().min(i64::MAX as u128) as i64
+}
+
+impl JobBackend for PgStore {
+    fn worker(&self) -> &WorkerId {
+        &self.worker
+    }
+
+    fn find_by_key(&self, owner: Option<&str>, key: &str) -> Result<Option<KeyedJob>, StoreError> {
+        self.with(|c| find_by_key(c, owner, key))
+    }
+
+    fn insert(&self, job: &NewJob<'_>) -> Result<Inserted, InsertError> {
+        let outcome = self.with(|c| {
+            let mut tx = c.transaction()?;
+            tx.execute("SELECT pg_advisory_xact_lock($1)", &[&INSERT_LOCK])?;
+            if let Some(key) = job.idempotency_key
+                && let Some(first) = find_by_key(&mut tx, job.owner, key)?
+            {
+                if first.request_hash != job.request_hash {
+                    return Ok(Err(InsertError::KeyReused {
+                        key: key.to_string(),
+                        id: first.id,
+                    }));
+                }
+                return Ok(Ok(Inserted::Existing {
+                    id: first.id,
+                    kind: first.kind,
+                    status: first.status,
+                }));
+            }
+            let pending: i64 = tx
+                .query_one(
+                    "SELECT count(*) FROM jobs WHERE status IN ('queued', 'running')",
+                    &[],
+                )?
+                .get(0);
+            if pending as usize >= job.max_pending {
+                return Ok(Err(InsertError::QueueFull {
+                    pending: pending as usize,
+                    limit: job.max_pending,
+                }));
+            }
+            if let Some(owner) = job.owner {
+                let mine: i64 = tx
+                    .query_one(
+                        "SELECT count(*) FROM jobs WHERE owner = $1 AND status IN ('queued', 'running')",
+                        &[&owner],
+                    )?
+                    .get(0);
+                if mine as usize >= job.max_pending_per_owner {
+                    return Ok(Err(InsertError::QuotaFull {
+                        pending: mine as usize,
+                        limit: job.max_pending_per_owner,
+                    }));
+                }
+            }
+            let priority = job.priority as i32;
+            let id: i64 = tx
+                .query_one(
+                    "INSERT INTO jobs (kind, request, status, owner, idempotency_key, request_hash, priority)
+                     VALUES ($1, $2, 'queued', $3, $4, $5, $6) RETURNING id",
+                    &[
+                        &job.kind,
+                        &job.request,
+                        &job.owner,
+                        &job.idempotency_key,
+                        &job.request_hash,
+                        &priority,
+                    ],
+                )?
+                .get(0);
+            tx.commit()?;
+            Ok(Ok(Inserted::New(id)))
+        })?;
+        outcome
+    }
+
+    fn claim(&self, policy: &ClaimPolicy<'_>) -> Result<Option<ClaimedJob>, StoreError> {
+        let owner = self.worker.as_str().to_string();
+        self.with(|c| {
+            let now = now_ms();
+            let max_attempts = policy.max_attempts.min(i32::MAX as u32) as i32;
+            let exhausted = c.execute(
+                &format!(
+                    "UPDATE jobs SET status = 'failed', result = NULL, error = $1, finished_at = {NOW},
+                        lease_expires_ms = NULL
+                     WHERE status = 'running' AND coalesce(lease_expires_ms, 0) < $2 AND attempts >= $3"
+                ),
+                &[&policy.exhausted_error, &now, &max_attempts],
+            )?;
+            if exhausted > 0 {
+                tracing::warn!(
+                    jobs = exhausted,
+                    attempts = policy.max_attempts,
+                    "jobs whose process died at every attempt were failed"
+                );
+            }
+            let expires = now.saturating_add(millis(policy.lease));
+            let row = c.query_opt(
+                &format!(
+                    "UPDATE jobs SET status = 'running', progress = 0, attempts = attempts + 1,
+                        started_at = {NOW}, lease_owner = $1, lease_expires_ms = $2,
+                        lease_epoch = lease_epoch + 1
+                     WHERE id = (SELECT id FROM jobs
+                                 WHERE status = 'queued'
+                                    OR (status = 'running' AND coalesce(lease_expires_ms, 0) < $3)
+                                 ORDER BY priority, id LIMIT 1
+                                 FOR UPDATE SKIP LOCKED)
+                     RETURNING id, kind, request, attempts, lease_epoch"
+                ),
+                &[&owner, &expires, &now],
+            )?;
+            Ok(row.map(|r| {
+                let attempts: i32 = r.get(3);
+                ClaimedJob {
+                    id: r.get(0),
+                    kind: r.get(1),
+                    request: r.get(2),
+                    attempts: attempts.max(0) as u32,
+                    lease: Lease {
+                        job_id: r.get(0),
+                        owner: owner.clone(),
+                        epoch: r.get(4),
+                    },
+                }
+            }))
+        })
+    }
+
+    fn renew(&self, lease: &Lease, duration: Duration) -> Result<bool, StoreError> {
+        let at = expiry_ms(duration);
+        self.fenced("lease_expires_ms = $4", lease, Some(&at))
+    }
+
+    fn set_progress(&self, lease: &Lease, progress: f64) -> Result<bool, StoreError> {
+        let p = progress.clamp(0.0, 1.0);
+        self.fenced("progress = $4", lease, Some(&p))
+    }
+
+    fn finish_done(&self, lease: &Lease, result: &str) -> Result<bool, StoreError> {
+        self.fenced(
+            &format!(
+                "status = 'done', progress = 1, result = $4, error = NULL, finished_at = {NOW},
+                 lease_expires_ms = NULL"
+            ),
+            lease,
+            Some(&result),
+        )
+    }
+
+    fn finish_failed(&self, lease: &Lease, error: &str) -> Result<bool, StoreError> {
+        self.fenced(
+            &format!(
+                "status = 'failed', result = NULL, error = $4, finished_at = {NOW},
+                 lease_expires_ms = NULL"
+            ),
+            lease,
+            Some(&error),
+        )
+    }
+
+    fn release(&self, lease: &Lease) -> Result<bool, StoreError> {
+        self.fenced("status = 'queued', lease_expires_ms = NULL", lease, None)
+    }
+
+    fn release_all(&self) -> Result<usize, StoreError> {
+        let me = self.worker.as_str();
+        self.with(|c| {
+            c.execute(
+                "UPDATE job_chunks SET status = 'pending', lease_expires_ms = NULL
+                 WHERE status = 'running' AND lease_owner = $1",
+                &[&me],
+            )?;
+            Ok(c.execute(
+                "UPDATE jobs SET status = 'queued', lease_expires_ms = NULL
+                 WHERE status = 'running' AND lease_owner = $1",
+                &[&me],
+            )? as usize)
+        })
+    }
+
+    fn recover_local(&self) -> Result<usize, StoreError> {
+        self.with(|c| {
+            let mut n = 0;
+            for table in ["jobs", "job_chunks"] {
+                let owners: Vec<String> = c
+                    .query(
+                        &format!(
+                            "SELECT DISTINCT lease_owner FROM {table}
+                             WHERE status = 'running' AND lease_owner IS NOT NULL"
+                        ),
+                        &[],
+                    )?
+                    .iter()
+                    .map(|r| r.get(0))
+                    .collect();
+                for owner in owners.iter().filter(|o| self.worker.is_dead_local(o)) {
+                    let k = c.execute(
+                        &format!(
+                            "UPDATE {table} SET lease_expires_ms = 0
+                             WHERE status = 'running' AND lease_owner = $1"
+                        ),
+                        &[owner],
+                    )?;
+                    if table == "jobs" {
+                        n += k as usize;
+                    }
+                }
+            }
+            Ok(n)
+        })
+    }
+
+    fn cancel(
+        &self,
+        id: i64,
+        owner: Option<&str>,
+        error: &str,
+    ) -> Result<Option<JobRecord>, StoreError> {
+        self.with(|c| {
+            c.execute(
+                &format!(
+                    "UPDATE jobs SET status = 'cancelled', error = $2, finished_at = {NOW},
+                        lease_expires_ms = NULL
+                     WHERE id = $1 AND status IN ('queued', 'running')
+                       AND ($3::TEXT IS NULL OR owner = $3)"
+                ),
+                &[&id, &error, &owner],
+            )?;
+            Ok(())
+        })?;
+        self.get_owned(id, owner)
+    }
+
+    fn get_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobRecord>, StoreError> {
+        self.with(|c| {
+            Ok(c.query_opt(
+                &format!(
+                    "SELECT {COLUMNS}, result, error FROM jobs
+                     WHERE id = $1 AND ($2::TEXT IS NULL OR owner = $2)"
+                ),
+                &[&id, &owner],
+            )?
+            .map(|r| {
+                let mut rec = record(&r);
+                rec.result = r.get(9);
+                rec.error = r.get(10);
+                rec
+            }))
+        })
+    }
+
+    fn list_owned(
+        &self,
+        owner: Option<&str>,
+        status: Option<JobStatus>,
+        limit: usize,
+    ) -> Result<Vec<JobRecord>, StoreError> {
+        let status = status.map(JobStatus::as_str);
+        let limit = limit.min(i64::MAX as usize) as i64;
+        self.with(|c| {
+            Ok(c.query(
+                &format!(
+                    "SELECT {COLUMNS}, error FROM jobs
+                     WHERE ($1::TEXT IS NULL OR status = $1) AND ($3::TEXT IS NULL OR owner = $3)
+                     ORDER BY id DESC LIMIT $2"
+                ),
+                &[&status, &limit, &owner],
+            )?
+            .iter()
+            .map(|r| {
+                let mut rec = record(r);
+                rec.error = r.get(9);
+                rec
+            })
+            .collect())
+        })
+    }
+
+    fn status_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobStatus>, StoreError> {
+        self.with(|c| {
+            Ok(c.query_opt(
+                "SELECT status FROM jobs WHERE id = $1 AND ($2::TEXT IS NULL OR owner = $2)",
+                &[&id, &owner],
+            )?
+            .map(|r| JobStatus::parse(&r.get::<_, String>(0))))
+        })
+    }
+
+    fn pending(&self) -> Result<usize, StoreError> {
+        self.with(|c| {
+            let n: i64 = c
+                .query_one(
+                    "SELECT count(*) FROM jobs WHERE status IN ('queued', 'running')",
+                    &[],
+                )?
+                .get(0);
+            Ok(n as usize)
+        })
+    }
+
+    fn store_kind(&self) -> &'static str {
+        "postgres"
+    }
+
+    fn create_chunks(&self, lease: &Lease, count: usize) -> Result<bool, StoreError> {
+        let count = count.min(i32::MAX as usize) as i32;
+        self.with(|c| {
+            let mut tx = c.transaction()?;
+            let held = tx.query_opt(
+                &format!("SELECT id FROM jobs WHERE {FENCE} FOR UPDATE"),
+                &[&lease.job_id, &lease.owner, &lease.epoch],
+            )?;
+            if held.is_none() {
+                return Ok(false);
+            }
+            tx.execute(
+                "INSERT INTO job_chunks (job_id, idx, status)
+                 SELECT $1, i, 'pending' FROM generate_series(0, $2 - 1) AS i
+                 ON CONFLICT (job_id, idx) DO NOTHING",
+                &[&lease.job_id, &count],
+            )?;
+            tx.commit()?;
+            Ok(true)
+        })
+    }
+
+    fn claim_chunk(
+        &self,
+        job: Option<i64>,
+        policy: &ClaimPolicy<'_>,
+    ) -> Result<Option<ClaimedChunk>, StoreError> {
+        let owner = self.worker.as_str().to_string();
+        self.with(|c| {
+            let now = now_ms();
+            let max_attempts = policy.max_attempts.min(i32::MAX as u32) as i32;
+            c.execute(
+                "UPDATE job_chunks SET status = 'failed', error = $1, lease_expires_ms = NULL
+                 WHERE status = 'running' AND coalesce(lease_expires_ms, 0) < $2 AND attempts >= $3",
+                &[&policy.exhausted_error, &now, &max_attempts],
+            )?;
+            let expires = now.saturating_add(millis(policy.lease));
+            let row = c.query_opt(
+                "WITH next AS (
+                     SELECT c.job_id, c.idx FROM job_chunks c JOIN jobs j ON j.id = c.job_id
+                     WHERE j.status = 'running' AND ($4::BIGINT IS NULL OR c.job_id = $4)
+                       AND (c.status = 'pending'
+                            OR (c.status = 'running' AND coalesce(c.lease_expires_ms, 0) < $3))
+                     ORDER BY j.priority, c.job_id, c.idx LIMIT 1
+                     FOR UPDATE OF c SKIP LOCKED)
+                 UPDATE job_chunks u SET status = 'running', attempts = u.attempts + 1,
+                     lease_owner = $1, lease_expires_ms = $2, lease_epoch = u.lease_epoch + 1
+                 FROM next WHERE u.job_id = next.job_id AND u.idx = next.idx
+                 RETURNING u.job_id, u.idx, u.attempts, u.lease_epoch,
+                     (SELECT request FROM jobs WHERE id = u.job_id)",
+                &[&owner, &expires, &now, &job],
+            )?;
+            Ok(row.map(|r| {
+                let idx: i32 = r.get(1);
+                let attempts: i32 = r.get(2);
+                ClaimedChunk {
+                    lease: ChunkLease {
+                        job_id: r.get(0),
+                        index: idx.max(0) as usize,
+                        owner: owner.clone(),
+                        epoch: r.get(3),
+                    },
+                    request: r.get(4),
+                    attempts: attempts.max(0) as u32,
+                }
+            }))
+        })
+    }
+
+    fn renew_chunk(&self, lease: &ChunkLease, duration: Duration) -> Result<bool, StoreError> {
+        let at = expiry_ms(duration);
+        self.chunk_fenced("lease_expires_ms = $5", lease, Some(&at))
+    }
+
+    fn finish_chunk(&self, lease: &ChunkLease, result: &str) -> Result<bool, StoreError> {
+        self.chunk_fenced(
+            "status = 'done', result = $5, lease_expires_ms = NULL, finished_by = lease_owner",
+            lease,
+            Some(&result),
+        )
+    }
+
+    fn fail_chunk(&self, lease: &ChunkLease, error: &str) -> Result<bool, StoreError> {
+        self.chunk_fenced(
+            "status = 'failed', error = $5, lease_expires_ms = NULL",
+            lease,
+            Some(&error),
+        )
+    }
+
+    fn release_chunk(&self, lease: &ChunkLease) -> Result<bool, StoreError> {
+        self.chunk_fenced("status = 'pending', lease_expires_ms = NULL", lease, None)
+    }
+
+    fn chunk_state(&self, job_id: i64) -> Result<ChunkState, StoreError> {
+        self.with(|c| {
+            let r = c.query_one(
+                "SELECT count(*), count(*) FILTER (WHERE status = 'done'),
+                    (SELECT error FROM job_chunks WHERE job_id = $1 AND status = 'failed'
+                     ORDER BY idx LIMIT 1)
+                 FROM job_chunks WHERE job_id = $1",
+                &[&job_id],
+            )?;
+            let (total, done): (i64, i64) = (r.get(0), r.get(1));
+            Ok(ChunkState {
+                total: total as usize,
+                done: done as usize,
+                failed: r.get(2),
+            })
+        })
+    }
+
+    fn chunk_results(&self, job_id: i64) -> Result<Vec<(usize, String)>, StoreError> {
+        self.with(|c| {
+            Ok(c.query(
+                "SELECT idx, result FROM job_chunks WHERE job_id = $1 AND status = 'done'
+                 ORDER BY idx",
+                &[&job_id],
+            )?
+            .iter()
+            .map(|r| (r.get::<_, i32>(0).max(0) as usize, r.get(1)))
+            .collect())
+        })
+    }
+
+    fn worker_heartbeat(&self, role: &str) -> Result<(), StoreError> {
+        let me = self.worker.as_str();
+        self.with(|c| {
+            let now = now_ms();
+            c.execute(
+                "INSERT INTO workers (id, role, started_ms, heartbeat_ms) VALUES ($1, $2, $3, $3)
+                 ON CONFLICT (id) DO UPDATE SET heartbeat_ms = excluded.heartbeat_ms",
+                &[&me, &role, &now],
+            )?;
+            Ok(())
+        })
+    }
+
+    fn worker_leave(&self) -> Result<(), StoreError> {
+        let me = self.worker.as_str();
+        self.with(|c| {
+            c.execute("DELETE FROM workers WHERE id = $1", &[&me])?;
+            Ok(())
+        })
+    }
+
+    fn live_workers(&self, within: Duration) -> Result<usize, StoreError> {
+        let since = now_ms() - millis(within);
+        self.with(|c| {
+            let n: i64 = c
+                .query_one(
+                    "SELECT count(*) FROM workers WHERE heartbeat_ms >= $1",
+                    &[&since],
+                )?
+                .get(0);
+            Ok(n as usize)
+        })
+    }
+}
