@@ -191,7 +191,7 @@ fn every_route_is_documented_with_its_statuses() {
 #[test]
 fn numeric_fields_name_their_unit() {
     const UNITS: &[&str] = &[
-        "_m", "_s", "_m_s", "_m_s2", "_n", "_kg", "_kg_m", "_kg_m3", "_m2", "_1_s", "_hz",
+        "_m", "_s", "_m_s", "_m_s2", "_m_s3", "_n", "_kg", "_kg_m", "_kg_m3", "_m2", "_1_s", "_hz",
         "_nondim", "_db", "_deg", "_m3",
     ];
     // Counts, ids and fractions; RateGrid's bounds are described in m/s by its parent `rates_m_s`.
