@@ -1,7 +1,7 @@
 //! Scale-out figures over PostgreSQL (plain harness; skipped with a message
 //! when PostgreSQL is unreachable):
 //!
-//! 1. a GE chart job (48 points, 10 elements) run by 1 and by 2
+//! 1. a GE chart job (80 points, 10 elements, 10 chunks) run by 1 and by 2
 //!    `tetherplan worker` processes (one rayon thread each) behind an
 //!    API-only `tetherplan serve`: wall time from submission to `done`,
 //!    median of `TETHERPLAN_BENCH_RUNS` (3) runs each, and the speed-up;
@@ -42,10 +42,9 @@ impl Db {
             }
         };
         let name = format!("tetherplan_bench_{tag}_{}", std::process::id());
-        c.batch_execute(&format!(
-            "DROP DATABASE IF EXISTS {name} WITH (FORCE); CREATE DATABASE {name}"
-        ))
-        .unwrap();
+        c.batch_execute(&format!("DROP DATABASE IF EXISTS {name} WITH (FORCE)"))
+            .unwrap();
+        c.batch_execute(&format!("CREATE DATABASE {name}")).unwrap();
         let url = format!("{}/{name}", admin.rsplit_once('/').unwrap().0);
         Some(Self { admin, name, url })
     }
@@ -110,11 +109,26 @@ fn request(addr: SocketAddr, method: &str, path: &str, body: Option<&Value>) -> 
     let mut raw = Vec::new();
     s.read_to_end(&mut raw).unwrap();
     let split = raw.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
-    let text = String::from_utf8_lossy(&raw[split + 4..]).to_string();
-    // Small JSON answers come unchunked or in one chunk.
-    let json_start = text.find('{').unwrap_or(0);
-    let json_end = text.rfind('}').map_or(text.len(), |i| i + 1);
-    serde_json::from_str(&text[json_start..json_end]).unwrap_or(Value::Null)
+    let head = String::from_utf8_lossy(&raw[..split]).to_ascii_lowercase();
+    let mut body = raw[split + 4..].to_vec();
+    if head.contains("transfer-encoding: chunked") {
+        body = dechunk(&body);
+    }
+    serde_json::from_slice(&body).unwrap_or(Value::Null)
+}
+
+fn dechunk(mut b: &[u8]) -> Vec<u8> {
+    let mut out = vec![];
+    loop {
+        let eol = b.windows(2).position(|w| w == b"\r\n").unwrap();
+        let size =
+            usize::from_str_radix(std::str::from_utf8(&b[..eol]).unwrap().trim(), 16).unwrap();
+        if size == 0 {
+            return out;
+        }
+        out.extend_from_slice(&b[eol + 2..eol + 2 + size]);
+        b = &b[eol + 4 + size..];
+    }
 }
 
 fn chart_job() -> Value {
@@ -124,8 +138,8 @@ fn chart_job() -> Value {
         "initial_length_m": 1.0,
         "model": {"kind": "geometrically_exact", "elements": 10, "bending_stiffness_n_m2": 1000.0, "inertia_ratio": 1.0},
         "stiffness_ratios": [1e4, 1e5],
-        "rates_m_s": {"min": 60.0, "max": 110.0, "count": 24},
-        "numerics": {"horizon_s": 0.3}
+        "rates_m_s": {"min": 70.0, "max": 110.0, "count": 40},
+        "numerics": {"horizon_s": 20.0}
     }})
 }
 

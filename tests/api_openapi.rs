@@ -240,6 +240,8 @@ fn numeric_fields_name_their_unit() {
         "iterations_total",
         "_solves",
         "_cuts",
+        // Counts of processes (`/healthz` live_workers).
+        "_workers",
     ];
     let doc = doc();
     let mut offenders = vec![];
