@@ -310,52 +310,6 @@ fn tolerance_is_validated_and_honoured() {
     );
 }
 
-#[test]
-#[ignore = "diagnostic: prints the level values"]
-fn print_acceleration_ladder() {
-    use tetherplan::numerics::profile::Profile;
-    use tetherplan::numerics::string::StringModel;
-    use tetherplan::numerics::string::critical::{self, SearchConfig};
-    let sys = AerostatSystem::new(RHO_A, 1000.0, 10.0, 1.0, G).unwrap();
-    for a in [0.05, 0.5] {
-        let profile = Profile::constant_acceleration(1.0, a, None).unwrap();
-        let h = sys.closed_form_elevation_accelerating_m(a);
-        println!("a = {a}: closed form t* = {}", (2.0 * (h - 1.0) / a).sqrt());
-        for k in 0..16 {
-            let model = StringModel::with_operators(sys, converged::graded_operators(k));
-            let r = critical::critical_time(
-                &model,
-                &profile,
-                SearchConfig {
-                    confirm_with_qep: false,
-                },
-            )
-            .unwrap();
-            println!(
-                "  level {k} ({} el): {:?} {:?} confirmed {}",
-                model.elements(),
-                r.time_s(),
-                r.method,
-                r.confirmed()
-            );
-        }
-        for n in [25, 50, 100, 200, 400] {
-            let model = StringModel::new(sys, n).unwrap();
-            let r = critical::critical_time(
-                &model,
-                &profile,
-                SearchConfig {
-                    confirm_with_qep: false,
-                },
-            )
-            .unwrap();
-            println!("  uniform {n}: {:?} {:?}", r.time_s(), r.method);
-        }
-        let c = converged::constant_acceleration(&sys, a, None, 1e-4).unwrap();
-        println!("  converged: {:?}", c.time_s);
-    }
-}
-
 fn stability(body: Value) -> tetherplan::contract::dto::StabilityResponse {
     let req: tetherplan::contract::dto::StabilityRequest =
         contract::parse(body.to_string().as_bytes()).unwrap();
@@ -439,52 +393,3 @@ fn the_roller_element_mesh_gives_the_graded_mesh_value() {
     }
 }
 
-#[test]
-#[ignore = "diagnostic: timings"]
-fn print_timings() {
-    use std::time::Instant;
-    use tetherplan::numerics::string::StringModel;
-    let sys = AerostatSystem::thesis();
-    let s = sys.to_nondim(tetherplan::numerics::params::Kinematics {
-        length_m: 1100.0,
-        rate_m_s: 30.0,
-        acceleration_m_s2: 0.5,
-    });
-    for level in [0, 4, 7, 10] {
-        let model = StringModel::with_operators(sys, converged::graded_operators(level));
-        let t0 = Instant::now();
-        for _ in 0..20 {
-            model.spectrum(s).unwrap();
-        }
-        println!(
-            "QEP graded level {level} ({} el): {:?}",
-            model.elements(),
-            t0.elapsed() / 20
-        );
-    }
-    for n in [16, 24, 50] {
-        let model = StringModel::new(sys, n).unwrap();
-        let t0 = Instant::now();
-        for _ in 0..20 {
-            model.spectrum(s).unwrap();
-        }
-        println!("QEP uniform {n}: {:?}", t0.elapsed() / 20);
-    }
-    let t0 = Instant::now();
-    for _ in 0..20 {
-        converged::constant_acceleration(&sys, 0.5, None, 1e-4).unwrap();
-    }
-    println!("converged accel: {:?}", t0.elapsed() / 20);
-    let t0 = Instant::now();
-    for _ in 0..2000 {
-        converged::constant_rate(&sys, 10.0, None, 1e-4);
-    }
-    println!("converged rate: {:?}", t0.elapsed() / 2000);
-    let t0 = Instant::now();
-    for _ in 0..2000 {
-        converged::safe_rate(&sys, 1200.0, 1e-4).unwrap();
-    }
-    println!("converged safe rate: {:?}", t0.elapsed() / 2000);
-    let c = converged::constant_acceleration(&sys, 0.5, None, 1e-4).unwrap();
-    println!("{:?}", c);
-}

@@ -287,6 +287,11 @@ fn cable_one_of(cable: &mut Value) {
         }
         p
     };
+    // optional in both forms
+    let breaking = props
+        .get("breaking_strength_n")
+        .cloned()
+        .unwrap_or_else(|| json!({}));
     let description = cable
         .get("description")
         .cloned()
@@ -298,7 +303,10 @@ fn cable_one_of(cable: &mut Value) {
                 "title": "mass per length",
                 "type": "object",
                 "required": ["mass_per_length_kg_m"],
-                "properties": {"mass_per_length_kg_m": number("mass_per_length_kg_m")},
+                "properties": {
+                    "mass_per_length_kg_m": number("mass_per_length_kg_m"),
+                    "breaking_strength_n": breaking
+                },
                 "additionalProperties": false
             },
             {
@@ -307,7 +315,8 @@ fn cable_one_of(cable: &mut Value) {
                 "required": ["density_kg_m3", "area_m2"],
                 "properties": {
                     "density_kg_m3": number("density_kg_m3"),
-                    "area_m2": number("area_m2")
+                    "area_m2": number("area_m2"),
+                    "breaking_strength_n": breaking
                 },
                 "additionalProperties": false
             }

@@ -10,13 +10,13 @@ use utoipa::ToSchema;
 #[serde(deny_unknown_fields)]
 pub struct CableInput {
     /// Mass per unit length ρA (kg/m).
-    #[schema(example = 0.078, exclusive_minimum = 0.0)]
+    #[schema(example = 0.078, minimum = 1e-5, maximum = 100.0)]
     pub mass_per_length_kg_m: Option<f64>,
     /// Material density ρ (kg/m³), with `area_m2` (e.g. 7800 for steel).
-    #[schema(exclusive_minimum = 0.0)]
+    #[schema(minimum = 100.0, maximum = 30000.0)]
     pub density_kg_m3: Option<f64>,
     /// Cross-section area A (m²), with `density_kg_m3` (e.g. 1e-5).
-    #[schema(exclusive_minimum = 0.0)]
+    #[schema(minimum = 1e-9, maximum = 0.1)]
     pub area_m2: Option<f64>,
     /// Breaking strength (N): gives `critical` a safety factor (optional).
     #[serde(default)]
@@ -29,11 +29,11 @@ pub struct CableInput {
 #[serde(deny_unknown_fields)]
 pub struct AerostatInput {
     /// Net buoyancy F = F_b − m g (N): the upward pull on the cable.
-    #[schema(example = 1000.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1000.0, minimum = 0.001, maximum = 1e7)]
     pub net_buoyancy_n: f64,
     /// Aerostat mass m (kg).
     #[serde(default)]
-    #[schema(example = 10.0, minimum = 0.0)]
+    #[schema(example = 10.0, minimum = 0.0, maximum = 1e6)]
     pub mass_kg: f64,
 }
 
@@ -124,11 +124,11 @@ pub struct SystemInput {
     pub aerostat: AerostatInput,
     /// Initial cable length L0 (m), the length scale.
     #[serde(default = "default_initial_length")]
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 0.001, maximum = 10000.0)]
     pub initial_length_m: f64,
     /// Gravitational acceleration (m/s²).
     #[serde(default = "default_gravity")]
-    #[schema(example = 9.81, exclusive_minimum = 0.0)]
+    #[schema(example = 9.81, minimum = 0.01, maximum = 100.0)]
     pub gravity_m_s2: f64,
     #[serde(default)]
     pub model: ModelInput,
@@ -153,35 +153,37 @@ pub enum ProfileInput {
     /// L = L0 + v t.
     ConstantRate {
         /// Winch rate v (m/s); negative retrieves.
-        #[schema(example = 10.0)]
+        #[schema(example = 10.0, minimum = -1000.0, maximum = 1000.0)]
         rate_m_s: f64,
         /// Length at which the winch stops (m); none: never stops.
         #[serde(default)]
+        #[schema(minimum = 0.001, maximum = 1e5)]
         target_length_m: Option<f64>,
     },
     /// From rest: L = L0 + a t²/2.
     ConstantAcceleration {
         /// Winch acceleration a (m/s²); negative retrieves.
-        #[schema(example = 0.5)]
+        #[schema(example = 0.5, minimum = -1000.0, maximum = 1000.0)]
         acceleration_m_s2: f64,
         /// Length at which the winch stops (m); none: never stops.
         #[serde(default)]
+        #[schema(minimum = 0.001, maximum = 1e5)]
         target_length_m: Option<f64>,
     },
     /// Rate ramps linearly from 0 to the cruise rate, holds, and ramps back
     /// to 0, arriving at rest at the target length (thesis Figs 4.8–4.9).
     Trapezoidal {
         /// Cruise rate (m/s); negative retrieves.
-        #[schema(example = 10.0)]
+        #[schema(example = 10.0, minimum = -1000.0, maximum = 1000.0)]
         cruise_rate_m_s: f64,
         /// Ramp-up time (s), > 0: short is sharp, long is gradual.
-        #[schema(example = 5.0, exclusive_minimum = 0.0)]
+        #[schema(example = 5.0, minimum = 1e-6, maximum = 1e7)]
         ramp_up_s: f64,
         /// Ramp-down time (s), > 0.
-        #[schema(example = 5.0, exclusive_minimum = 0.0)]
+        #[schema(example = 5.0, minimum = 1e-6, maximum = 1e7)]
         ramp_down_s: f64,
         /// Length at which the winch comes to rest (m).
-        #[schema(example = 1100.0, exclusive_minimum = 0.0)]
+        #[schema(example = 1100.0, minimum = 0.001, maximum = 1e5)]
         target_length_m: f64,
     },
     /// Rate interpolated linearly in a table of (time, rate), first time 0;
@@ -191,6 +193,7 @@ pub enum ProfileInput {
         points: Vec<RatePointInput>,
         /// Length at which the winch stops (m); none: the table decides.
         #[serde(default)]
+        #[schema(minimum = 0.001, maximum = 1e5)]
         target_length_m: Option<f64>,
     },
 }
@@ -200,10 +203,10 @@ pub enum ProfileInput {
 #[serde(deny_unknown_fields)]
 pub struct RatePointInput {
     /// Time (s).
-    #[schema(example = 0.0, minimum = 0.0)]
+    #[schema(example = 0.0, minimum = 0.0, maximum = 1e7)]
     pub time_s: f64,
     /// Winch rate at that time (m/s).
-    #[schema(example = 10.0)]
+    #[schema(example = 10.0, minimum = -1000.0, maximum = 1000.0)]
     pub rate_m_s: f64,
 }
 
@@ -212,14 +215,15 @@ pub struct RatePointInput {
 #[serde(deny_unknown_fields)]
 pub struct StateInput {
     /// Cable length L (m).
-    #[schema(example = 500.0, exclusive_minimum = 0.0)]
+    #[schema(example = 500.0, minimum = 0.001, maximum = 1e5)]
     pub length_m: f64,
     /// Winch rate L̇ (m/s).
     #[serde(default)]
-    #[schema(example = 10.0)]
+    #[schema(example = 10.0, minimum = -1000.0, maximum = 1000.0)]
     pub rate_m_s: f64,
     /// Winch acceleration L̈ (m/s²).
     #[serde(default)]
+    #[schema(minimum = -1000.0, maximum = 1000.0)]
     pub acceleration_m_s2: f64,
 }
 
@@ -282,7 +286,7 @@ pub struct SafeRateRequest {
 #[serde(deny_unknown_fields)]
 pub struct SafeRateParams {
     /// Elevation (cable length) to reach (m).
-    #[schema(example = 1200.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1200.0, minimum = 0.001, maximum = 1e5)]
     pub target_elevation_m: f64,
 }
 
@@ -291,10 +295,10 @@ pub struct SafeRateParams {
 #[serde(deny_unknown_fields)]
 pub struct RateGrid {
     /// Smallest rate (m/s).
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 1e-6, maximum = 1000.0)]
     pub min: f64,
     /// Largest rate (m/s).
-    #[schema(example = 100.0, exclusive_minimum = 0.0)]
+    #[schema(example = 100.0, minimum = 1e-6, maximum = 1000.0)]
     pub max: f64,
     /// Number of rates.
     #[schema(example = 100, minimum = 1, maximum = 1000000)]
@@ -318,6 +322,7 @@ pub struct ChartParams {
     pub rates_m_s: RateGrid,
     /// Net buoyancies, one series each (N); default: the aerostat's.
     #[serde(default)]
+    #[schema(minimum = 0.001, maximum = 1e7)]
     pub net_buoyancies_n: Vec<f64>,
 }
 

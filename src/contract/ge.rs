@@ -35,15 +35,15 @@ pub const MAX_SPECTRA: usize = 2000;
 #[serde(deny_unknown_fields)]
 pub struct GeAerostatInput {
     /// Net buoyancy F = F_b − m g (N), applied at the aerostat along the guide axis.
-    #[schema(example = 1000.0, minimum = 0.0)]
+    #[schema(example = 1000.0, minimum = 0.0, maximum = 1e7)]
     pub net_buoyancy_n: f64,
     /// Aerostat mass m (kg).
     #[serde(default)]
-    #[schema(example = 10.0, minimum = 0.0)]
+    #[schema(example = 10.0, minimum = 0.0, maximum = 1e6)]
     pub mass_kg: f64,
     /// Length of the rigid link from the cable end to the aerostat's centre (m).
     #[serde(default)]
-    #[schema(example = 0.0, minimum = 0.0)]
+    #[schema(example = 0.0, minimum = 0.0, maximum = 1000.0)]
     pub link_length_m: f64,
 }
 
@@ -65,17 +65,17 @@ pub struct GeModelInput {
     #[schema(example = 20, minimum = 1, maximum = 2000)]
     pub elements: usize,
     /// Bending stiffness EI (N m²).
-    #[schema(example = 1000.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1000.0, minimum = 1e-6, maximum = 1e12)]
     pub bending_stiffness_n_m2: f64,
     /// E* = EA L0²/EI, axial over bending stiffness.
-    #[schema(example = 1e5, exclusive_minimum = 0.0)]
+    #[schema(example = 1e5, minimum = 1.0, maximum = 1e12)]
     pub stiffness_ratio: f64,
     /// G A_s L0²/EI; defaults to `stiffness_ratio` (the thesis takes GA = EA).
     #[serde(default)]
-    #[schema(example = 1e5, exclusive_minimum = 0.0)]
+    #[schema(example = 1e5, minimum = 1.0, maximum = 1e12)]
     pub shear_stiffness_ratio: Option<f64>,
     /// γ̃ = A_ρ L0²/I_ρ, translational over rotary inertia.
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 1e-6, maximum = 1e12)]
     pub inertia_ratio: f64,
 }
 
@@ -92,16 +92,16 @@ pub enum LoadTimeInput {
     Constant {},
     /// Rises linearly over `ramp_s`, held until `hold_s`, then released.
     Held {
-        #[schema(example = 0.1, minimum = 0.0)]
+        #[schema(example = 0.1, minimum = 0.0, maximum = 1e7)]
         ramp_s: f64,
-        #[schema(example = 0.5, minimum = 0.0)]
+        #[schema(example = 0.5, minimum = 0.0, maximum = 1e7)]
         hold_s: f64,
     },
     /// Triangular pulse: peak at `peak_s`, zero again at `end_s`.
     Triangle {
-        #[schema(example = 1.0, exclusive_minimum = 0.0)]
+        #[schema(example = 1.0, exclusive_minimum = 0.0, maximum = 1e7)]
         peak_s: f64,
-        #[schema(example = 2.0, exclusive_minimum = 0.0)]
+        #[schema(example = 2.0, minimum = 0.0, maximum = 1e7)]
         end_s: f64,
     },
 }
@@ -112,13 +112,15 @@ pub enum LoadTimeInput {
 pub struct EndLoadInput {
     /// Force along the guide axis (N).
     #[serde(default)]
+    #[schema(minimum = -1e8, maximum = 1e8)]
     pub axial_force_n: f64,
     /// Force across the guide axis (N).
     #[serde(default)]
-    #[schema(example = 400.0)]
+    #[schema(example = 400.0, minimum = -1e8, maximum = 1e8)]
     pub transverse_force_n: f64,
     /// Couple on the top section (N m).
     #[serde(default)]
+    #[schema(minimum = -1e8, maximum = 1e8)]
     pub moment_n_m: f64,
     pub time: LoadTimeInput,
 }
@@ -177,31 +179,31 @@ pub struct GeSimulateRequest {
     pub aerostat: GeAerostatInput,
     /// Initial cable length L0 (m), the length scale of E* and γ̃.
     #[serde(default = "default_initial_length")]
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 0.001, maximum = 10000.0)]
     pub initial_length_m: f64,
     /// Gravity on the cable (m/s²).
     #[serde(default = "default_gravity")]
-    #[schema(example = 9.81, minimum = 0.0)]
+    #[schema(example = 9.81, minimum = 0.0, maximum = 100.0)]
     pub gravity_m_s2: f64,
     pub model: GeModelInput,
     /// Deployment profile; none: constant length.
     #[serde(default)]
     pub profile: Option<ProfileInput>,
     /// Time step (s).
-    #[schema(example = 0.000883, exclusive_minimum = 0.0)]
+    #[schema(example = 0.000883, minimum = 1e-9, maximum = 1000.0)]
     pub time_step_s: f64,
     /// Duration of the run (s).
-    #[schema(example = 8.83, exclusive_minimum = 0.0)]
+    #[schema(example = 8.83, minimum = 1e-6, maximum = 1e7)]
     pub duration_s: f64,
     #[serde(default)]
     pub end_load: Option<EndLoadInput>,
     /// Linear viscous damping per unit mass (1/s).
     #[serde(default)]
-    #[schema(example = 0.0, minimum = 0.0)]
+    #[schema(example = 0.0, minimum = 0.0, maximum = 1e6)]
     pub damping_per_s: f64,
     /// Time from which the damping acts (s).
     #[serde(default)]
-    #[schema(example = 0.0, minimum = 0.0)]
+    #[schema(example = 0.0, minimum = 0.0, maximum = 1e7)]
     pub damping_from_s: f64,
     /// How the cable starts (the same field as the linear string's
     /// `initial`); default: static equilibrium.

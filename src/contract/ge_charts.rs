@@ -44,11 +44,11 @@ pub struct GeChartModelInput {
     #[schema(example = 20, minimum = 1, maximum = 200)]
     pub elements: usize,
     /// Bending stiffness EI (N m²), the same for every series.
-    #[schema(example = 1000.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1000.0, minimum = 1e-6, maximum = 1e12)]
     pub bending_stiffness_n_m2: f64,
     /// γ̃ = A_ρ L0²/I_ρ.
     #[serde(default = "default_inertia_ratio")]
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 1e-6, maximum = 1e12)]
     pub inertia_ratio: f64,
 }
 
@@ -70,15 +70,15 @@ fn default_gravity() -> f64 {
 #[serde(deny_unknown_fields)]
 pub struct PerturbationInput {
     /// Peak forces F0 (N), one series each; 0 is the unperturbed cable.
-    #[schema(example = json!([0.0, 200.0, 400.0]))]
+    #[schema(example = json!([0.0, 200.0, 400.0]), minimum = -1e8, maximum = 1e8)]
     pub forces_n: Vec<f64>,
     /// Linear rise time (s).
     #[serde(default = "default_ramp")]
-    #[schema(example = 0.25, minimum = 0.0)]
+    #[schema(example = 0.25, minimum = 0.0, maximum = 1e7)]
     pub ramp_s: f64,
     /// Release time (s), at least `ramp_s`.
     #[serde(default = "default_hold")]
-    #[schema(example = 1.0, minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 0.0, maximum = 1e7)]
     pub hold_s: f64,
 }
 
@@ -92,10 +92,11 @@ fn default_hold() -> f64 {
 /// A point of a tabulated wind profile.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(as = GeWindPointInput)]
 pub struct WindPointInput {
-    #[schema(example = 100.0, minimum = 0.0)]
+    #[schema(example = 100.0, minimum = 0.0, maximum = 1e5)]
     pub elevation_m: f64,
-    #[schema(example = 4.2)]
+    #[schema(example = 4.2, minimum = -200.0, maximum = 200.0)]
     pub speed_m_s: f64,
 }
 
@@ -105,12 +106,12 @@ pub struct WindPointInput {
 #[serde(deny_unknown_fields)]
 pub enum WindProfileInput {
     Uniform {
-        #[schema(example = 5.0)]
+        #[schema(example = 5.0, minimum = -200.0, maximum = 200.0)]
         speed_m_s: f64,
     },
     /// u = a z^p.
     PowerLaw {
-        #[schema(example = 0.1)]
+        #[schema(example = 0.1, minimum = -200.0, maximum = 200.0)]
         coefficient: f64,
         #[schema(example = 0.333, minimum = 0.0, maximum = 2.0)]
         exponent: f64,
@@ -127,16 +128,17 @@ pub enum WindProfileInput {
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 #[serde(deny_unknown_fields)]
+#[schema(as = GeForceModelInput)]
 pub enum ForceModelInput {
     /// Inviscid sphere (thesis (4.4)).
     Thesis {},
     /// Quadratic drag plus added mass.
     Drag {
-        #[schema(example = 0.5, minimum = 0.0)]
+        #[schema(example = 0.5, minimum = 0.0, maximum = 100.0)]
         drag_coefficient: f64,
         /// Reference area (m²); default: the sphere's frontal area.
         #[serde(default)]
-        #[schema(exclusive_minimum = 0.0)]
+        #[schema(minimum = 1e-6, maximum = 1e6)]
         reference_area_m2: Option<f64>,
     },
 }
@@ -149,18 +151,18 @@ pub struct GeWindInput {
     pub force_model: ForceModelInput,
     /// Aerostat radius (m).
     #[serde(default = "default_radius")]
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 0.001, maximum = 1000.0)]
     pub radius_m: f64,
     #[serde(default = "default_air_density")]
-    #[schema(example = 1.12, exclusive_minimum = 0.0)]
+    #[schema(example = 1.12, minimum = 1e-4, maximum = 100.0)]
     pub air_density_kg_m3: f64,
     /// A0 of u0(1 + A0 sin(k z)), one series each; 0 is the steady profile.
     #[serde(default = "default_amplitudes")]
-    #[schema(example = json!([0.0, 0.5, 1.0]))]
+    #[schema(example = json!([0.0, 0.5, 1.0]), minimum = -10.0, maximum = 10.0)]
     pub amplitudes_nondim: Vec<f64>,
     /// k (1/m).
     #[serde(default = "default_wavenumber")]
-    #[schema(example = 0.01)]
+    #[schema(example = 0.01, minimum = 0.0, maximum = 1000.0)]
     pub wavenumber_1_m: f64,
 }
 
@@ -183,7 +185,7 @@ fn default_wavenumber() -> f64 {
 pub struct GeChartNumericsInput {
     /// Newmark step (s).
     #[serde(default = "default_dt")]
-    #[schema(example = 0.02, exclusive_minimum = 0.0)]
+    #[schema(example = 0.02, minimum = 1e-9, maximum = 1000.0)]
     pub time_step_s: f64,
     /// Local QEP every this many steps (the bracket is then retraced step by step).
     #[serde(default = "default_check")]
@@ -191,11 +193,11 @@ pub struct GeChartNumericsInput {
     pub check_every_steps: usize,
     /// Stop searching (stable) after this long (s).
     #[serde(default = "default_horizon")]
-    #[schema(example = 2000.0, exclusive_minimum = 0.0)]
+    #[schema(example = 2000.0, minimum = 1e-6, maximum = 1e7)]
     pub horizon_s: f64,
     /// Floor of the growth-rate tolerance on Re λ (1/s).
     #[serde(default = "default_growth")]
-    #[schema(example = 1e-6, minimum = 0.0)]
+    #[schema(example = 1e-6, minimum = 0.0, maximum = 1e6)]
     pub growth_tolerance_1_s: f64,
     /// Time-stepping scheme; default: generalized-α, which dissipates the
     /// unresolved axial modes a start from rest sets ringing (they
@@ -236,18 +238,19 @@ pub struct GeChartRequest {
     pub aerostat: GeAerostatInput,
     /// Initial length L0 (m), the length scale of E* and γ̃.
     #[serde(default = "default_initial_length")]
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 0.001, maximum = 10000.0)]
     pub initial_length_m: f64,
     #[serde(default = "default_gravity")]
-    #[schema(example = 9.81, minimum = 0.0)]
+    #[schema(example = 9.81, minimum = 0.01, maximum = 100.0)]
     pub gravity_m_s2: f64,
     pub model: GeChartModelInput,
     /// E* = EA L0²/EI (= GA L0²/EI), one series each.
-    #[schema(example = json!([1e3, 1e4, 1e5]))]
+    #[schema(example = json!([1e3, 1e4, 1e5]), minimum = 1.0, maximum = 1e12)]
     pub stiffness_ratios: Vec<f64>,
     pub rates_m_s: RateGrid,
     /// Net buoyancies (N), one series each; default: the aerostat's.
     #[serde(default)]
+    #[schema(minimum = 0.001, maximum = 1e7)]
     pub net_buoyancies_n: Vec<f64>,
     #[serde(default)]
     pub perturbation: Option<PerturbationInput>,
@@ -655,10 +658,10 @@ pub enum ExcitationKind {
 #[serde(deny_unknown_fields)]
 pub struct FrequencyGridInput {
     /// Lowest ω0 (rad/s).
-    #[schema(example = 11.3, exclusive_minimum = 0.0)]
+    #[schema(example = 11.3, exclusive_minimum = 0.0, maximum = 10000.0)]
     pub min: f64,
     /// Highest ω0 (rad/s).
-    #[schema(example = 792.6, exclusive_minimum = 0.0)]
+    #[schema(example = 792.6, minimum = 0.0, maximum = 10000.0)]
     pub max: f64,
     #[schema(example = 70, minimum = 1, maximum = 2000)]
     pub count: usize,
@@ -676,33 +679,33 @@ pub struct GeBaseFrequencyResponseRequest {
     #[serde(default)]
     pub aerostat: Option<GeAerostatInput>,
     #[serde(default = "default_initial_length")]
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 0.001, maximum = 10000.0)]
     pub initial_length_m: f64,
     /// Gravity on the cable (m/s²); thesis ch. 8 has none.
     #[serde(default)]
-    #[schema(example = 0.0, minimum = 0.0)]
+    #[schema(example = 0.0, minimum = 0.0, maximum = 100.0)]
     pub gravity_m_s2: f64,
     pub model: GeModelInput,
     /// Deployment profile; absent: constant length.
     #[serde(default)]
     pub profile: Option<ProfileInput>,
     /// Platform amplitude R0 (m).
-    #[schema(example = 0.001, exclusive_minimum = 0.0)]
+    #[schema(example = 0.001, minimum = 1e-9, maximum = 1000.0)]
     pub amplitude_m: f64,
     pub frequencies_rad_s: FrequencyGridInput,
     /// The normalising run's ω (rad/s); default ω̄ = 0.01 as in (8.3).
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0)]
+    #[schema(minimum = 0.0, maximum = 10000.0)]
     pub reference_frequency_rad_s: Option<f64>,
     /// Duration of each run (s).
-    #[schema(example = 0.883, exclusive_minimum = 0.0)]
+    #[schema(example = 0.883, minimum = 1e-6, maximum = 1e7)]
     pub duration_s: f64,
     /// Newmark step (s).
-    #[schema(example = 0.000442, exclusive_minimum = 0.0)]
+    #[schema(example = 0.000442, minimum = 1e-9, maximum = 1000.0)]
     pub time_step_s: f64,
     /// ε of the two-DOF model (8.8)–(8.9) for the predicted bands.
     #[serde(default = "default_epsilon")]
-    #[schema(example = 0.2, minimum = 0.0)]
+    #[schema(example = 0.2, minimum = 0.0, maximum = 10.0)]
     pub reduced_model_epsilon_nondim: f64,
     #[serde(default)]
     pub newton: Option<NewtonInput>,

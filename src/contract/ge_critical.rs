@@ -101,10 +101,10 @@ pub struct GeCriticalRequest {
     pub aerostat: GeAerostatInput,
     /// Initial length L0 (m), the length scale of E* and γ̃.
     #[serde(default = "default_initial_length")]
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 0.001, maximum = 10000.0)]
     pub initial_length_m: f64,
     #[serde(default = "default_gravity")]
-    #[schema(example = 9.81, minimum = 0.0)]
+    #[schema(example = 9.81, minimum = 0.0, maximum = 100.0)]
     pub gravity_m_s2: f64,
     pub model: GeModelInput,
     pub profile: ProfileInput,
@@ -440,10 +440,10 @@ pub struct GeStabilityRequest {
     pub aerostat: GeAerostatInput,
     /// Initial length L0 (m), the length scale of E* and γ̃.
     #[serde(default = "default_initial_length")]
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 0.001, maximum = 10000.0)]
     pub initial_length_m: f64,
     #[serde(default = "default_gravity")]
-    #[schema(example = 9.81, minimum = 0.0)]
+    #[schema(example = 9.81, minimum = 0.0, maximum = 100.0)]
     pub gravity_m_s2: f64,
     pub model: GeModelInput,
     pub state: StateInput,
@@ -729,7 +729,9 @@ fn is_ge(body: &[u8]) -> Result<bool, RequestError> {
 /// Parses a critical-time body, choosing the model by `model.kind`.
 pub fn parse_critical(body: &[u8]) -> Result<AnyCriticalRequest, RequestError> {
     if is_ge(body)? {
-        crate::contract::parse_plain(body).map(AnyCriticalRequest::GeometricallyExact)
+        let req: Box<GeCriticalRequest> = crate::contract::parse_plain(body)?;
+        req.check_ranges()?;
+        Ok(AnyCriticalRequest::GeometricallyExact(req))
     } else {
         crate::contract::parse(body).map(AnyCriticalRequest::LinearString)
     }
@@ -738,7 +740,9 @@ pub fn parse_critical(body: &[u8]) -> Result<AnyCriticalRequest, RequestError> {
 /// Parses a stability body, choosing the model by `model.kind`.
 pub fn parse_stability(body: &[u8]) -> Result<AnyStabilityRequest, RequestError> {
     if is_ge(body)? {
-        crate::contract::parse_plain(body).map(AnyStabilityRequest::GeometricallyExact)
+        let req: Box<GeStabilityRequest> = crate::contract::parse_plain(body)?;
+        req.check_ranges()?;
+        Ok(AnyStabilityRequest::GeometricallyExact(req))
     } else {
         crate::contract::parse(body).map(AnyStabilityRequest::LinearString)
     }

@@ -10,6 +10,7 @@ use crate::contract::ge::{
 use crate::contract::ge_charts::{
     self, GeBaseFrequencyResponseRequest, GeChartRequest, GeWindInput, WindProfileInput,
 };
+use crate::contract::ge_critical::{GeCriticalRequest, GeStabilityRequest};
 use crate::contract::transient::{
     AeroBodyInput, AirFlowInput, FlowPointInput, ForceModelInput, FrequencyResponseParams,
     InitialStateInput, SimulateParams, SteadyFlowInput,
@@ -511,5 +512,50 @@ impl GeBaseFrequencyResponseRequest {
                 self.reduced_model_epsilon_nondim,
             )
             .map(drop)
+    }
+}
+
+fn check_ge_numerics(n: &ge_charts::GeChartNumericsInput) -> Checked {
+    TIME_STEP_S.check("numerics.time_step_s", n.time_step_s)?;
+    DURATION_S.check("numerics.horizon_s", n.horizon_s)?;
+    RATE_1_S
+        .check("numerics.growth_tolerance_1_s", n.growth_tolerance_1_s)
+        .map(drop)
+}
+
+impl GeCriticalRequest {
+    /// The ranges of a GE critical-time request (the same fields as the
+    /// GE chart's, so the schema bounds hold on every route).
+    pub fn check_ranges(&self) -> Checked {
+        check_ge_system(
+            &self.cable,
+            Some(&self.aerostat),
+            self.initial_length_m,
+            self.gravity_m_s2,
+        )?;
+        check_ge_model(&self.model)?;
+        self.profile.check_ranges("profile")?;
+        match &self.numerics {
+            Some(n) => check_ge_numerics(n),
+            None => Ok(()),
+        }
+    }
+}
+
+impl GeStabilityRequest {
+    /// The ranges of a GE stability request.
+    pub fn check_ranges(&self) -> Checked {
+        check_ge_system(
+            &self.cable,
+            Some(&self.aerostat),
+            self.initial_length_m,
+            self.gravity_m_s2,
+        )?;
+        check_ge_model(&self.model)?;
+        StabilityParams {
+            state: self.state.clone(),
+            modes: 1,
+        }
+        .check_ranges(self.initial_length_m)
     }
 }

@@ -64,9 +64,9 @@ pub enum InitialStateInput {
     },
     /// From rest, a horizontal force on the aerostat held for a time, then released.
     TipForce {
-        #[schema(example = 200.0)]
+        #[schema(example = 200.0, minimum = -1e8, maximum = 1e8)]
         force_n: f64,
-        #[schema(example = 1.0, exclusive_minimum = 0.0)]
+        #[schema(example = 1.0, minimum = 1e-6, maximum = 1e7)]
         duration_s: f64,
     },
 }
@@ -84,12 +84,12 @@ impl Default for InitialStateInput {
 pub enum SteadyFlowInput {
     /// u = U.
     Uniform {
-        #[schema(example = 5.0)]
+        #[schema(example = 5.0, minimum = -200.0, maximum = 200.0)]
         speed_m_s: f64,
     },
     /// u = a z^p; a is the speed at z = 1 m.
     PowerLaw {
-        #[schema(example = 0.1)]
+        #[schema(example = 0.1, minimum = -200.0, maximum = 200.0)]
         coefficient_m_s: f64,
         #[schema(example = 0.3333, minimum = 0.0, maximum = 2.0)]
         exponent_nondim: f64,
@@ -102,9 +102,9 @@ pub enum SteadyFlowInput {
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FlowPointInput {
-    #[schema(example = 100.0, minimum = 0.0)]
+    #[schema(example = 100.0, minimum = 0.0, maximum = 1e5)]
     pub elevation_m: f64,
-    #[schema(example = 4.0)]
+    #[schema(example = 4.0, minimum = -200.0, maximum = 200.0)]
     pub speed_m_s: f64,
 }
 
@@ -115,19 +115,19 @@ pub struct FlowPointInput {
 pub enum AirFlowInput {
     /// u = U.
     Uniform {
-        #[schema(example = 5.0)]
+        #[schema(example = 5.0, minimum = -200.0, maximum = 200.0)]
         speed_m_s: f64,
     },
     /// u = a z^p; a is the speed at z = 1 m (thesis: 0.1 z^(1/3), z^(1/2)).
     PowerLaw {
-        #[schema(example = 0.1)]
+        #[schema(example = 0.1, minimum = -200.0, maximum = 200.0)]
         coefficient_m_s: f64,
         #[schema(example = 0.3333, minimum = 0.0, maximum = 2.0)]
         exponent_nondim: f64,
     },
     /// Uniform in space, u = U0 sin(ω t).
     Sinusoidal {
-        #[schema(example = 10.0)]
+        #[schema(example = 10.0, minimum = -200.0, maximum = 200.0)]
         amplitude_m_s: f64,
         #[schema(example = 2.0, minimum = 0.0, maximum = 10000.0)]
         angular_frequency_rad_s: f64,
@@ -139,11 +139,11 @@ pub enum AirFlowInput {
     Perturbed {
         base: SteadyFlowInput,
         /// A0.
-        #[schema(example = 0.5)]
+        #[schema(example = 0.5, minimum = -10.0, maximum = 10.0)]
         amplitude_nondim: f64,
         /// k (1/m); the thesis uses 0.01.
         #[serde(default = "default_wavenumber")]
-        #[schema(example = 0.01)]
+        #[schema(example = 0.01, minimum = 0.0, maximum = 1000.0)]
         wavenumber_1_m: f64,
     },
 }
@@ -157,11 +157,11 @@ pub enum ForceModelInput {
     Thesis {},
     /// Quadratic drag ½ ρ_air C_D A |u − ẏ|(u − ẏ) plus the added mass ½ m_f (u_t − ÿ).
     Drag {
-        #[schema(example = 0.5, minimum = 0.0)]
+        #[schema(example = 0.5, minimum = 0.0, maximum = 100.0)]
         drag_coefficient_nondim: f64,
         /// Reference area (m²); default π r².
         #[serde(default)]
-        #[schema(exclusive_minimum = 0.0)]
+        #[schema(minimum = 1e-6, maximum = 1e6)]
         reference_area_m2: Option<f64>,
     },
 }
@@ -179,16 +179,16 @@ pub struct AeroBodyInput {
     #[serde(default)]
     pub model: ForceModelInput,
     /// Sphere radius r (m): volume, displaced air, default drag area.
-    #[schema(example = 0.5, exclusive_minimum = 0.0)]
+    #[schema(example = 0.5, minimum = 0.001, maximum = 1000.0)]
     pub radius_m: f64,
     /// Air density (kg/m³).
     #[serde(default = "default_air_density")]
-    #[schema(example = 1.205, exclusive_minimum = 0.0)]
+    #[schema(example = 1.205, minimum = 1e-4, maximum = 100.0)]
     pub air_density_kg_m3: f64,
     /// Lifting-gas density (kg/m³). When given, the displaced air mass is
     /// m ρ_air/ρ_gas (the thesis's ρ̃ in (4.5)); otherwise ρ_air 4/3 π r³.
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0)]
+    #[schema(minimum = 1e-4, maximum = 100.0)]
     pub gas_density_kg_m3: Option<f64>,
 }
 
@@ -206,11 +206,11 @@ pub struct AeroInput {
     pub radius_m: f64,
     /// Air density (kg/m³).
     #[serde(default = "default_air_density")]
-    #[schema(example = 1.205, minimum = 0.0001, maximum = 100.0)]
+    #[schema(example = 1.205, minimum = 1e-4, maximum = 100.0)]
     pub air_density_kg_m3: f64,
     /// Lifting-gas density (kg/m³); see [`AeroBodyInput`].
     #[serde(default)]
-    #[schema(minimum = 0.0001, maximum = 100.0)]
+    #[schema(minimum = 1e-4, maximum = 100.0)]
     pub gas_density_kg_m3: Option<f64>,
 }
 
@@ -231,7 +231,7 @@ impl AeroInput {
 #[serde(deny_unknown_fields)]
 pub struct EigenTrackingInput {
     /// Time between QEP solves (s).
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 1e-6, maximum = 1e7)]
     pub interval_s: f64,
     /// How many modes to report (by frequency).
     #[serde(default = "default_eigen_count")]
@@ -267,12 +267,12 @@ impl std::ops::DerefMut for SimulateRequest {
 pub struct SimulateParams {
     pub profile: ProfileInput,
     /// Simulated time (s).
-    #[schema(example = 150.0, exclusive_minimum = 0.0)]
+    #[schema(example = 150.0, minimum = 1e-6, maximum = 1e7)]
     pub duration_s: f64,
     /// Time step (s); default: 64 steps per period of the first mode (at the
     /// start and the end) and of the forcing, 8 per profile ramp.
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0)]
+    #[schema(minimum = 1e-9, maximum = 1000.0)]
     pub time_step_s: Option<f64>,
     /// Output samples, evenly spaced in time (2..=100000).
     #[serde(default = "default_samples")]
@@ -371,7 +371,7 @@ pub struct SimulateResponse {
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FrequencyGrid {
-    #[schema(example = 0.25, minimum = 0.0)]
+    #[schema(example = 0.25, minimum = 0.0, maximum = 10000.0)]
     pub min: f64,
     #[schema(example = 8.0, minimum = 0.0, maximum = 10000.0)]
     pub max: f64,
@@ -407,11 +407,11 @@ impl std::ops::DerefMut for FrequencyResponseRequest {
 #[serde(deny_unknown_fields)]
 pub struct FrequencyResponseParams {
     pub profile: ProfileInput,
-    #[schema(example = 60.0, exclusive_minimum = 0.0)]
+    #[schema(example = 60.0, minimum = 1e-6, maximum = 1e7)]
     pub duration_s: f64,
     /// Time step (s), shared by all runs; default set by the highest frequency.
     #[serde(default)]
-    #[schema(exclusive_minimum = 0.0)]
+    #[schema(minimum = 1e-9, maximum = 1000.0)]
     pub time_step_s: Option<f64>,
     /// Samples of the envelope in time (2..=100000).
     #[serde(default = "default_response_samples")]
@@ -422,7 +422,7 @@ pub struct FrequencyResponseParams {
     /// The aerostat as an aerodynamic body.
     pub aero: AeroBodyInput,
     /// U0 (m/s).
-    #[schema(example = 10.0)]
+    #[schema(example = 10.0, minimum = -200.0, maximum = 200.0)]
     pub wind_amplitude_m_s: f64,
     /// ω grid (rad/s).
     pub frequencies_rad_s: FrequencyGrid,

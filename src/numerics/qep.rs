@@ -130,7 +130,12 @@ pub fn solve(system: &SecondOrderSystem) -> Result<Spectrum, QepError> {
             -rhs[(i - n) * cols + j] * c_scale
         }
     });
-    let (re, im) = eigenvalues_real(&companion)?;
+    let (re, im) = if cols <= SMALL_DIM {
+        // faer when nalgebra's iteration hits its cap
+        eigenvalues_small(&companion).or_else(|_| eigenvalues_real(&companion))?
+    } else {
+        eigenvalues_real(&companion)?
+    };
     if !re.iter().chain(&im).all(|v| v.is_finite()) {
         return Err(QepError::NonFinite);
     }
@@ -171,6 +176,25 @@ fn eigenvalue_scale(minv_kc: &[f64], n: usize) -> f64 {
     if exp.abs() <= 64.0 { 1.0 } else { exp.exp2() }
 }
 
+/// Largest companion dimension solved by nalgebra's Schur decomposition:
+/// at these sizes it is several times faster than faer's (whose kernels
+/// are tuned for large matrices); above it, faer.
+pub const SMALL_DIM: usize = 128;
+
+/// Eigenvalues of a small real square matrix: nalgebra's real Schur form
+/// (Francis double shift), with an iteration cap.
+pub fn eigenvalues_small(a: &Mat<f64>) -> Result<(Vec<f64>, Vec<f64>), QepError> {
+    let n = a.nrows();
+    let m = nalgebra::DMatrix::<f64>::from_fn(n, n, |i, j| a[(i, j)]);
+    let schur =
+        nalgebra::Schur::try_new(m, f64::EPSILON, 100 * n.max(1)).ok_or(QepError::NoConvergence)?;
+    let eig = schur.complex_eigenvalues();
+    Ok((
+        eig.iter().map(|z| z.re).collect(),
+        eig.iter().map(|z| z.im).collect(),
+    ))
+}
+
 /// Eigenvalues of a real square matrix, sequential faer.
 pub fn eigenvalues_real(a: &Mat<f64>) -> Result<(Vec<f64>, Vec<f64>), QepError> {
     let n = a.nrows();
@@ -203,6 +227,53 @@ pub fn eigenvalues_real(a: &Mat<f64>) -> Result<(Vec<f64>, Vec<f64>), QepError> 
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn the_small_and_the_large_eigensolvers_agree() {
+        // a companion of a graded-mesh string: nalgebra's Schur (used up to
+        // SMALL_DIM) against faer's, eigenvalue by eigenvalue
+        use crate::numerics::params::{AerostatSystem, Kinematics};
+        use crate::numerics::string::StringModel;
+        let sys = AerostatSystem::thesis();
+        let ops = crate::numerics::string::converged::graded_operators(8);
+        let model = StringModel::with_operators(sys, ops);
+        let m = model.matrices(sys.to_nondim(Kinematics {
+            length_m: 1100.0,
+            rate_m_s: 30.0,
+            acceleration_m_s2: 0.5,
+        }));
+        let n = m.mass.dim();
+        let mut minv = vec![0.0; n * 2 * n];
+        for i in 0..n {
+            for j in i.saturating_sub(1)..(i + 2).min(n) {
+                minv[i * 2 * n + j] = m.stiffness.get(i, j);
+                minv[i * 2 * n + n + j] = m.damping.get(i, j);
+            }
+        }
+        m.mass.solve_columns_in_place(&mut minv, 2 * n);
+        let a = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| {
+            if i < n {
+                if j == i + n { 1.0 } else { 0.0 }
+            } else {
+                -minv[(i - n) * 2 * n + j]
+            }
+        });
+        let sorted = |(re, im): (Vec<f64>, Vec<f64>)| {
+            let mut v: Vec<(f64, f64)> = re.into_iter().zip(im).collect();
+            v.sort_by(|x, y| (x.1, x.0).partial_cmp(&(y.1, y.0)).unwrap());
+            v
+        };
+        let small = sorted(eigenvalues_small(&a).unwrap());
+        let large = sorted(eigenvalues_real(&a).unwrap());
+        let radius = large.iter().map(|z| z.0.hypot(z.1)).fold(0.0, f64::max);
+        for (x, y) in small.iter().zip(&large) {
+            assert!(
+                (x.0 - y.0).abs() + (x.1 - y.1).abs() <= 1e-9 * radius,
+                "{x:?} vs {y:?}"
+            );
+        }
+    }
+
     use super::*;
     use crate::numerics::tridiag::Tridiagonal;
 
