@@ -59,6 +59,12 @@ pub struct QsSearchConfig {
     pub scan_points: usize,
     /// Relative half-width `δ` of the QEP confirmation and of the QEP bisection.
     pub relative_tolerance: f64,
+    /// Solve the QEP (at the lower end and on either side of the root).
+    /// Without it the verdict is the inertia of `K` alone: exact by the
+    /// Kelvin–Tait–Chetaev theorem in calm air at a constant payout rate
+    /// (`K` symmetric, damping positive definite), O(n) per state, so fine
+    /// meshes stay cheap. Refused in wind or with an acceleration.
+    pub confirm_with_qep: bool,
 }
 
 impl Default for QsSearchConfig {
@@ -67,6 +73,7 @@ impl Default for QsSearchConfig {
             state: QsConfig::default(),
             scan_points: 16,
             relative_tolerance: 1e-4,
+            confirm_with_qep: true,
         }
     }
 }
@@ -230,6 +237,12 @@ pub fn search_onset(
 ) -> Result<QsSearch, InvalidInput> {
     config.validate()?;
     require_positive("net_buoyancy_n", net_buoyancy_n)?;
+    if !config.confirm_with_qep && !air.is_calm() {
+        return Err(InvalidInput::new(
+            "numerics.confirm_with_qep",
+            "the inertia of K alone decides stability only in calm air; confirm with the QEP in wind",
+        ));
+    }
     let (lo, hi) = range;
     require_finite("range.min", lo)?;
     require_finite("range.max", hi)?;
@@ -266,6 +279,9 @@ pub fn search_onset(
         out.equilibria = s.equilibria;
         out
     };
+    if !config.confirm_with_qep {
+        return Ok(inertia_only(&mut s, lo, hi, out));
+    }
     // the lower end
     let (v0, st0) = s.verdict(lo, false);
     let q_lo = s.last.clone();
@@ -411,6 +427,81 @@ pub fn search_onset(
         None => stable.1,
     });
     Ok(finish(out, &s))
+}
+
+/// The search on the inertia of `K` alone (see [`QsSearchConfig::confirm_with_qep`]).
+fn inertia_only<K: Fn(f64) -> Kinematics>(
+    s: &mut Searcher<'_, K>,
+    lo: f64,
+    hi: f64,
+    mut out: QsSearch,
+) -> QsSearch {
+    let state = |s: &mut Searcher<'_, K>, p: f64| -> Option<(usize, OnsetState)> {
+        let q = s.equilibrium(p).ok()?;
+        let kin = (s.kin)(p);
+        let c = stiffness_negative_count(s.model, kin, s.load, s.air, &q)?;
+        let top = node(&q, s.model.elements);
+        Some((
+            c,
+            OnsetState {
+                root_axial_force_n: super::critical::root_axial_force_n(s.model, kin.length_m, &q),
+                tip_altitude_m: kin.length_m + top[0],
+                tip_downwind_m: top[1],
+            },
+        ))
+    };
+    let finish = |mut out: QsSearch, s: &Searcher<'_, K>| {
+        out.equilibria = s.equilibria;
+        out
+    };
+    let Some((c0, st0)) = state(s, lo) else {
+        out.onset = QsOnset::EquilibriumFailed {
+            at: lo,
+            failure: NewtonFailure { time_s: 0.0, iterations: 0, residual_norm: f64::NAN },
+        };
+        return finish(out, s);
+    };
+    if c0 > 0 {
+        out.onset = QsOnset::Immediate { max_real_1_s: f64::NAN };
+        out.at_onset = Some(st0);
+        return finish(out, s);
+    }
+    let n = s.config.scan_points;
+    let (mut a, mut sa) = (lo, st0);
+    let mut b = None;
+    for k in 1..=n {
+        let p = lo + (hi - lo) * k as f64 / n as f64;
+        match state(s, p) {
+            Some((0, st)) => (a, sa) = (p, st),
+            other => {
+                b = Some((p, other.map(|x| x.1)));
+                break;
+            }
+        }
+    }
+    let Some((mut b, mut sb)) = b else {
+        out.onset = QsOnset::Never { up_to: hi };
+        out.at_onset = Some(sa);
+        return finish(out, s);
+    };
+    for _ in 0..MAX_BISECTIONS {
+        if b - a <= 1e-12 * b.abs() {
+            break;
+        }
+        let m = 0.5 * (a + b);
+        match state(s, m) {
+            Some((0, st)) => (a, sa) = (m, st),
+            other => (b, sb) = (m, other.map(|x| x.1)),
+        }
+    }
+    out.onset = QsOnset::During { at: 0.5 * (a + b) };
+    out.bracket = Some((a, b));
+    out.divergence = true;
+    out.at_onset = Some(match sb {
+        Some(x) => interpolate(sa, x, 0.5),
+        None => sa,
+    });
+    finish(out, s)
 }
 
 /// Quasi-static critical length of a payout at constant rate `rate_m_s`
