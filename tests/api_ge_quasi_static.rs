@@ -23,7 +23,11 @@ use tetherplan::jobs::store::JobStore;
 use tower::ServiceExt;
 
 fn app() -> Router {
-    let queue = Arc::new(JobQueue::new(JobStore::open_in_memory().unwrap(), 2, Limits::default()));
+    let queue = Arc::new(JobQueue::new(
+        JobStore::open_in_memory().unwrap(),
+        2,
+        Limits::default(),
+    ));
     api::router(AppState::new(queue), Path::new("static"))
 }
 
@@ -86,7 +90,11 @@ async fn quasi_static_refuses_what_it_cannot_answer() {
     pushed["perturbation"] = json!({"force_n": 400.0});
     let mut stepped = body(Some("quasi_static"));
     stepped["numerics"] = json!({"time_step_s": 0.01});
-    for (b, field) in [(accel, "method"), (pushed, "perturbation"), (stepped, "numerics")] {
+    for (b, field) in [
+        (accel, "method"),
+        (pushed, "perturbation"),
+        (stepped, "numerics"),
+    ] {
         let (s, v) = post(&app, &b).await;
         assert_eq!(s, StatusCode::UNPROCESSABLE_ENTITY, "{v}");
         assert!(v.to_string().contains(field), "{v}");

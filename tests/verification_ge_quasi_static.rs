@@ -9,20 +9,22 @@
 //! * the quasi-static critical length against the marching GE search and
 //!   the string's closed form (within 2 % in h*).
 
-use tetherplan::numerics::ge::air_load::AirLoads;
 use rayon::prelude::*;
+use tetherplan::numerics::ge::air_load::AirLoads;
 use tetherplan::numerics::ge::chart::GeChartSystem;
-use tetherplan::numerics::ge::critical::{CriticalConfig, CriticalProblem, GeOnset, StartState, critical_time};
-use tetherplan::numerics::ge::{GeModel, Section, TipBody};
-use tetherplan::numerics::profile::Profile;
-use tetherplan::numerics::tether::{Body, Cable, EquilibriumConfig, EquilibriumProblem};
+use tetherplan::numerics::ge::critical::{
+    CriticalConfig, CriticalProblem, GeOnset, StartState, critical_time,
+};
 use tetherplan::numerics::ge::element::TipLoad;
 use tetherplan::numerics::ge::qs_critical::{QsOnset, QsSearchConfig, critical_length};
 use tetherplan::numerics::ge::quasi_static::{QsConfig, wind_stability};
-use tetherplan::numerics::ge::stability::{StateMotion, state_stability};
 use tetherplan::numerics::ge::solver::NewtonConfig;
+use tetherplan::numerics::ge::stability::{StateMotion, state_stability};
+use tetherplan::numerics::ge::{GeModel, Section, TipBody};
 use tetherplan::numerics::params::Kinematics;
+use tetherplan::numerics::profile::Profile;
 use tetherplan::numerics::tether::wind::WindProfile;
+use tetherplan::numerics::tether::{Body, Cable, EquilibriumConfig, EquilibriumProblem};
 
 fn never() -> bool {
     false
@@ -46,7 +48,6 @@ fn air(u: f64) -> AirLoads {
     }
 }
 
-
 fn table(elements: usize, stiffness_ratio: f64) -> GeModel {
     let mut sys = GeChartSystem::table_7_1();
     sys.elements = elements;
@@ -57,7 +58,13 @@ fn qs_length(model: &GeModel, v: f64, air: &AirLoads) -> (f64, bool) {
     qs_length_with(model, v, air, &QsSearchConfig::default(), 1.0)
 }
 
-fn qs_length_with(model: &GeModel, v: f64, air: &AirLoads, config: &QsSearchConfig, from: f64) -> (f64, bool) {
+fn qs_length_with(
+    model: &GeModel,
+    v: f64,
+    air: &AirLoads,
+    config: &QsSearchConfig,
+    from: f64,
+) -> (f64, bool) {
     let r = critical_length(
         model,
         1000.0,
@@ -86,10 +93,23 @@ fn calm_air_is_state_stability_exactly() {
         (1200.0, 12.0, 0.5, StateMotion::SteadyPayout),
         (50.0, 0.0, 0.0, StateMotion::AtRest),
     ] {
-        let kin = Kinematics { length_m: l, rate_m_s: v, acceleration_m_s2: a };
-        let s = state_stability(&model, kin, buoyancy(), motion, 2, NewtonConfig::default()).unwrap();
-        let w = wind_stability(&model, kin, buoyancy(), &AirLoads::calm(), motion, &QsConfig::default(), None)
-            .unwrap();
+        let kin = Kinematics {
+            length_m: l,
+            rate_m_s: v,
+            acceleration_m_s2: a,
+        };
+        let s =
+            state_stability(&model, kin, buoyancy(), motion, 2, NewtonConfig::default()).unwrap();
+        let w = wind_stability(
+            &model,
+            kin,
+            buoyancy(),
+            &AirLoads::calm(),
+            motion,
+            &QsConfig::default(),
+            None,
+        )
+        .unwrap();
         assert_eq!(s.state.q, w.state.q);
         assert_eq!(s.state.a, w.state.a);
         assert_eq!(s.spectrum.eigenvalues, w.spectrum.eigenvalues);
@@ -103,19 +123,46 @@ fn calm_air_is_state_stability_exactly() {
 #[test]
 fn small_wind_tends_to_the_calm_answer() {
     let model = table(20, 1e5);
-    let kin = Kinematics { length_m: 500.0, rate_m_s: 10.0, acceleration_m_s2: 0.0 };
-    let calm = wind_stability(&model, kin, buoyancy(), &AirLoads::calm(), StateMotion::AtRest, &QsConfig::default(), None)
-        .unwrap();
+    let kin = Kinematics {
+        length_m: 500.0,
+        rate_m_s: 10.0,
+        acceleration_m_s2: 0.0,
+    };
+    let calm = wind_stability(
+        &model,
+        kin,
+        buoyancy(),
+        &AirLoads::calm(),
+        StateMotion::AtRest,
+        &QsConfig::default(),
+        None,
+    )
+    .unwrap();
     let at = |u: f64| {
-        wind_stability(&model, kin, buoyancy(), &air(u), StateMotion::AtRest, &QsConfig::default(), None).unwrap()
+        wind_stability(
+            &model,
+            kin,
+            buoyancy(),
+            &air(u),
+            StateMotion::AtRest,
+            &QsConfig::default(),
+            None,
+        )
+        .unwrap()
     };
     let (w1, w2, w3) = (at(0.01), at(0.02), at(1e-4));
     let ratio = w2.tip_downwind_m / w1.tip_downwind_m;
-    println!("downwind at 0.01 / 0.02 m/s: {:.3e} / {:.3e} m (ratio {ratio:.4})", w1.tip_downwind_m, w2.tip_downwind_m);
+    println!(
+        "downwind at 0.01 / 0.02 m/s: {:.3e} / {:.3e} m (ratio {ratio:.4})",
+        w1.tip_downwind_m, w2.tip_downwind_m
+    );
     assert!((ratio - 4.0).abs() < 0.01, "{ratio}");
     let d1 = (w1.spectrum.max_real - calm.spectrum.max_real).abs();
     let d3 = (w3.spectrum.max_real - calm.spectrum.max_real).abs();
-    println!("max Re λ − calm: {d1:.3e} at 0.01 m/s, {d3:.3e} at 1e-4 m/s (calm {:.4e} 1/s)", calm.spectrum.max_real);
+    println!(
+        "max Re λ − calm: {d1:.3e} at 0.01 m/s, {d3:.3e} at 1e-4 m/s (calm {:.4e} 1/s)",
+        calm.spectrum.max_real
+    );
     assert!(d1 < 1e-6 * calm.spectrum.max_real.abs() && d3 < 1e-6 * calm.spectrum.max_real.abs());
     assert!((w3.tip_altitude_m - calm.tip_altitude_m).abs() < 1e-6);
 }
@@ -129,10 +176,21 @@ fn small_wind_tends_to_the_calm_answer() {
 fn blown_down_shape_matches_the_tether_shooting() {
     let (rho_a, f, l, ea) = (0.05, 2000.0, 600.0, 1e7);
     let model_of = |n: usize| {
-        GeModel::new(Section::new(ea, ea, 1.0, rho_a, 1e-4).unwrap(), n, TipBody { mass_kg: 50.0, link_length_m: 0.0 }, 9.81)
-            .unwrap()
+        GeModel::new(
+            Section::new(ea, ea, 1.0, rho_a, 1e-4).unwrap(),
+            n,
+            TipBody {
+                mass_kg: 50.0,
+                link_length_m: 0.0,
+            },
+            9.81,
+        )
+        .unwrap()
     };
-    for wind in [WindProfile::uniform(12.0), WindProfile::log_law(10.0, 10.0, 0.03, "wind").unwrap()] {
+    for wind in [
+        WindProfile::uniform(12.0),
+        WindProfile::log_law(10.0, 10.0, 0.03, "wind").unwrap(),
+    ] {
         let air = AirLoads {
             wind: wind.clone(),
             air_density_kg_m3: 1.225,
@@ -149,7 +207,12 @@ fn blown_down_shape_matches_the_tether_shooting() {
                 axial_stiffness_n: Some(ea),
                 breaking_strength_n: None,
             },
-            body: Body { net_buoyancy_n: f, drag_coefficient: 0.3, lift_coefficient: 0.0, reference_area_m2: 20.0 },
+            body: Body {
+                net_buoyancy_n: f,
+                drag_coefficient: 0.3,
+                lift_coefficient: 0.0,
+                reference_area_m2: 20.0,
+            },
             wind,
             air_density_kg_m3: 1.225,
             tether_length_m: l,
@@ -157,18 +220,36 @@ fn blown_down_shape_matches_the_tether_shooting() {
         }
         .solve(&EquilibriumConfig::default())
         .unwrap();
-        let kin = Kinematics { length_m: l, rate_m_s: 0.0, acceleration_m_s2: 0.0 };
-        let load = TipLoad { force_n: [f, 0.0], moment_n_m: 0.0 };
+        let kin = Kinematics {
+            length_m: l,
+            rate_m_s: 0.0,
+            acceleration_m_s2: 0.0,
+        };
+        let load = TipLoad {
+            force_n: [f, 0.0],
+            moment_n_m: 0.0,
+        };
         let errs: Vec<(f64, f64)> = [40usize, 80]
             .iter()
             .map(|&n| {
-                let w = wind_stability(&model_of(n), kin, load, &air, StateMotion::AtRest, &QsConfig::default(), None)
-                    .unwrap();
+                let w = wind_stability(
+                    &model_of(n),
+                    kin,
+                    load,
+                    &air,
+                    StateMotion::AtRest,
+                    &QsConfig::default(),
+                    None,
+                )
+                .unwrap();
                 println!(
                     "{n} elements: GE ({:.3}, {:.3}) m, tether ({:.3}, {:.3}) m",
                     w.tip_altitude_m, w.tip_downwind_m, tether.altitude_m, tether.downwind_m
                 );
-                ((w.tip_altitude_m - tether.altitude_m).abs(), (w.tip_downwind_m - tether.downwind_m).abs())
+                (
+                    (w.tip_altitude_m - tether.altitude_m).abs(),
+                    (w.tip_downwind_m - tether.downwind_m).abs(),
+                )
             })
             .collect();
         assert!(tether.downwind_m > 50.0);
@@ -195,7 +276,10 @@ fn calm_quasi_static_matches_the_marching_search() {
                 aero: None,
                 start: StartState::AtRest,
             };
-            match critical_time(&model, &problem, &CriticalConfig::default(), &never).unwrap().onset {
+            match critical_time(&model, &problem, &CriticalConfig::default(), &never)
+                .unwrap()
+                .onset
+            {
                 GeOnset::During { length_m, .. } => length_m,
                 other => panic!("{other:?}"),
             }
@@ -203,10 +287,19 @@ fn calm_quasi_static_matches_the_marching_search() {
         .collect();
     for (v, h_march) in rates.iter().zip(marched) {
         let (h_qs, divergence) = qs_length(&model, *v, &AirLoads::calm());
-        let no_qep = QsSearchConfig { confirm_with_qep: false, ..QsSearchConfig::default() };
+        let no_qep = QsSearchConfig {
+            confirm_with_qep: false,
+            ..QsSearchConfig::default()
+        };
         let (h_inertia, _) = qs_length_with(&model, *v, &AirLoads::calm(), &no_qep, 1.0);
-        assert!((h_inertia / h_qs - 1.0).abs() < 2e-4, "{h_inertia} vs {h_qs}");
-        println!("{v} m/s: quasi-static h* {h_qs:.2} m, marching {h_march:.2} m ({:+.3} %)", 100.0 * (h_qs / h_march - 1.0));
+        assert!(
+            (h_inertia / h_qs - 1.0).abs() < 2e-4,
+            "{h_inertia} vs {h_qs}"
+        );
+        println!(
+            "{v} m/s: quasi-static h* {h_qs:.2} m, marching {h_march:.2} m ({:+.3} %)",
+            100.0 * (h_qs / h_march - 1.0)
+        );
         assert!(divergence);
         assert!((h_qs / h_march - 1.0).abs() < 0.02);
     }
@@ -233,11 +326,31 @@ fn converged_calm_quasi_static_matches_the_string() {
             let mut sys = GeChartSystem::table_7_1();
             sys.bending_stiffness_n_m2 = ei;
             // inertia of K only (Kelvin–Tait–Chetaev, calm air, constant rate), from 100 m
-            let config = QsSearchConfig { confirm_with_qep: false, ..QsSearchConfig::default() };
+            let config = QsSearchConfig {
+                confirm_with_qep: false,
+                ..QsSearchConfig::default()
+            };
             sys.elements = 320;
-            let fine = qs_length_with(&sys.model(es).unwrap(), v, &AirLoads::calm(), &config, 100.0).0;
+            let fine = qs_length_with(
+                &sys.model(es).unwrap(),
+                v,
+                &AirLoads::calm(),
+                &config,
+                100.0,
+            )
+            .0;
             sys.elements = 160;
-            (fine, qs_length_with(&sys.model(es).unwrap(), v, &AirLoads::calm(), &config, 100.0).0)
+            (
+                fine,
+                qs_length_with(
+                    &sys.model(es).unwrap(),
+                    v,
+                    &AirLoads::calm(),
+                    &config,
+                    100.0,
+                )
+                .0,
+            )
         })
         .collect();
     for (&(es, v, ei), &(fine, coarse)) in cases.iter().zip(&out) {
@@ -257,7 +370,9 @@ fn converged_calm_quasi_static_matches_the_string() {
     // the bending offset scales as EI^{1/3} (heavy-column boundary layer): 12 m/s, E* = 1e5
     let string = (1000.0 / 0.078 - 144.0) / 9.81;
     let ratio = (out[6].0 - string) / (out[4].0 - string);
-    println!("offset EI = 1000 / EI = 100: {ratio:.3} (10^(1/3) = {:.3})", 10f64.cbrt());
+    println!(
+        "offset EI = 1000 / EI = 100: {ratio:.3} (10^(1/3) = {:.3})",
+        10f64.cbrt()
+    );
     assert!((ratio / 10f64.cbrt() - 1.0).abs() < 0.05, "{ratio}");
 }
-

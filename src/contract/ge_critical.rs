@@ -192,7 +192,7 @@ pub struct GeCriticalResponse {
     pub quasi_static_bracket_m: Option<[f64; 2]>,
     /// Quasi-static only: equilibria solved.
     #[serde(default)]
-    pub quasi_static_equilibria: Option<usize>,
+    pub quasi_static_equilibrium_solves: Option<usize>,
 }
 
 /// The cable model of a GE request.
@@ -458,7 +458,7 @@ pub fn ge_critical(
         wave_speed_m_s: (problem.net_buoyancy_n / rho_a).sqrt(),
         method: GeCriticalMethod::Marching,
         quasi_static_bracket_m: None,
-        quasi_static_equilibria: None,
+        quasi_static_equilibrium_solves: None,
     })
 }
 

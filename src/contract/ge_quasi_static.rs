@@ -3,9 +3,9 @@
 //! GE critical length in calm air ([`crate::numerics::ge::qs_critical`]),
 //! served in the shape of the marching answer, with `t* = (h* − L0)/v`.
 
+use crate::contract::ge_charts::GeOnsetKind;
 use crate::contract::ge_charts::newton_config;
 use crate::contract::ge_critical::{GeCriticalMethod, GeCriticalRequest, GeCriticalResponse};
-use crate::contract::ge_charts::GeOnsetKind;
 use crate::contract::ge_numerics::IntegratorOutput;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::ge::GeModel;
@@ -52,7 +52,13 @@ pub fn quasi_static_critical(
         (l0, upper.max(l0)),
         &cancel,
     )?;
-    let time_at = |l: f64| if v != 0.0 { ((l - l0) / v).max(0.0) } else { 0.0 };
+    let time_at = |l: f64| {
+        if v != 0.0 {
+            ((l - l0) / v).max(0.0)
+        } else {
+            0.0
+        }
+    };
     let (onset, t, h, ended, explanation) = match r.onset {
         QsOnset::Cancelled => return Err(RequestError::Cancelled),
         QsOnset::Immediate { max_real_1_s } => (
@@ -60,7 +66,9 @@ pub fn quasi_static_critical(
             Some(0.0),
             Some(l0),
             None,
-            format!("unstable at t = 0: the quasi-static state at L0 = {l0} m has a growth rate {max_real_1_s:.3e} 1/s"),
+            format!(
+                "unstable at t = 0: the quasi-static state at L0 = {l0} m has a growth rate {max_real_1_s:.3e} 1/s"
+            ),
         ),
         QsOnset::During { at } => (
             GeOnsetKind::During,
@@ -70,7 +78,11 @@ pub fn quasi_static_critical(
             format!(
                 "quasi-static: stable until the cable is {at:.2} m long (t* = {:.3} s at {v} m/s){}",
                 time_at(at),
-                if r.divergence { "; a real eigenvalue crosses zero there (divergence)" } else { "" }
+                if r.divergence {
+                    "; a real eigenvalue crosses zero there (divergence)"
+                } else {
+                    ""
+                }
             ),
         ),
         QsOnset::Never { up_to } => (
@@ -119,7 +131,8 @@ pub fn quasi_static_critical(
         max_elevation_m: h,
         ended_at_s: ended,
         string_closed_form_elevation_m: (v > 0.0).then(|| closed(f64::INFINITY)),
-        extensible_closed_form_elevation_m: (v > 0.0).then(|| closed(model.section.axial_stiffness_n)),
+        extensible_closed_form_elevation_m: (v > 0.0)
+            .then(|| closed(model.section.axial_stiffness_n)),
         closed_form_applies: v > 0.0,
         closed_form_note: (v <= 0.0).then(|| "no closed form for a retrieval".to_string()),
         onset_root_axial_force_n: match r.onset {
@@ -138,6 +151,6 @@ pub fn quasi_static_critical(
         wave_speed_m_s: (f / rho_a).sqrt(),
         method: GeCriticalMethod::QuasiStatic,
         quasi_static_bracket_m: r.bracket.map(|(a, b)| [a, b]),
-        quasi_static_equilibria: Some(r.equilibria),
+        quasi_static_equilibrium_solves: Some(r.equilibria),
     })
 }

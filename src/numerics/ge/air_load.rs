@@ -132,7 +132,10 @@ impl AirLoads {
         let l = length_m;
         let h = model.ops.h;
         let dn = [-1.0 / h, 1.0 / h];
-        let c = 0.5 * self.air_density_kg_m3 * self.cable_normal_drag_coefficient * self.cable_diameter_m;
+        let c = 0.5
+            * self.air_density_kg_m3
+            * self.cable_normal_drag_coefficient
+            * self.cable_diameter_m;
         if c > 0.0 {
             for e in 0..model.elements {
                 let (qa, qb) = (node(q, e), node(q, e + 1));
@@ -150,10 +153,7 @@ impl AirLoads {
                         dn[0] * qa[1] + dn[1] * qb[1],
                     ];
                     let z = zeta * l + nn[0] * qa[0] + nn[1] * qb[0];
-                    let vel = [
-                        nn[0] * va[0] + nn[1] * vb[0],
-                        nn[0] * va[1] + nn[1] * vb[1],
-                    ];
+                    let vel = [nn[0] * va[0] + nn[1] * vb[0], nn[0] * va[1] + nn[1] * vb[1]];
                     let (u, du) = self.wind_and_shear(z);
                     let w = [-vel[0], u - vel[1]];
                     let l2 = a[0] * a[0] + a[1] * a[1];
@@ -183,9 +183,8 @@ impl AirLoads {
                     let mut df_dw = [[0.0; 2]; 2];
                     for j in 0..2 {
                         for i in 0..2 {
-                            df_da[j][i] = s
-                                * ((dphi_dk * dk_da[i] + dphi_dl[i]) * m[j]
-                                    + phi * dm_da[i][j]);
+                            df_da[j][i] =
+                                s * ((dphi_dk * dk_da[i] + dphi_dl[i]) * m[j] + phi * dm_da[i][j]);
                             df_dw[j][i] = s * dphi_dk * dk_dw[i] * m[j];
                         }
                     }
@@ -283,7 +282,9 @@ mod tests {
         let s = Section::new(1e6, 1e6, 10.0, 0.05, 0.01).unwrap();
         let model = GeModel::new(s, 5, TipBody::default(), 9.81).unwrap();
         let n = model.dofs();
-        let q: Vec<f64> = (0..n).map(|i| 3.0 * ((i * 7 % 5) as f64 - 2.0) / 5.0 + 0.5 * i as f64).collect();
+        let q: Vec<f64> = (0..n)
+            .map(|i| 3.0 * ((i * 7 % 5) as f64 - 2.0) / 5.0 + 0.5 * i as f64)
+            .collect();
         let v: Vec<f64> = (0..n).map(|i| 0.3 * ((i * 3 % 4) as f64 - 1.5)).collect();
         for shear in [false, true] {
             let a = air(shear);
@@ -291,17 +292,31 @@ mod tests {
             let scale = t.force.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             for col in 0..n {
                 for (which, step) in [(0, 1e-5), (1, 1e-6)] {
-                    let (mut xp, mut xm) = if which == 0 { (q.clone(), q.clone()) } else { (v.clone(), v.clone()) };
+                    let (mut xp, mut xm) = if which == 0 {
+                        (q.clone(), q.clone())
+                    } else {
+                        (v.clone(), v.clone())
+                    };
                     xp[col] += step;
                     xm[col] -= step;
                     let (fp, fm) = if which == 0 {
-                        (a.terms(&model, 200.0, &xp, &v, false).force, a.terms(&model, 200.0, &xm, &v, false).force)
+                        (
+                            a.terms(&model, 200.0, &xp, &v, false).force,
+                            a.terms(&model, 200.0, &xm, &v, false).force,
+                        )
                     } else {
-                        (a.terms(&model, 200.0, &q, &xp, false).force, a.terms(&model, 200.0, &q, &xm, false).force)
+                        (
+                            a.terms(&model, 200.0, &q, &xp, false).force,
+                            a.terms(&model, 200.0, &q, &xm, false).force,
+                        )
                     };
                     for row in 0..n {
                         let fd = -(fp[row] - fm[row]) / (2.0 * step);
-                        let an = if which == 0 { t.stiffness.get(row, col) } else { t.damping.get(row, col) };
+                        let an = if which == 0 {
+                            t.stiffness.get(row, col)
+                        } else {
+                            t.damping.get(row, col)
+                        };
                         assert!(
                             (fd - an).abs() <= 1e-6 * scale.max(1.0),
                             "shear {shear} {which} ({row},{col}): fd {fd} analytic {an}"

@@ -83,13 +83,19 @@ impl QsSearchConfig {
         if !(1..=MAX_SCAN_POINTS).contains(&self.scan_points) {
             return Err(InvalidInput::new(
                 "numerics.scan_points",
-                format!("must be between 1 and {MAX_SCAN_POINTS}, got {}", self.scan_points),
+                format!(
+                    "must be between 1 and {MAX_SCAN_POINTS}, got {}",
+                    self.scan_points
+                ),
             ));
         }
         if !(1e-12..=0.1).contains(&self.relative_tolerance) {
             return Err(InvalidInput::new(
                 "numerics.relative_tolerance_nondim",
-                format!("must be between 1e-12 and 0.1, got {}", self.relative_tolerance),
+                format!(
+                    "must be between 1e-12 and 0.1, got {}",
+                    self.relative_tolerance
+                ),
             ));
         }
         Ok(())
@@ -194,7 +200,11 @@ impl<K: Fn(f64) -> Kinematics> Searcher<'_, K> {
         self.qep_solves += 1;
         let top = node(&state.q, self.model.elements);
         let at = OnsetState {
-            root_axial_force_n: super::critical::root_axial_force_n(self.model, kin.length_m, &state.q),
+            root_axial_force_n: super::critical::root_axial_force_n(
+                self.model,
+                kin.length_m,
+                &state.q,
+            ),
             tip_altitude_m: kin.length_m + top[0],
             tip_downwind_m: top[1],
         };
@@ -216,7 +226,8 @@ impl<K: Fn(f64) -> Kinematics> Searcher<'_, K> {
 
 fn interpolate(a: OnsetState, b: OnsetState, f: f64) -> OnsetState {
     OnsetState {
-        root_axial_force_n: a.root_axial_force_n + f * (b.root_axial_force_n - a.root_axial_force_n),
+        root_axial_force_n: a.root_axial_force_n
+            + f * (b.root_axial_force_n - a.root_axial_force_n),
         tip_altitude_m: a.tip_altitude_m + f * (b.tip_altitude_m - a.tip_altitude_m),
         tip_downwind_m: a.tip_downwind_m + f * (b.tip_downwind_m - a.tip_downwind_m),
     }
@@ -346,7 +357,11 @@ pub fn search_onset(
         let root = 0.5 * (a + b);
         // 3. confirm with the QEP on either side
         let (below, above) = (root - delta * root.abs(), root + delta * root.abs());
-        let (vb, stb) = if below > lo { s.verdict(below, false) } else { (Verdict::Stable, Some(stable.1)) };
+        let (vb, stb) = if below > lo {
+            s.verdict(below, false)
+        } else {
+            (Verdict::Stable, Some(stable.1))
+        };
         let (va, sta) = s.verdict(above.min(hi), true);
         match (&vb, &va) {
             (Verdict::Stable, Verdict::Unstable(_)) => {
@@ -420,7 +435,9 @@ pub fn search_onset(
             _ => bad = (m, st),
         }
     }
-    out.onset = QsOnset::During { at: 0.5 * (stable.0 + bad.0) };
+    out.onset = QsOnset::During {
+        at: 0.5 * (stable.0 + bad.0),
+    };
     out.bracket = Some((stable.0, bad.0));
     out.at_onset = Some(match bad.1 {
         Some(b) => interpolate(stable.1, b, 0.5),
@@ -457,12 +474,18 @@ fn inertia_only<K: Fn(f64) -> Kinematics>(
     let Some((c0, st0)) = state(s, lo) else {
         out.onset = QsOnset::EquilibriumFailed {
             at: lo,
-            failure: NewtonFailure { time_s: 0.0, iterations: 0, residual_norm: f64::NAN },
+            failure: NewtonFailure {
+                time_s: 0.0,
+                iterations: 0,
+                residual_norm: f64::NAN,
+            },
         };
         return finish(out, s);
     };
     if c0 > 0 {
-        out.onset = QsOnset::Immediate { max_real_1_s: f64::NAN };
+        out.onset = QsOnset::Immediate {
+            max_real_1_s: f64::NAN,
+        };
         out.at_onset = Some(st0);
         return finish(out, s);
     }
@@ -575,7 +598,10 @@ pub fn critical_rate(
 /// The default upper end of a length search: well past the static lift
 /// limit `(F + lift)/(ρA g)`, where the tether's weight equals the lift.
 pub fn lift_limit_length_m(model: &GeModel, net_buoyancy_n: f64, air: &AirLoads) -> f64 {
-    let u = air.wind.speed_m_s(net_buoyancy_n / (model.section.mass_per_length_kg_m * model.gravity_m_s2.max(1e-9)));
+    let u = air.wind.speed_m_s(
+        net_buoyancy_n / (model.section.mass_per_length_kg_m * model.gravity_m_s2.max(1e-9)),
+    );
     let lift = 0.5 * air.air_density_kg_m3 * air.aerostat_lift_area_m2 * u * u;
-    (net_buoyancy_n + lift.max(0.0)) / (model.section.mass_per_length_kg_m * model.gravity_m_s2.max(1e-9))
+    (net_buoyancy_n + lift.max(0.0))
+        / (model.section.mass_per_length_kg_m * model.gravity_m_s2.max(1e-9))
 }

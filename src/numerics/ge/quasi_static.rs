@@ -172,7 +172,14 @@ pub fn wind_equilibrium(
         steps += 1;
         let target = (done + step).min(1.0);
         let mut trial = q.clone();
-        match newton(model, kin, load, &air.scaled(target), &mut trial, config.newton) {
+        match newton(
+            model,
+            kin,
+            load,
+            &air.scaled(target),
+            &mut trial,
+            config.newton,
+        ) {
             Ok(it) => {
                 iterations += it;
                 q = trial;
@@ -258,8 +265,7 @@ pub fn wind_stability(
 ) -> Result<WindStateStability, GeStateFailure> {
     let eq = wind_equilibrium(model, kin, load, air, config, start)
         .map_err(GeStateFailure::Equilibrium)?;
-    let state =
-        state_at(model, kin, load, air, motion, eq.q).map_err(GeStateFailure::Spectrum)?;
+    let state = state_at(model, kin, load, air, motion, eq.q).map_err(GeStateFailure::Spectrum)?;
     let spectrum = spectrum_of(model, wind_matrices(model, kin, load, air, &state))
         .map_err(GeStateFailure::Spectrum)?;
     let top = node(&state.q, model.elements);
@@ -287,7 +293,10 @@ pub fn stiffness_determinant_sign(
     let zero = vec![0.0; q.len()];
     let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
     if !air.is_calm() {
-        k.add_scaled(1.0, &air.terms(model, kin.length_m, q, &zero, true).stiffness);
+        k.add_scaled(
+            1.0,
+            &air.terms(model, kin.length_m, q, &zero, true).stiffness,
+        );
     }
     band_determinant_sign(&k)
 }
@@ -306,7 +315,10 @@ pub fn stiffness_negative_count(
     let zero = vec![0.0; q.len()];
     let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
     if !air.is_calm() {
-        k.add_scaled(1.0, &air.terms(model, kin.length_m, q, &zero, true).stiffness);
+        k.add_scaled(
+            1.0,
+            &air.terms(model, kin.length_m, q, &zero, true).stiffness,
+        );
     }
     symmetric_negative_count(&k)
 }
