@@ -86,5 +86,51 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+/// One quasi-static GE critical time (issue 12: target ≤ 50 ms; the
+/// marching search takes about 0.8 s): Table 7.1 data, 20 elements,
+/// E* = 1e5, calm air, 12 and 40 m/s; and 40 m/s in a 10 m/s wind.
+fn bench_quasi_static(c: &mut Criterion) {
+    use tetherplan::numerics::ge::air_load::AirLoads;
+    use tetherplan::numerics::ge::chart::GeChartSystem;
+    use tetherplan::numerics::ge::qs_critical::{QsSearchConfig, critical_length};
+    use tetherplan::numerics::ge::stability::StateMotion;
+    use tetherplan::numerics::tether::wind::WindProfile;
+    let model = GeChartSystem::table_7_1().model(1e5).unwrap();
+    let never = || false;
+    let windy = AirLoads {
+        wind: WindProfile::uniform(10.0),
+        air_density_kg_m3: 1.225,
+        cable_diameter_m: 0.0036,
+        cable_normal_drag_coefficient: 1.2,
+        aerostat_drag_area_m2: 0.9,
+        aerostat_lift_area_m2: 0.0,
+    };
+    let mut g = c.benchmark_group("ge_quasi_static");
+    g.sample_size(10);
+    for (name, v, air) in [
+        ("critical_time_calm_12_m_s", 12.0, AirLoads::calm()),
+        ("critical_time_calm_40_m_s", 40.0, AirLoads::calm()),
+        ("critical_time_wind_10_m_s_at_40_m_s", 40.0, windy),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                critical_length(
+                    &model,
+                    1000.0,
+                    &air,
+                    v,
+                    0.0,
+                    StateMotion::AtRest,
+                    &QsSearchConfig::default(),
+                    (1.0, 1.5 * 1000.0 / (0.078 * 9.81)),
+                    &never,
+                )
+                .unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_quasi_static);
 criterion_main!(benches);

@@ -119,6 +119,27 @@ pub struct GeCriticalRequest {
     pub numerics: Option<GeChartNumericsInput>,
     #[serde(default)]
     pub newton: Option<NewtonInput>,
+    /// `marching` (default): march the deployment and solve the local QEP
+    /// along it. `quasi_static`: the fast quasi-static answer for a
+    /// constant rate — the quasi-static equilibrium at each length, its
+    /// stiffness inertia bisected to the divergence root, confirmed by the
+    /// local QEP on either side (within 0.01 % of the marching h* for
+    /// Table 7.1 data); `numerics` (time stepping) and `perturbation` are
+    /// refused with it.
+    #[serde(default)]
+    pub method: GeCriticalMethod,
+}
+
+/// How a GE critical time is found.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum GeCriticalMethod {
+    /// March the deployment (generalized-α), local QEP every few steps.
+    #[default]
+    Marching,
+    /// Quasi-static: equilibrium and local QEP at each length, no march
+    /// (constant-rate profiles only).
+    QuasiStatic,
 }
 
 /// The answer of a GE critical-time search.
@@ -163,6 +184,15 @@ pub struct GeCriticalResponse {
     pub time_scale_s: f64,
     /// √(F/ρA) (m/s).
     pub wave_speed_m_s: f64,
+    /// The method that produced this answer.
+    #[serde(default)]
+    pub method: GeCriticalMethod,
+    /// Quasi-static only: the final bracket of h* (stable, unstable) (m).
+    #[serde(default)]
+    pub quasi_static_bracket_m: Option<[f64; 2]>,
+    /// Quasi-static only: equilibria solved.
+    #[serde(default)]
+    pub quasi_static_equilibrium_solves: Option<usize>,
 }
 
 /// The cable model of a GE request.
@@ -223,6 +253,26 @@ pub fn prepare_critical(
             "profile.rate_m_s",
             "must be nonzero: a zero rate never changes the length (ask for the stability of that state instead)",
         ));
+    }
+    if req.method == GeCriticalMethod::QuasiStatic {
+        if !matches!(req.profile, ProfileInput::ConstantRate { .. }) {
+            return Err(InvalidInput::new(
+                "method",
+                "quasi_static needs a constant_rate profile (use marching for other profiles)",
+            ));
+        }
+        if req.perturbation.is_some() {
+            return Err(InvalidInput::new(
+                "perturbation",
+                "a tip perturbation needs the marching method: the quasi-static answer has no time history",
+            ));
+        }
+        if req.numerics.is_some() {
+            return Err(InvalidInput::new(
+                "numerics",
+                "time-stepping settings apply to the marching method only",
+            ));
+        }
     }
     let perturbation = match &req.perturbation {
         None => None,
@@ -315,6 +365,9 @@ pub fn ge_critical(
     progress: &dyn Progress,
 ) -> Result<GeCriticalResponse, RequestError> {
     let (model, problem, config) = prepare_critical(req)?;
+    if req.method == GeCriticalMethod::QuasiStatic {
+        return crate::contract::ge_quasi_static::quasi_static_critical(req, &model, &problem, progress);
+    }
     let cancel = || progress.cancelled();
     let r = critical_time(&model, &problem, &config, &cancel)?;
     if matches!(r.onset, GeOnset::Cancelled { .. }) {
@@ -403,6 +456,9 @@ pub fn ge_critical(
         elements: model.elements,
         time_scale_s: scale,
         wave_speed_m_s: (problem.net_buoyancy_n / rho_a).sqrt(),
+        method: GeCriticalMethod::Marching,
+        quasi_static_bracket_m: None,
+        quasi_static_equilibrium_solves: None,
     })
 }
 

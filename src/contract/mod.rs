@@ -11,6 +11,7 @@ pub mod ge;
 pub mod ge_charts;
 pub mod ge_critical;
 pub mod ge_numerics;
+pub mod ge_quasi_static;
 pub mod plan;
 pub mod ranges;
 pub mod run;

@@ -41,6 +41,7 @@
 // Element and band loops index several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
+pub mod air_load;
 pub mod banded;
 pub mod base;
 pub mod chart;
@@ -48,6 +49,8 @@ pub mod critical;
 pub mod diagnostics;
 pub mod element;
 pub mod extensible;
+pub mod qs_critical;
+pub mod quasi_static;
 pub mod solver;
 pub mod stability;
 

@@ -31,7 +31,8 @@ pub fn drive_spectrum(model: &GeModel, drive: &Drive, state: &State) -> Result<S
     spectrum_of(model, solver::drive_matrices(model, drive, state))
 }
 
-fn spectrum_of(model: &GeModel, sys: SystemMatrices) -> Result<Spectrum, QepError> {
+/// The QEP spectrum of the linearised system `sys` (companion form, scaled).
+pub fn spectrum_of(model: &GeModel, sys: SystemMatrices) -> Result<Spectrum, QepError> {
     let n = model.dofs();
     let k = sys.stiffness.to_dense();
     let c = sys.damping.to_dense();

@@ -1,0 +1,410 @@
+//! Local stability of the GE cable in a steady wind, from a quasi-static
+//! analysis (issue 12 item 4): the blown-down equilibrium at a deployment
+//! state `(L, L̇, L̈)`, then the local QEP (7.3) about it with the payout's
+//! rate terms and the linearised air loads of [`super::air_load`].
+//!
+//! **Equilibrium.** `R(q, 0, 0) − F_air(q, 0) = 0` in the mapped frame
+//! (the sliding terms of `L̇`, `L̈` included, as in
+//! [`super::stability::state_stability`]): first the straight calm-air
+//! equilibrium by [`super::solver::static_solve`] (the very same call as
+//! `state_stability`), then Newton under the air loads, continued in the
+//! dynamic pressure from 0 to 1 with an adaptive increment (halved when
+//! Newton fails, grown by 1.5 when it converges; at most
+//! [`MAX_CONTINUATION_STEPS`] increments). A caller that has a nearby
+//! equilibrium (the previous length of a search) passes it as `start`
+//! and Newton tries the full load from there first.
+//!
+//! **QEP.** `M = ∂R/∂q̈`, `C = ∂R/∂q̇ − ∂F_air/∂u̇` (the aerodynamic damping),
+//! `K = ∂R/∂q − ∂F_air/∂q`, about the state with the velocity of `motion`
+//! and the consistent acceleration `M q̈ = −(R(q, q̇, 0) − F_air)`.
+//!
+//! In calm air every air term is zero and is skipped, so the answer is
+//! bit for bit that of `state_stability` (tested).
+
+use super::GeModel;
+use super::air_load::AirLoads;
+use super::banded::Band;
+use super::element::{TipLoad, node};
+use super::solver::{self, NewtonConfig, NewtonFailure, State, SystemMatrices};
+use super::stability::{GeStateFailure, StateMotion, spectrum_of};
+use crate::numerics::params::Kinematics;
+use crate::numerics::qep::{QepError, Spectrum};
+
+/// Most load increments of the wind continuation.
+pub const MAX_CONTINUATION_STEPS: usize = 200;
+
+/// Settings of one quasi-static state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QsConfig {
+    pub newton: NewtonConfig,
+    /// Increments of gravity and buoyancy in the straight solve (as `state_stability`).
+    pub load_steps: usize,
+}
+
+impl Default for QsConfig {
+    fn default() -> Self {
+        Self {
+            newton: NewtonConfig::default(),
+            load_steps: 2,
+        }
+    }
+}
+
+/// The blown-down equilibrium.
+#[derive(Clone, Debug)]
+pub struct WindEquilibrium {
+    pub q: Vec<f64>,
+    /// Wind increments taken (0 in calm air or from a converged `start`).
+    pub continuation_steps: usize,
+    pub newton_iterations: usize,
+}
+
+/// Local stability at one state in wind.
+#[derive(Clone, Debug)]
+pub struct WindStateStability {
+    pub state: State,
+    pub spectrum: Spectrum,
+    /// Axial force in the element at the guide (N).
+    pub root_axial_force_n: f64,
+    /// Top of the cable: height above the guide and downwind offset (m).
+    pub tip_altitude_m: f64,
+    pub tip_downwind_m: f64,
+    pub continuation_steps: usize,
+    pub newton_iterations: usize,
+}
+
+fn norm(x: &[f64]) -> f64 {
+    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+fn at_roundoff(dq: &[f64], q: &[f64], length: f64) -> bool {
+    let big = q.iter().fold(length, |m, x| m.max(x.abs()));
+    dq.iter().all(|d| d.abs() <= 1e-13 * big)
+}
+
+/// Newton on `R(q, 0, 0) − F_air(q, 0) = 0` from `q`; the iterations taken.
+fn newton(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    q: &mut [f64],
+    config: NewtonConfig,
+) -> Result<usize, NewtonFailure> {
+    let n = q.len();
+    let zero = vec![0.0; n];
+    let mut iterations = 0;
+    loop {
+        let r = solver::residual(model, kin, load, 0.0, q, &zero, &zero);
+        let a = air.terms(model, kin.length_m, q, &zero, true);
+        let total: Vec<f64> = (0..n).map(|i| r.total[i] - a.force[i]).collect();
+        let rn = norm(&total);
+        let scale = r.scale.max(norm(&a.force));
+        if rn <= config.absolute_tolerance_n + config.relative_tolerance * scale {
+            return Ok(iterations);
+        }
+        let fail = NewtonFailure {
+            time_s: 0.0,
+            iterations,
+            residual_norm: rn,
+        };
+        if iterations >= config.max_iterations || !rn.is_finite() {
+            return Err(fail);
+        }
+        let mut s = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
+        s.add_scaled(1.0, &a.stiffness);
+        let lu = s.factor().ok_or(fail)?;
+        let mut dq: Vec<f64> = total.iter().map(|x| -x).collect();
+        lu.solve_in_place(&mut dq);
+        for (qi, di) in q.iter_mut().zip(&dq) {
+            *qi += di;
+        }
+        iterations += 1;
+        if dq.iter().any(|d| !d.is_finite()) {
+            return Err(fail);
+        }
+        if at_roundoff(&dq, q, kin.length_m) {
+            return Ok(iterations);
+        }
+    }
+}
+
+/// The blown-down equilibrium at `kin` under the tip `load`, gravity and `air`.
+pub fn wind_equilibrium(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    config: &QsConfig,
+    start: Option<&[f64]>,
+) -> Result<WindEquilibrium, NewtonFailure> {
+    if let Some(s) = start
+        && s.len() == model.dofs()
+    {
+        let mut q = s.to_vec();
+        if let Ok(it) = newton(model, kin, load, air, &mut q, config.newton) {
+            return Ok(WindEquilibrium {
+                q,
+                continuation_steps: 0,
+                newton_iterations: it,
+            });
+        }
+    }
+    let mut q = solver::static_solve(model, kin, load, config.load_steps, config.newton)?;
+    if air.is_calm() {
+        return Ok(WindEquilibrium {
+            q,
+            continuation_steps: 0,
+            newton_iterations: 0,
+        });
+    }
+    let (mut done, mut step) = (0.0f64, 1.0f64);
+    let (mut steps, mut iterations) = (0usize, 0usize);
+    let mut last_failure = None;
+    while done < 1.0 {
+        if steps >= MAX_CONTINUATION_STEPS || step < 1e-6 {
+            return Err(last_failure.unwrap_or(NewtonFailure {
+                time_s: 0.0,
+                iterations,
+                residual_norm: f64::NAN,
+            }));
+        }
+        steps += 1;
+        let target = (done + step).min(1.0);
+        let mut trial = q.clone();
+        match newton(
+            model,
+            kin,
+            load,
+            &air.scaled(target),
+            &mut trial,
+            config.newton,
+        ) {
+            Ok(it) => {
+                iterations += it;
+                q = trial;
+                done = target;
+                step *= 1.5;
+            }
+            Err(f) => {
+                iterations += f.iterations;
+                last_failure = Some(f);
+                step *= 0.5;
+            }
+        }
+    }
+    Ok(WindEquilibrium {
+        q,
+        continuation_steps: steps,
+        newton_iterations: iterations,
+    })
+}
+
+/// `M`, `C`, `K` about a state, air terms included.
+pub fn wind_matrices(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    state: &State,
+) -> SystemMatrices {
+    let mut sys = solver::system_matrices(model, kin, load, 0.0, &state.q, &state.v, &state.a);
+    if !air.is_calm() {
+        let a = air.terms(model, kin.length_m, &state.q, &state.v, true);
+        sys.stiffness.add_scaled(1.0, &a.stiffness);
+        sys.damping.add_scaled(1.0, &a.damping);
+    }
+    sys
+}
+
+/// The quasi-static state at an equilibrium `q`: the velocity of `motion`
+/// and the consistent acceleration.
+pub fn state_at(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    motion: StateMotion,
+    q: Vec<f64>,
+) -> Result<State, QepError> {
+    let v = match motion {
+        StateMotion::AtRest => vec![0.0; q.len()],
+        StateMotion::SteadyPayout => super::critical::steady_payout_velocity(model, kin, &q),
+    };
+    let zero = vec![0.0; q.len()];
+    let r = solver::residual(model, kin, load, 0.0, &q, &v, &zero);
+    let m = solver::system_matrices(model, kin, load, 0.0, &q, &v, &zero).mass;
+    let lu = m.factor().ok_or(QepError::NonFinite)?;
+    let mut a: Vec<f64> = r.total.iter().map(|x| -x).collect();
+    if !air.is_calm() {
+        let f = air.terms(model, kin.length_m, &q, &v, false).force;
+        for (ai, fi) in a.iter_mut().zip(&f) {
+            *ai += fi;
+        }
+    }
+    lu.solve_in_place(&mut a);
+    Ok(State {
+        time_s: 0.0,
+        q,
+        v,
+        a,
+    })
+}
+
+/// Local stability of the GE cable at a deployment state in a steady
+/// wind: the blown-down equilibrium, then the QEP about it. With
+/// [`AirLoads::calm`] this is [`super::stability::state_stability`].
+pub fn wind_stability(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    motion: StateMotion,
+    config: &QsConfig,
+    start: Option<&[f64]>,
+) -> Result<WindStateStability, GeStateFailure> {
+    let eq = wind_equilibrium(model, kin, load, air, config, start)
+        .map_err(GeStateFailure::Equilibrium)?;
+    let state = state_at(model, kin, load, air, motion, eq.q).map_err(GeStateFailure::Spectrum)?;
+    let spectrum = spectrum_of(model, wind_matrices(model, kin, load, air, &state))
+        .map_err(GeStateFailure::Spectrum)?;
+    let top = node(&state.q, model.elements);
+    Ok(WindStateStability {
+        root_axial_force_n: super::critical::root_axial_force_n(model, kin.length_m, &state.q),
+        tip_altitude_m: kin.length_m + top[0],
+        tip_downwind_m: top[1],
+        spectrum,
+        state,
+        continuation_steps: eq.continuation_steps,
+        newton_iterations: eq.newton_iterations,
+    })
+}
+
+/// Sign of `det K` of the quasi-static state (`K` with the air stiffness):
+/// `+1`, `−1`, or 0 when singular. A real eigenvalue of the QEP crosses
+/// zero exactly where it changes sign (divergence).
+pub fn stiffness_determinant_sign(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    q: &[f64],
+) -> i8 {
+    let zero = vec![0.0; q.len()];
+    let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
+    if !air.is_calm() {
+        k.add_scaled(
+            1.0,
+            &air.terms(model, kin.length_m, q, &zero, true).stiffness,
+        );
+    }
+    band_determinant_sign(&k)
+}
+
+/// Number of negative eigenvalues of the symmetric part of `K` (with the
+/// air stiffness) at the equilibrium `q` (Sylvester's law of inertia on a
+/// band `LDLᵀ`). In calm air at a constant rate `K` is symmetric and this is
+/// its inertia; a zero or non-finite pivot gives `None`.
+pub fn stiffness_negative_count(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    q: &[f64],
+) -> Option<usize> {
+    let zero = vec![0.0; q.len()];
+    let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
+    if !air.is_calm() {
+        k.add_scaled(
+            1.0,
+            &air.terms(model, kin.length_m, q, &zero, true).stiffness,
+        );
+    }
+    symmetric_negative_count(&k)
+}
+
+/// Negative pivots of `LDLᵀ` of `(A + Aᵀ)/2` for a band `A` (no pivoting).
+pub fn symmetric_negative_count(a: &Band) -> Option<usize> {
+    let n = a.n;
+    let b = a.kl.min(a.ku);
+    // l[i][k] for k in i-b..i stored at offset (k + b − i); d[i]
+    let mut l = vec![0.0; n * (b + 1)];
+    let mut d = vec![0.0; n];
+    let sym = |i: usize, j: usize| 0.5 * (a.get(i, j) + a.get(j, i));
+    let mut negative = 0;
+    for i in 0..n {
+        let lo = i.saturating_sub(b);
+        for j in lo..i {
+            // l_ij d_j = a_ij − Σ_{k<j} l_ik l_jk d_k
+            let mut s = sym(i, j);
+            for k in lo.max(j.saturating_sub(b))..j {
+                s -= l[i * (b + 1) + (k + b - i)] * l[j * (b + 1) + (k + b - j)] * d[k];
+            }
+            l[i * (b + 1) + (j + b - i)] = s / d[j];
+        }
+        let mut s = sym(i, i);
+        for k in lo..i {
+            let lik = l[i * (b + 1) + (k + b - i)];
+            s -= lik * lik * d[k];
+        }
+        if !s.is_finite() || s == 0.0 {
+            return None;
+        }
+        d[i] = s;
+        if s < 0.0 {
+            negative += 1;
+        }
+    }
+    Some(negative)
+}
+
+/// Sign of the determinant of a band matrix (LU with partial pivoting on a copy).
+pub fn band_determinant_sign(a: &Band) -> i8 {
+    let n = a.n;
+    let (kl, ku) = (a.kl, a.ku);
+    let w = 2 * kl + ku + 1;
+    // row i holds columns i − kl ..= i + kl + ku at offset j + kl − i
+    let mut d = vec![0.0; n * w];
+    for i in 0..n {
+        for j in i.saturating_sub(kl)..=(i + ku).min(n.saturating_sub(1)) {
+            d[i * w + (j + kl - i)] = a.get(i, j);
+        }
+    }
+    let idx = |i: usize, j: usize| i * w + (j + kl - i);
+    let mut sign = 1i8;
+    for k in 0..n {
+        let last_row = (k + kl).min(n - 1);
+        let mut p = k;
+        let mut best = d[idx(k, k)].abs();
+        for r in k + 1..=last_row {
+            let v = d[idx(r, k)].abs();
+            if v > best {
+                best = v;
+                p = r;
+            }
+        }
+        if !best.is_finite() || best == 0.0 {
+            return 0;
+        }
+        let last_col = (k + kl + ku).min(n - 1);
+        if p != k {
+            sign = -sign;
+            for j in k..=last_col {
+                d.swap(idx(k, j), idx(p, j));
+            }
+        }
+        let pivot = d[idx(k, k)];
+        if pivot < 0.0 {
+            sign = -sign;
+        }
+        for r in k + 1..=last_row {
+            let l = d[idx(r, k)] / pivot;
+            if l != 0.0 {
+                for j in k + 1..=last_col {
+                    d[idx(r, j)] -= l * d[idx(k, j)];
+                }
+            }
+        }
+    }
+    sign
+}
