@@ -361,6 +361,9 @@ pub struct SimulateResponse {
     pub magnitude_cap_lengths_nondim: f64,
     pub time_step_s: f64,
     pub steps: usize,
+    /// Tension at the winch and the aerostat per output time (with the
+    /// rate and acceleration terms), its extremes, slack and safety factor.
+    pub tension: crate::contract::tension::TensionSeriesOutput,
     /// Displaced air mass m_f used by the aerodynamics (kg).
     pub displaced_air_mass_kg: Option<f64>,
     pub groups: Groups,
@@ -651,6 +654,7 @@ pub fn simulate(
     let model = req.system.model()?;
     let sys = model.system;
     let profile = req.profile.profile(sys.initial_length_m)?;
+    let breaking_strength_n = req.system.cable.breaking_strength()?;
     let aero = match &req.aero {
         Some(a) => Some(
             a.body()
@@ -756,6 +760,12 @@ pub fn simulate(
         magnitude_cap_lengths_nondim: MAGNITUDE_CAP_LENGTHS,
         time_step_s: run.time_step_s,
         steps: run.steps,
+        tension: crate::contract::tension::TensionSeriesOutput::of(
+            &sys,
+            &profile,
+            &col(|s| s.time_s),
+            breaking_strength_n,
+        ),
         displaced_air_mass_kg,
         groups: groups(&sys),
         elements: model.elements(),
