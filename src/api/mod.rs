@@ -95,10 +95,7 @@ pub struct Health {
 pub async fn get_health(axum::extract::State(app): axum::extract::State<AppState>) -> Response {
     let queue = app.queue.clone();
     let live = tokio::task::spawn_blocking(move || {
-        queue
-            .store
-            .live_workers(crate::jobs::PRESENCE_TIMEOUT)
-            .ok()
+        queue.store.live_workers(crate::jobs::PRESENCE_TIMEOUT).ok()
     });
     let live_workers = tokio::time::timeout(std::time::Duration::from_secs(1), live)
         .await
@@ -159,7 +156,10 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
         .route("/api/v1/plan", post(solve::compute_plan))
         .route("/api/v1/bands", post(solve::compute_bands))
         .route("/api/v1/plan/bands", post(bands::compute_plan_bands))
-        .route("/api/v1/envelope/bands", post(bands::compute_envelope_bands))
+        .route(
+            "/api/v1/envelope/bands",
+            post(bands::compute_envelope_bands),
+        )
         .route("/api/v1/jobs", post(jobs::create_job).get(jobs::list_jobs))
         .route(
             "/api/v1/jobs/{id}",

@@ -569,8 +569,7 @@ pub fn ge_chart_points(
     }
     let cancel = || progress.cancelled();
     let report = |done: usize, total: usize| progress.report(done, total);
-    let flat =
-        ge_chart_core::chart_points_range(&core, range, parallelism, &report, &cancel)?;
+    let flat = ge_chart_core::chart_points_range(&core, range, parallelism, &report, &cancel)?;
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }

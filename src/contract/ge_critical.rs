@@ -366,7 +366,9 @@ pub fn ge_critical(
 ) -> Result<GeCriticalResponse, RequestError> {
     let (model, problem, config) = prepare_critical(req)?;
     if req.method == GeCriticalMethod::QuasiStatic {
-        return crate::contract::ge_quasi_static::quasi_static_critical(req, &model, &problem, progress);
+        return crate::contract::ge_quasi_static::quasi_static_critical(
+            req, &model, &problem, progress,
+        );
     }
     let cancel = || progress.cancelled();
     let r = critical_time(&model, &problem, &config, &cancel)?;

@@ -972,8 +972,10 @@ impl JobSubmission {
             Self::One(item) => item.run_range(range, progress),
             Self::Batch(b) => {
                 let items = b.request.get(range).unwrap_or(&[]);
-                let outcomes: Vec<BatchItemOutcome> =
-                    items.par_iter().map(|item| batch_item(item, progress)).collect();
+                let outcomes: Vec<BatchItemOutcome> = items
+                    .par_iter()
+                    .map(|item| batch_item(item, progress))
+                    .collect();
                 if progress.cancelled() {
                     return Err(RequestError::Cancelled);
                 }
@@ -997,9 +999,8 @@ impl JobSubmission {
             Self::Batch(_) => {
                 let mut items = Vec::new();
                 for part in parts {
-                    let chunk: Vec<Box<RawValue>> = serde_json::from_str(part).map_err(|e| {
-                        RequestError::Malformed(format!("a chunk result: {e}"))
-                    })?;
+                    let chunk: Vec<Box<RawValue>> = serde_json::from_str(part)
+                        .map_err(|e| RequestError::Malformed(format!("a chunk result: {e}")))?;
                     items.extend(chunk);
                 }
                 to_json(&RawBatchOutcome { items })

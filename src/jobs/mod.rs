@@ -176,7 +176,9 @@ impl JobQueue {
             request_hash: &request_hash,
             max_pending: self.limits.max_pending_jobs,
             max_pending_per_owner: self.limits.max_pending_jobs_per_token,
-            priority: submission.chunk_plan().map_or(0, |p| i64::from(p.count() > 1)),
+            priority: submission
+                .chunk_plan()
+                .map_or(0, |p| i64::from(p.count() > 1)),
         };
         let submitted = match self.store.insert(&new)? {
             Inserted::New(id) => {

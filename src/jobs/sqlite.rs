@@ -18,8 +18,8 @@ use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
 
 use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
 use super::store::{
-    ChunkLease, ChunkState, ClaimPolicy, ClaimedChunk, ClaimedJob, InsertError, Inserted, JobBackend, JobRecord, JobStatus, KeyedJob,
-    NewJob, StoreError,
+    ChunkLease, ChunkState, ClaimPolicy, ClaimedChunk, ClaimedJob, InsertError, Inserted,
+    JobBackend, JobRecord, JobStatus, KeyedJob, NewJob, StoreError,
 };
 
 const SCHEMA_V1: &str = "
@@ -226,7 +226,13 @@ impl JobStore {
         let x: &dyn rusqlite::ToSql = extra.unwrap_or(&none);
         let n = self.conn().execute(
             &sql,
-            params![lease.job_id, lease.index as i64, lease.owner, x, lease.epoch],
+            params![
+                lease.job_id,
+                lease.index as i64,
+                lease.owner,
+                x,
+                lease.epoch
+            ],
         )?;
         Ok(n == 1)
     }

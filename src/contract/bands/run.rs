@@ -474,18 +474,20 @@ pub fn bands_from_chunks(
     for part in parts {
         let wire: Vec<WireSample> = serde_json::from_str(part)
             .map_err(|e| RequestError::Malformed(format!("a chunk of the bands job: {e}")))?;
-        results.extend(wire.into_iter().map(|w| match w {
-            WireSample::Ok(points) => Ok(points
-                .into_iter()
-                .map(|(h, t, he, te, immediate)| PointValue {
-                    elevation_m: f64::from_bits(h),
-                    time_s: f64::from_bits(t),
-                    elevation_error_m: f64::from_bits(he),
-                    time_error_s: f64::from_bits(te),
-                    immediate,
-                })
-                .collect()),
-            WireSample::Rejected(k) => Err(k),
+        results.extend(wire.into_iter().map(|w| {
+            match w {
+                WireSample::Ok(points) => Ok(points
+                    .into_iter()
+                    .map(|(h, t, he, te, immediate)| PointValue {
+                        elevation_m: f64::from_bits(h),
+                        time_s: f64::from_bits(t),
+                        elevation_error_m: f64::from_bits(he),
+                        time_error_s: f64::from_bits(te),
+                        immediate,
+                    })
+                    .collect()),
+                WireSample::Rejected(k) => Err(k),
+            }
         }));
     }
     if results.len() != prep.ensemble.samples {
