@@ -37,7 +37,11 @@ fn simulate(v: &Value) -> Value {
 }
 
 fn floats(v: &Value) -> Vec<f64> {
-    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
 }
 
 #[test]
@@ -61,8 +65,16 @@ fn constant_acceleration_tensions_follow_the_closed_form() {
         let top_exact = F - M * a;
         let winch_exact = top_exact - RHO_A * (G + a) * length;
         let tol = 1e-9 * F;
-        assert!((top[i] - top_exact).abs() < tol, "top at {t}: {} vs {top_exact}", top[i]);
-        assert!((winch[i] - winch_exact).abs() < tol, "winch at {t}: {} vs {winch_exact}", winch[i]);
+        assert!(
+            (top[i] - top_exact).abs() < tol,
+            "top at {t}: {} vs {top_exact}",
+            top[i]
+        );
+        assert!(
+            (winch[i] - winch_exact).abs() < tol,
+            "winch at {t}: {} vs {winch_exact}",
+            winch[i]
+        );
         let eff_exact = winch_exact - RHO_A * rate * rate;
         assert!((effective[i] - eff_exact).abs() < tol, "effective at {t}");
         max_winch = max_winch.max(winch_exact.max(top_exact));

@@ -392,4 +392,3 @@ fn the_roller_element_mesh_gives_the_graded_mesh_value() {
         }
     }
 }
-
