@@ -8,7 +8,7 @@ use axum::response::Response;
 
 use crate::api::AppState;
 use crate::api::error::{ApiError, JsonBody};
-use crate::api::solve::{Deadline, SolveCtx};
+use crate::api::solve::{Deadline, SolveCtx, solve_path};
 use crate::contract::bands::envelope::{self, EnvelopeBandsRequest, EnvelopeBandsResponse};
 use crate::contract::bands::plan::{self, PlanBandsRequest, PlanBandsResponse};
 use crate::contract::dto::ErrorBody;
@@ -24,39 +24,22 @@ fn to_json(value: &impl serde::Serialize) -> Result<Vec<u8>, ApiError> {
     Ok(serde_json::to_vec(value).expect("responses serialise"))
 }
 
-/// A deployment plan under uncertain inputs: the nominal schedule, and per
-/// sample what it does to that sample's system.
-///
-/// The body is a `POST /api/v1/plan` request plus `uncertainty` (seeded
-/// Monte Carlo over `aerostat.net_buoyancy_n`, `aerostat.mass_kg`, the
-/// cable's mass, `gravity_m_s2`, `tether.breaking_strength_n`). The answer
-/// holds the nominal plan, 5/50/95 % bands of the winch tension, largest
-/// tension and stability margin at every instant of its schedule, and the
-/// probabilities (Wilson 95 % interval) that some instant is unstable,
-/// breaks the lift reserve, or exceeds the tether rating. Synchronously at
-/// most 2 000 000 sample × instant values; larger as a job with
-/// `"kind": "plan_bands"`.
-#[utoipa::path(
-    post, path = "/api/v1/plan/bands", tag = "solve", operation_id = "compute_plan_bands",
-    request_body(content = PlanBandsRequest, description = "A plan request and `uncertainty` (SI units)"),
-    responses(
-        (status = 200, description = "The answer", body = PlanBandsResponse),
-        (status = 400, description = "Malformed JSON", body = ErrorBody),
-        (status = 413, description = "Body larger than the limit", body = ErrorBody),
-        (status = 415, description = "Content type is not JSON", body = ErrorBody),
-        (status = 422, description = "Invalid input (`invalid_input`) or too large for a synchronous answer (`too_large`: use /api/v1/jobs); `field` names the culprit", body = ErrorBody),
-        (status = 500, description = "Numerical failure on valid input (a bug)", body = ErrorBody),
-        (status = 503, description = "Too many solves in flight", body = ErrorBody,
-            headers(("Retry-After" = u32, description = "Seconds to wait before retrying"))),
-        (status = 504, description = "No answer within the solve timeout", body = ErrorBody),
-    )
-)]
-pub async fn compute_plan_bands(
-    State(app): State<AppState>,
-    JsonBody(body): JsonBody,
-) -> Result<Response, ApiError> {
-    app.solve(move |ctx: &SolveCtx| {
-        let req = plan::parse_plan_bands(&body)?;
+solve_path!(
+    /// A deployment plan under uncertain inputs: the nominal schedule, and per
+    /// sample what it does to that sample's system.
+    ///
+    /// The body is a `POST /api/v1/plan` request plus `uncertainty` (seeded
+    /// Monte Carlo over `aerostat.net_buoyancy_n`, `aerostat.mass_kg`, the
+    /// cable's mass, `gravity_m_s2`, `tether.breaking_strength_n`). The answer
+    /// holds the nominal plan, 5/50/95 % bands of the winch tension, largest
+    /// tension and stability margin at every instant of its schedule, and the
+    /// probabilities (Wilson 95 % interval) that some instant is unstable,
+    /// breaks the lift reserve, or exceeds the tether rating. Synchronously at
+    /// most 2 000 000 sample × instant values; larger as a job with
+    /// `"kind": "plan_bands"`.
+    compute_plan_bands, "/api/v1/plan/bands", PlanBandsRequest, PlanBandsResponse,
+    parse = |body| plan::parse_plan_bands(body),
+    |req, ctx| {
         plan::prepare_plan_bands(&req)?;
         let values = plan::plan_band_values(&req);
         if values > MAX_SYNC_PLAN_BAND_VALUES {
@@ -68,41 +51,23 @@ pub async fn compute_plan_bands(
             ));
         }
         to_json(&plan::plan_bands(&req, Parallelism::Rayon, &Deadline::after(ctx))?)
-    })
-    .await
-}
+    }
+);
 
-/// The operating envelope under uncertain inputs: per cell, the
-/// probability of exceeding the tension limit, of instability and of
-/// leaving the envelope, and the band of the largest tension.
-///
-/// The body is a `POST /api/v1/envelope` request plus `uncertainty` (over
-/// the aerostat's buoyancy, drag and lift coefficients and area, the
-/// tether's mass, diameter, drag coefficient, stiffness and breaking
-/// strength, the air density and gravity). Each sample solves the whole
-/// envelope. Synchronously at most 10 000 sample × cell equilibria; up to
-/// 2 000 000 as a job with `"kind": "envelope_bands"`.
-#[utoipa::path(
-    post, path = "/api/v1/envelope/bands", tag = "solve", operation_id = "compute_envelope_bands",
-    request_body(content = EnvelopeBandsRequest, description = "An envelope request and `uncertainty` (SI units)"),
-    responses(
-        (status = 200, description = "The answer", body = EnvelopeBandsResponse),
-        (status = 400, description = "Malformed JSON", body = ErrorBody),
-        (status = 413, description = "Body larger than the limit", body = ErrorBody),
-        (status = 415, description = "Content type is not JSON", body = ErrorBody),
-        (status = 422, description = "Invalid input (`invalid_input`) or too large for a synchronous answer (`too_large`: use /api/v1/jobs); `field` names the culprit", body = ErrorBody),
-        (status = 500, description = "Numerical failure on valid input (a bug)", body = ErrorBody),
-        (status = 503, description = "Too many solves in flight", body = ErrorBody,
-            headers(("Retry-After" = u32, description = "Seconds to wait before retrying"))),
-        (status = 504, description = "No answer within the solve timeout", body = ErrorBody),
-    )
-)]
-pub async fn compute_envelope_bands(
-    State(app): State<AppState>,
-    JsonBody(body): JsonBody,
-) -> Result<Response, ApiError> {
-    app.solve(move |ctx: &SolveCtx| {
-        let req = envelope::parse_envelope_bands(&body)?;
+solve_path!(
+    /// The operating envelope under uncertain inputs: per cell, the
+    /// probability of exceeding the tension limit, of instability and of
+    /// leaving the envelope, and the band of the largest tension.
+    ///
+    /// The body is a `POST /api/v1/envelope` request plus `uncertainty` (over
+    /// the aerostat's buoyancy, drag and lift coefficients and area, the
+    /// tether's mass, diameter, drag coefficient, stiffness and breaking
+    /// strength, the air density and gravity). Each sample solves the whole
+    /// envelope. Synchronously at most 10 000 sample × cell equilibria; up to
+    /// 2 000 000 as a job with `"kind": "envelope_bands"`.
+    compute_envelope_bands, "/api/v1/envelope/bands", EnvelopeBandsRequest, EnvelopeBandsResponse,
+    parse = |body| envelope::parse_envelope_bands(body),
+    |req, ctx| {
         envelope::prepare_envelope_bands(&req)?;
         let total = envelope::envelope_band_evaluations(&req);
         if total > MAX_SYNC_ENVELOPE_BAND_EVALUATIONS {
@@ -114,6 +79,5 @@ pub async fn compute_envelope_bands(
             ));
         }
         to_json(&envelope::envelope_bands(&req, Parallelism::Rayon, &Deadline::after(ctx))?)
-    })
-    .await
-}
+    }
+);

@@ -245,6 +245,7 @@ macro_rules! solve_path {
         }
     };
 }
+pub(crate) use solve_path;
 
 solve_path!(
     /// Eigenvalues and stability verdict at one deployment state.
