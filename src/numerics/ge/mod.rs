@@ -53,6 +53,7 @@ pub mod qs_critical;
 pub mod quasi_static;
 pub mod solver;
 pub mod stability;
+pub mod tether_system;
 
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 
