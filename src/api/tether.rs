@@ -7,7 +7,7 @@ use axum::response::Response;
 
 use crate::api::AppState;
 use crate::api::error::{ApiError, JsonBody};
-use crate::api::solve::{Deadline, SolveCtx};
+use crate::api::solve::{Deadline, SolveCtx, solve_path};
 use crate::contract::dto::ErrorBody;
 use crate::contract::envelope::dto::{EnvelopeRequest, EnvelopeResponse};
 use crate::contract::envelope::{self, MAX_SYNC_ENVELOPE_POINTS};
@@ -19,70 +19,33 @@ fn to_json(value: &impl serde::Serialize) -> Result<Vec<u8>, ApiError> {
     Ok(serde_json::to_vec(value).expect("responses serialise"))
 }
 
-/// Static equilibrium of the tether in a steady wind: altitude, downwind
-/// distance, winch and top tension, safety factor, blow-down and shape.
-///
-/// A heavy, optionally elastic tether under its weight, normal wind drag
-/// and the aerostat's drag, lift and net buoyancy, integrated from the
-/// aerostat down (RK4, shooting on the altitude). Slack (part of the
-/// tether on the ground) is an answer, not an error. Presets
-/// (`cable.preset`, `aerostat.preset`) fill the fields left out.
-#[utoipa::path(
-    post, path = "/api/v1/equilibrium", tag = "solve", operation_id = "compute_equilibrium",
-    request_body(content = EquilibriumRequest, description = "Tether, aerostat, length and wind (SI units)"),
-    responses(
-        (status = 200, description = "The answer", body = EquilibriumResponse),
-        (status = 400, description = "Malformed JSON", body = ErrorBody),
-        (status = 413, description = "Body larger than the limit", body = ErrorBody),
-        (status = 415, description = "Content type is not JSON", body = ErrorBody),
-        (status = 422, description = "Invalid input (`invalid_input`); `field` names the culprit", body = ErrorBody),
-        (status = 500, description = "Numerical failure on valid input (a bug)", body = ErrorBody),
-        (status = 503, description = "Too many solves in flight", body = ErrorBody,
-            headers(("Retry-After" = u32, description = "Seconds to wait before retrying"))),
-        (status = 504, description = "No answer within the solve timeout", body = ErrorBody),
-    )
-)]
-pub async fn compute_equilibrium(
-    State(app): State<AppState>,
-    JsonBody(body): JsonBody,
-) -> Result<Response, ApiError> {
-    app.solve(move |_: &SolveCtx| {
-        let req: EquilibriumRequest = contract::parse_plain(&body)?;
-        to_json(&equilibrium::equilibrium(&req)?)
-    })
-    .await
-}
+solve_path!(
+    /// Static equilibrium of the tether in a steady wind: altitude, downwind
+    /// distance, winch and top tension, safety factor, blow-down and shape.
+    ///
+    /// A heavy, optionally elastic tether under its weight, normal wind drag
+    /// and the aerostat's drag, lift and net buoyancy, integrated from the
+    /// aerostat down (RK4, shooting on the altitude). Slack (part of the
+    /// tether on the ground) is an answer, not an error. Presets
+    /// (`cable.preset`, `aerostat.preset`) fill the fields left out.
+    compute_equilibrium, "/api/v1/equilibrium", EquilibriumRequest, EquilibriumResponse,
+    parse = |body| contract::parse_plain(body),
+    |req, _ctx| to_json(&equilibrium::equilibrium(&req)?)
+);
 
-/// Operating envelope over wind speed × tether length: altitude,
-/// blow-down, tensions, safety factor, slack and stability at each point,
-/// the largest operating wind per length and the highest altitude per wind.
-///
-/// Each point is judged against slack, the required safety factor, an
-/// optional ceiling and (with `payout_rate_m_s`) stability; the first
-/// violated is its binding limit. Synchronously at most 5 000 points;
-/// larger envelopes (up to 250 000 points) go to `POST /api/v1/jobs` with
-/// `"kind": "envelope"`.
-#[utoipa::path(
-    post, path = "/api/v1/envelope", tag = "solve", operation_id = "compute_envelope",
-    request_body(content = EnvelopeRequest, description = "Tether, aerostat, wind shape, grids and limits (SI units)"),
-    responses(
-        (status = 200, description = "The answer", body = EnvelopeResponse),
-        (status = 400, description = "Malformed JSON", body = ErrorBody),
-        (status = 413, description = "Body larger than the limit", body = ErrorBody),
-        (status = 415, description = "Content type is not JSON", body = ErrorBody),
-        (status = 422, description = "Invalid input (`invalid_input`) or too large for a synchronous answer (`too_large`: use /api/v1/jobs); `field` names the culprit", body = ErrorBody),
-        (status = 500, description = "Numerical failure on valid input (a bug)", body = ErrorBody),
-        (status = 503, description = "Too many solves in flight", body = ErrorBody,
-            headers(("Retry-After" = u32, description = "Seconds to wait before retrying"))),
-        (status = 504, description = "No answer within the solve timeout", body = ErrorBody),
-    )
-)]
-pub async fn compute_envelope(
-    State(app): State<AppState>,
-    JsonBody(body): JsonBody,
-) -> Result<Response, ApiError> {
-    app.solve(move |ctx: &SolveCtx| {
-        let req: EnvelopeRequest = contract::parse_plain(&body)?;
+solve_path!(
+    /// Operating envelope over wind speed × tether length: altitude,
+    /// blow-down, tensions, safety factor, slack and stability at each point,
+    /// the largest operating wind per length and the highest altitude per wind.
+    ///
+    /// Each point is judged against slack, the required safety factor, an
+    /// optional ceiling and (with `payout_rate_m_s`) stability; the first
+    /// violated is its binding limit. Synchronously at most 5 000 points;
+    /// larger envelopes (up to 250 000 points) go to `POST /api/v1/jobs` with
+    /// `"kind": "envelope"`.
+    compute_envelope, "/api/v1/envelope", EnvelopeRequest, EnvelopeResponse,
+    parse = |body| contract::parse_plain(body),
+    |req, ctx| {
         req.validate()?;
         let points = req.points();
         if points > MAX_SYNC_ENVELOPE_POINTS {
@@ -94,6 +57,5 @@ pub async fn compute_envelope(
             ));
         }
         to_json(&envelope::envelope(&req, Parallelism::Rayon, &Deadline::after(ctx))?)
-    })
-    .await
-}
+    }
+);
