@@ -7,25 +7,9 @@
 # Then open http://localhost:8080/ (chart page), /docs (API), /healthz.
 # Jobs persist in the SQLite database on the /data volume.
 #
-# Security: inside the container the server binds 0.0.0.0:8080 (it must, to
-# be reachable through the port mapping) and logs a loud warning when no
-# tokens are set. Publish on loopback as above, or before exposing the port:
-#   -e TETHERPLAN_API_TOKENS=token1,token2    every /api route then needs
-#                                             "Authorization: Bearer token1"
-#   -e TETHERPLAN_ALLOWED_HOSTS=plan.example.org   Host names besides
-#                                             localhost (others get 421)
-# Connection limits: TETHERPLAN_HEADER_TIMEOUT_S (5), TETHERPLAN_BODY_TIMEOUT_S
-# (10), TETHERPLAN_MAX_CONNECTIONS (10000, clamped below the file limit).
-#
-# The image listens on 0.0.0.0: give it API tokens, or anyone who can reach
-# the port can read, submit and cancel every job (the server logs a loud
-# warning when it has none):
-#   docker run --rm -p 8080:8080 -v tetherplan-data:/data \
-#     -e TETHERPLAN_API_TOKENS="$(openssl rand -hex 24),$(openssl rand -hex 24)" \
-#     --hostname tetherplan-1 tetherplan
-# A fixed --hostname lets a restarted container take over its interrupted job
-# at once; otherwise it is taken over when its lease (TETHERPLAN_JOB_LEASE_S,
-# 30 s) expires.
+# Security (the server binds 0.0.0.0:8080 inside the container; API tokens,
+# Host allow-list, connection limits) and the fixed --hostname for job
+# takeover: README.md, "Security and limits" and the Docker paragraph.
 
 # ---- build: release binary ----
 FROM rust:1.95-slim-bookworm AS build
