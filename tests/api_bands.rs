@@ -3,50 +3,18 @@
 //! is a 422 naming the field, large ensembles point to jobs, and a job runs
 //! to the same answer with progress.
 
-use std::path::Path;
-use std::sync::Arc;
-
-use axum::Router;
-use axum::body::Body;
-use axum::http::{Request, StatusCode, header};
-use http_body_util::BodyExt;
+use axum::http::StatusCode;
 use serde_json::{Value, json};
-use tetherplan::api::{self, AppState};
+use tetherplan::api::{self};
 use tetherplan::config::Limits;
 use tetherplan::contract::bands;
-use tetherplan::contract::dto::ErrorBody;
 use tetherplan::contract::run::NoProgress;
-use tetherplan::jobs::store::{JobStatus, JobStore};
-use tetherplan::jobs::{JobQueue, try_execute_next};
+use tetherplan::jobs::store::JobStatus;
+use tetherplan::jobs::try_execute_next;
 use tetherplan::numerics::chart::Parallelism;
-use tower::ServiceExt;
 
-fn app() -> (Router, Arc<JobQueue>) {
-    let queue = Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        2,
-        Limits::default(),
-    ));
-    (
-        api::router(AppState::new(queue.clone()), Path::new("static")),
-        queue,
-    )
-}
-
-async fn send(app: &Router, method: &str, uri: &str, body: Option<&Value>) -> (StatusCode, String) {
-    let mut req = Request::builder().method(method).uri(uri);
-    let body = match body {
-        Some(b) => {
-            req = req.header(header::CONTENT_TYPE, "application/json");
-            Body::from(serde_json::to_vec(b).unwrap())
-        }
-        None => Body::empty(),
-    };
-    let resp = app.clone().oneshot(req.body(body).unwrap()).await.unwrap();
-    let status = resp.status();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    (status, String::from_utf8_lossy(&bytes).into_owned())
-}
+mod common;
+use common::{app, error, send_text as send};
 
 fn body(samples: usize) -> Value {
     json!({
@@ -64,11 +32,6 @@ fn body(samples: usize) -> Value {
 fn direct(v: &Value) -> String {
     let req = bands::parse_bands(&serde_json::to_vec(v).unwrap()).unwrap();
     serde_json::to_string(&bands::bands(&req, Parallelism::Rayon, &NoProgress).unwrap()).unwrap()
-}
-
-fn error(text: &str) -> (String, Option<String>) {
-    let e: ErrorBody = serde_json::from_str(text).unwrap_or_else(|_| panic!("{text}"));
-    (e.error.code, e.error.field)
 }
 
 #[tokio::test]

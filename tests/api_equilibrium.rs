@@ -1,54 +1,19 @@
 //! The tether routes and contract: `POST /api/v1/equilibrium`,
 //! `POST /api/v1/envelope`, the envelope job, presets and strict input.
 
-use std::path::Path;
-use std::sync::Arc;
-
-use axum::Router;
-use axum::body::Body;
-use axum::http::{Request, StatusCode, header};
-use http_body_util::BodyExt;
+use axum::http::StatusCode;
 use serde_json::{Value, json};
-use tetherplan::api::{self, AppState};
-use tetherplan::config::Limits;
 use tetherplan::contract::envelope::dto::EnvelopeRequest;
 use tetherplan::contract::equilibrium::dto::{EquilibriumRequest, WindFlowInput};
 use tetherplan::contract::run::NoProgress;
 use tetherplan::contract::{self, envelope, equilibrium};
-use tetherplan::jobs::store::{JobStatus, JobStore};
-use tetherplan::jobs::{JobQueue, try_execute_next};
+use tetherplan::jobs::store::JobStatus;
+use tetherplan::jobs::try_execute_next;
 use tetherplan::numerics::chart::Parallelism;
-use tower::ServiceExt;
 use utoipa::PartialSchema;
 
-fn app() -> (Router, Arc<JobQueue>) {
-    let queue = Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        2,
-        Limits::default(),
-    ));
-    (
-        api::router(AppState::new(queue.clone()), Path::new("static")),
-        queue,
-    )
-}
-
-async fn send(app: &Router, method: &str, uri: &str, body: Option<&Value>) -> (StatusCode, Value) {
-    let mut req = Request::builder().method(method).uri(uri);
-    let body = match body {
-        Some(b) => {
-            req = req.header(header::CONTENT_TYPE, "application/json");
-            Body::from(serde_json::to_vec(b).unwrap())
-        }
-        None => Body::empty(),
-    };
-    let resp = app.clone().oneshot(req.body(body).unwrap()).await.unwrap();
-    let status = resp.status();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    let value = serde_json::from_slice(&bytes)
-        .unwrap_or_else(|e| panic!("not JSON ({e}): {}", String::from_utf8_lossy(&bytes)));
-    (status, value)
-}
+mod common;
+use common::{app, paths, replaced, send};
 
 fn example<T: PartialSchema>() -> Value {
     serde_json::to_value(T::schema()).unwrap()["example"].clone()
@@ -338,43 +303,6 @@ async fn envelope_runs_as_a_job_with_progress() {
     );
     assert_eq!(job["result"]["points"].as_array().unwrap().len(), 40 * 200);
     assert_eq!(job["progress"], 1.0);
-}
-
-/// Every path of a JSON value (object keys, array indices).
-fn paths(v: &Value, prefix: Vec<String>, out: &mut Vec<Vec<String>>) {
-    match v {
-        Value::Object(m) => {
-            for (k, x) in m {
-                let mut p = prefix.clone();
-                p.push(k.clone());
-                out.push(p.clone());
-                paths(x, p, out);
-            }
-        }
-        Value::Array(a) => {
-            for (i, x) in a.iter().enumerate() {
-                let mut p = prefix.clone();
-                p.push(i.to_string());
-                out.push(p.clone());
-                paths(x, p, out);
-            }
-        }
-        _ => {}
-    }
-}
-
-fn replaced(v: &Value, path: &[String], new: Value) -> Value {
-    let mut out = v.clone();
-    let mut cur = &mut out;
-    for key in path {
-        cur = match cur {
-            Value::Object(m) => m.get_mut(key).unwrap(),
-            Value::Array(a) => &mut a[key.parse::<usize>().unwrap()],
-            _ => unreachable!(),
-        };
-    }
-    *cur = new;
-    out
 }
 
 #[tokio::test]

@@ -2,8 +2,6 @@
 //! requests with one field replaced by a random value, never give a 5xx
 //! and always give the one error body (or a real answer).
 
-use std::path::Path;
-use std::sync::Arc;
 use std::time::Duration;
 
 use axum::Router;
@@ -12,12 +10,20 @@ use axum::http::{Request, header};
 use http_body_util::BodyExt;
 use proptest::prelude::*;
 use serde_json::{Value, json};
-use tetherplan::api::{self, AppState};
 use tetherplan::config::Limits;
 use tetherplan::contract::dto::ErrorBody;
-use tetherplan::jobs::JobQueue;
-use tetherplan::jobs::store::JobStore;
 use tower::ServiceExt;
+
+mod common;
+use common::{paths, replace};
+
+fn app() -> Router {
+    let limits = Limits {
+        solve_timeout: Duration::from_secs(60),
+        ..Limits::default()
+    };
+    common::app_with(1, limits).0
+}
 
 const ROUTES: [&str; 5] = [
     "/api/v1/stability",
@@ -30,19 +36,6 @@ const ROUTES: [&str; 5] = [
 /// Transient routes: random JSON only (a mutated valid body can ask for a
 /// legitimately long run, which is the job queue's business, not a fuzz case).
 const TRANSIENT_ROUTES: [&str; 2] = ["/api/v1/simulate", "/api/v1/frequency-response"];
-
-fn app() -> Router {
-    let limits = Limits {
-        solve_timeout: Duration::from_secs(60),
-        ..Limits::default()
-    };
-    let queue = Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        1,
-        limits,
-    ));
-    api::router(AppState::new(queue), Path::new("static"))
-}
 
 fn valid(route: &str) -> Value {
     let mut v = json!({
@@ -106,41 +99,6 @@ fn json_value() -> impl Strategy<Value = Value> {
             .prop_map(|m| Value::Object(m.into_iter().collect())),
         ]
     })
-}
-
-/// Every path (object keys, array indices) of a JSON value.
-fn paths(v: &Value, prefix: Vec<String>, out: &mut Vec<Vec<String>>) {
-    match v {
-        Value::Object(m) => {
-            for (k, x) in m {
-                let mut p = prefix.clone();
-                p.push(k.clone());
-                out.push(p.clone());
-                paths(x, p, out);
-            }
-        }
-        Value::Array(a) => {
-            for (i, x) in a.iter().enumerate() {
-                let mut p = prefix.clone();
-                p.push(i.to_string());
-                out.push(p.clone());
-                paths(x, p, out);
-            }
-        }
-        _ => {}
-    }
-}
-
-fn replace(v: &mut Value, path: &[String], new: Value) {
-    let mut cur = v;
-    for key in path {
-        cur = match cur {
-            Value::Object(m) => m.get_mut(key).unwrap(),
-            Value::Array(a) => &mut a[key.parse::<usize>().unwrap()],
-            _ => unreachable!(),
-        };
-    }
-    *cur = new;
 }
 
 fn check(

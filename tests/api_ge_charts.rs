@@ -4,55 +4,16 @@
 //! synchronous and as jobs: answers equal the contract's, bad input is a
 //! 4xx naming the field.
 
-use std::path::Path;
-use std::sync::Arc;
-
-use axum::Router;
-use axum::body::Body;
-use axum::http::{Request, StatusCode, header};
-use http_body_util::BodyExt;
+use axum::http::StatusCode;
 use serde_json::{Value, json};
-use tetherplan::api::{self, AppState};
-use tetherplan::config::Limits;
-use tetherplan::contract::dto::ErrorBody;
 use tetherplan::contract::ge_charts::{self, GeBaseFrequencyResponseRequest, GeChartRequest};
 use tetherplan::contract::run::NoProgress;
-use tetherplan::jobs::store::{JobStatus, JobStore};
-use tetherplan::jobs::{JobQueue, try_execute_next};
+use tetherplan::jobs::store::JobStatus;
+use tetherplan::jobs::try_execute_next;
 use tetherplan::numerics::chart::Parallelism;
-use tower::ServiceExt;
 
-fn app() -> (Router, Arc<JobQueue>) {
-    let queue = Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        2,
-        Limits::default(),
-    ));
-    (
-        api::router(AppState::new(queue.clone()), Path::new("static")),
-        queue,
-    )
-}
-
-async fn post(app: &Router, uri: &str, body: &Value) -> (StatusCode, String) {
-    let req = Request::builder()
-        .method("POST")
-        .uri(uri)
-        .header(header::CONTENT_TYPE, "application/json")
-        .body(Body::from(serde_json::to_vec(body).unwrap()))
-        .unwrap();
-    let resp = app.clone().oneshot(req).await.unwrap();
-    let status = resp.status();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    (status, String::from_utf8_lossy(&bytes).into_owned())
-}
-
-async fn get(app: &Router, uri: &str) -> Value {
-    let req = Request::builder().uri(uri).body(Body::empty()).unwrap();
-    let resp = app.clone().oneshot(req).await.unwrap();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    serde_json::from_slice(&bytes).unwrap()
-}
+mod common;
+use common::{app, error, get, post_text as post};
 
 /// Table 7.1 cable and aerostat, fast rates so each point is short.
 fn ge_chart_body(count: usize) -> Value {
@@ -90,12 +51,6 @@ fn from_text<T: serde::de::DeserializeOwned>(body: &Value) -> T {
 /// An answer as the route writes it (serialised, parsed back).
 fn as_text_value(v: &impl serde::Serialize) -> Value {
     serde_json::from_str(&serde_json::to_string(v).unwrap()).unwrap()
-}
-
-fn error(text: &str) -> (String, Option<String>) {
-    let body: ErrorBody =
-        serde_json::from_str(text).unwrap_or_else(|e| panic!("not an error body ({e}): {text}"));
-    (body.error.code, body.error.field)
 }
 
 #[tokio::test]

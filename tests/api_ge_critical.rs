@@ -11,55 +11,13 @@
 //!   (E* = 1 at 75 m/s);
 //! * bad input is a 422 naming the field; the string bodies still answer.
 
-use std::path::Path;
-use std::sync::Arc;
-
-use axum::Router;
-use axum::body::Body;
-use axum::http::{Request, StatusCode, header};
-use http_body_util::BodyExt;
+use axum::http::StatusCode;
 use serde_json::{Value, json};
-use tetherplan::api::{self, AppState};
-use tetherplan::config::Limits;
-use tetherplan::jobs::store::{JobStatus, JobStore};
-use tetherplan::jobs::{JobQueue, try_execute_next};
-use tower::ServiceExt;
+use tetherplan::jobs::store::JobStatus;
+use tetherplan::jobs::try_execute_next;
 
-fn app() -> (Router, Arc<JobQueue>) {
-    let queue = Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        2,
-        Limits::default(),
-    ));
-    (
-        api::router(AppState::new(queue.clone()), Path::new("static")),
-        queue,
-    )
-}
-
-async fn post(app: &Router, uri: &str, body: &Value) -> (StatusCode, Value) {
-    let req = Request::builder()
-        .method("POST")
-        .uri(uri)
-        .header(header::CONTENT_TYPE, "application/json")
-        .body(Body::from(serde_json::to_vec(body).unwrap()))
-        .unwrap();
-    let resp = app.clone().oneshot(req).await.unwrap();
-    let status = resp.status();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    let text = String::from_utf8_lossy(&bytes).into_owned();
-    (
-        status,
-        serde_json::from_str(&text).unwrap_or_else(|_| panic!("not JSON: {text}")),
-    )
-}
-
-async fn get(app: &Router, uri: &str) -> Value {
-    let req = Request::builder().uri(uri).body(Body::empty()).unwrap();
-    let resp = app.clone().oneshot(req).await.unwrap();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    serde_json::from_slice(&bytes).unwrap()
-}
+mod common;
+use common::{app, get, post, with};
 
 fn system(stiffness_ratio: f64) -> Value {
     json!({
@@ -70,13 +28,6 @@ fn system(stiffness_ratio: f64) -> Value {
         "model": {"kind": "geometrically_exact", "elements": 20, "bending_stiffness_n_m2": 1000.0,
                   "stiffness_ratio": stiffness_ratio, "inertia_ratio": 1.0}
     })
-}
-
-fn with(mut base: Value, extra: Value) -> Value {
-    for (k, v) in extra.as_object().unwrap() {
-        base[k] = v.clone();
-    }
-    base
 }
 
 fn string_critical(rate: f64) -> Value {

@@ -8,40 +8,18 @@
 //!   rate, with a perturbation, with time-stepping numerics, or an
 //!   unknown method.
 
-use std::path::Path;
-use std::sync::Arc;
-
 use axum::Router;
-use axum::body::Body;
-use axum::http::{Request, StatusCode, header};
-use http_body_util::BodyExt;
+use axum::http::StatusCode;
 use serde_json::{Value, json};
-use tetherplan::api::{self, AppState};
-use tetherplan::config::Limits;
-use tetherplan::jobs::JobQueue;
-use tetherplan::jobs::store::JobStore;
-use tower::ServiceExt;
+
+mod common;
 
 fn app() -> Router {
-    let queue = Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        2,
-        Limits::default(),
-    ));
-    api::router(AppState::new(queue), Path::new("static"))
+    common::app().0
 }
 
 async fn post(app: &Router, body: &Value) -> (StatusCode, Value) {
-    let req = Request::builder()
-        .method("POST")
-        .uri("/api/v1/critical")
-        .header(header::CONTENT_TYPE, "application/json")
-        .body(Body::from(serde_json::to_vec(body).unwrap()))
-        .unwrap();
-    let resp = app.clone().oneshot(req).await.unwrap();
-    let status = resp.status();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    (status, serde_json::from_slice(&bytes).unwrap())
+    common::post(app, "/api/v1/critical", body).await
 }
 
 fn body(method: Option<&str>) -> Value {

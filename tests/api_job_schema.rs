@@ -3,20 +3,14 @@
 //! crate, JSON Schema 2020-12 as OpenAPI 3.1 uses), and so do lists,
 //! failures and cancellations. POST /jobs links to GET and DELETE /jobs/{id}.
 
-use std::path::Path;
-use std::sync::Arc;
-
-use axum::Router;
-use axum::body::Body;
-use axum::http::{Request, StatusCode, header};
-use http_body_util::BodyExt;
+use axum::http::StatusCode;
 use serde_json::{Value, json};
 use tetherplan::api::openapi::openapi;
-use tetherplan::api::{self, AppState};
-use tetherplan::config::Limits;
-use tetherplan::jobs::store::{JobStatus, JobStore};
-use tetherplan::jobs::{JobQueue, try_execute_next};
-use tower::ServiceExt;
+use tetherplan::jobs::store::JobStatus;
+use tetherplan::jobs::try_execute_next;
+
+mod common;
+use common::{app, send as call, with};
 
 fn string(elements: usize) -> Value {
     json!({
@@ -25,13 +19,6 @@ fn string(elements: usize) -> Value {
         "initial_length_m": 1.0,
         "model": {"kind": "linear_string", "elements": elements}
     })
-}
-
-fn with(mut base: Value, extra: Value) -> Value {
-    for (k, v) in extra.as_object().unwrap() {
-        base[k] = v.clone();
-    }
-    base
 }
 
 /// One small request of every kind and model.
@@ -132,33 +119,6 @@ fn assert_valid(v: &jsonschema::Validator, what: &str, instance: &Value) {
         errors.is_empty(),
         "{what} does not match the schema: {errors:#?}"
     );
-}
-
-fn app() -> (Router, Arc<JobQueue>) {
-    let queue = Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        2,
-        Limits::default(),
-    ));
-    (
-        api::router(AppState::new(queue.clone()), Path::new("static")),
-        queue,
-    )
-}
-
-async fn call(app: &Router, method: &str, uri: &str, body: Option<&Value>) -> (StatusCode, Value) {
-    let mut req = Request::builder().method(method).uri(uri);
-    let body = match body {
-        Some(b) => {
-            req = req.header(header::CONTENT_TYPE, "application/json");
-            Body::from(serde_json::to_vec(b).unwrap())
-        }
-        None => Body::empty(),
-    };
-    let resp = app.clone().oneshot(req.body(body).unwrap()).await.unwrap();
-    let status = resp.status();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    (status, serde_json::from_slice(&bytes).unwrap())
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

@@ -8,16 +8,20 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use axum::Router;
-use axum::body::Body;
-use axum::http::{Request, StatusCode, header};
-use http_body_util::BodyExt;
+use axum::http::{StatusCode, header};
 use serde_json::{Value, json};
 use tetherplan::api::auth::Tokens;
 use tetherplan::api::{self, AppState};
 use tetherplan::config::Limits;
 use tetherplan::jobs::store::{ClaimPolicy, InsertError, JobBackend, JobStatus, JobStore, NewJob};
 use tetherplan::jobs::{JobQueue, Submitter, try_execute_next};
-use tower::ServiceExt;
+
+mod common;
+use common::Answer;
+
+fn bearer(token: &str) -> String {
+    format!("Bearer {token}")
+}
 
 fn system(elements: usize) -> Value {
     json!({
@@ -41,38 +45,10 @@ fn critical_job(rate: f64) -> Value {
 }
 
 fn app_with(limits: Limits, tokens: &[&str]) -> (Router, Arc<JobQueue>) {
-    let queue = Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        2,
-        limits,
-    ));
+    let queue = common::queue_with(2, limits);
     let tokens: Vec<String> = tokens.iter().map(|t| t.to_string()).collect();
     let state = AppState::new(queue.clone()).with_tokens(&tokens);
     (api::router(state, Path::new("static")), queue)
-}
-
-struct Answer {
-    status: StatusCode,
-    headers: axum::http::HeaderMap,
-    text: String,
-}
-
-impl Answer {
-    fn json(&self) -> Value {
-        serde_json::from_str(&self.text).unwrap_or_else(|e| panic!("not JSON ({e}): {}", self.text))
-    }
-    fn code(&self) -> String {
-        self.json()["error"]["code"]
-            .as_str()
-            .unwrap_or("")
-            .to_string()
-    }
-    fn field(&self) -> String {
-        self.json()["error"]["field"]
-            .as_str()
-            .unwrap_or("")
-            .to_string()
-    }
 }
 
 async fn send(
@@ -82,30 +58,11 @@ async fn send(
     headers: &[(&str, &str)],
     body: Option<&Value>,
 ) -> Answer {
-    let mut req = Request::builder().method(method).uri(uri);
+    let (mut req, body) = common::json_request(method, uri, body);
     for (k, v) in headers {
         req = req.header(*k, *v);
     }
-    let body = match body {
-        Some(b) => {
-            req = req.header(header::CONTENT_TYPE, "application/json");
-            Body::from(serde_json::to_vec(b).unwrap())
-        }
-        None => Body::empty(),
-    };
-    let resp = app.clone().oneshot(req.body(body).unwrap()).await.unwrap();
-    let status = resp.status();
-    let headers = resp.headers().clone();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    Answer {
-        status,
-        headers,
-        text: String::from_utf8_lossy(&bytes).into_owned(),
-    }
-}
-
-fn bearer(token: &str) -> String {
-    format!("Bearer {token}")
+    common::request(app, req, body).await
 }
 
 // ---------------------------------------------------------------- bounded

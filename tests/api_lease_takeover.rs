@@ -3,8 +3,7 @@
 //! the job over once the lease has expired (not before), runs it once to
 //! the end, and its answer is the synchronous one.
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::net::{SocketAddr, TcpStream};
+use std::net::SocketAddr;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -15,6 +14,9 @@ use tetherplan::contract::dto::ChartRequest;
 use tetherplan::contract::run::{self, NoProgress};
 use tetherplan::numerics::chart::Parallelism;
 
+mod common;
+use common::http::{connect, exchange, spawn_listening};
+
 struct Server {
     child: Child,
     addr: SocketAddr,
@@ -22,30 +24,18 @@ struct Server {
 
 impl Server {
     fn start(dir: &Path) -> Self {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_tetherplan"))
-            .args(["serve", "--addr", "127.0.0.1:0"])
-            .arg("--db")
-            .arg(dir.join("jobs.db"))
-            .arg("--static-dir")
-            .arg(dir)
-            .env("RUST_LOG", "warn")
-            .env("TETHERPLAN_JOB_LEASE_S", "2")
-            .env("TETHERPLAN_JOB_THREADS", "1")
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .expect("the server starts");
-        let mut line = String::new();
-        BufReader::new(child.stdout.take().unwrap())
-            .read_line(&mut line)
-            .unwrap();
-        let addr = line
-            .trim()
-            .strip_prefix("tetherplan listening on http://")
-            .unwrap_or_else(|| panic!("unexpected first line {line:?}"))
-            .parse()
-            .unwrap();
+        let (child, addr) = spawn_listening(
+            Command::new(env!("CARGO_BIN_EXE_tetherplan"))
+                .args(["serve", "--addr", "127.0.0.1:0"])
+                .arg("--db")
+                .arg(dir.join("jobs.db"))
+                .arg("--static-dir")
+                .arg(dir)
+                .env("RUST_LOG", "warn")
+                .env("TETHERPLAN_JOB_LEASE_S", "2")
+                .env("TETHERPLAN_JOB_THREADS", "1")
+                .stderr(Stdio::inherit()),
+        );
         Self { child, addr }
     }
 
@@ -53,28 +43,19 @@ impl Server {
         let body = body
             .map(|b| serde_json::to_vec(b).unwrap())
             .unwrap_or_default();
-        let mut s = TcpStream::connect(self.addr).unwrap();
-        s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
-        let head = format!(
-            "{method} {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n",
-            self.addr,
-            body.len()
+        let s = connect(self.addr, Duration::from_secs(60));
+        let r = exchange(
+            s,
+            method,
+            path,
+            &self.addr.to_string(),
+            Some("application/json"),
+            &body,
         );
-        s.write_all(head.as_bytes()).unwrap();
-        s.write_all(&body).unwrap();
-        let mut raw = Vec::new();
-        s.read_to_end(&mut raw).unwrap();
-        let split = raw.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
-        let head = String::from_utf8_lossy(&raw[..split]).to_string();
-        let status = head.split(' ').nth(1).unwrap().parse().unwrap();
-        let mut body = raw[split + 4..].to_vec();
-        if head
-            .to_ascii_lowercase()
-            .contains("transfer-encoding: chunked")
-        {
-            body = dechunk(&body);
-        }
-        (status, serde_json::from_slice(&body).unwrap_or(Value::Null))
+        (
+            r.status,
+            serde_json::from_str(&r.body).unwrap_or(Value::Null),
+        )
     }
 }
 
@@ -82,20 +63,6 @@ impl Drop for Server {
     fn drop(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
-    }
-}
-
-fn dechunk(mut b: &[u8]) -> Vec<u8> {
-    let mut out = vec![];
-    loop {
-        let eol = b.windows(2).position(|w| w == b"\r\n").unwrap();
-        let size =
-            usize::from_str_radix(std::str::from_utf8(&b[..eol]).unwrap().trim(), 16).unwrap();
-        if size == 0 {
-            return out;
-        }
-        out.extend_from_slice(&b[eol + 2..eol + 2 + size]);
-        b = &b[eol + 4 + size..];
     }
 }
 

@@ -4,68 +4,27 @@
 //! same plan.
 
 use std::io::Write;
-use std::path::Path;
 use std::process::{Command, Stdio};
 use std::sync::Arc;
 
-use axum::body::Body;
-use axum::http::{Request, StatusCode, header};
-use http_body_util::BodyExt;
+use axum::http::StatusCode;
 use serde_json::{Value, json};
-use tetherplan::api::{self, AppState};
 use tetherplan::config::Limits;
 use tetherplan::jobs::JobQueue;
-use tetherplan::jobs::store::JobStore;
-use tower::ServiceExt;
+
+mod common;
+use common::send;
 
 fn app() -> axum::Router {
     app_and_queue().0
 }
 
 fn app_and_queue() -> (axum::Router, Arc<JobQueue>) {
-    let queue = Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        1,
-        Limits::default(),
-    ));
-    (
-        api::router(AppState::new(queue.clone()), Path::new("static")),
-        queue,
-    )
-}
-
-async fn send(
-    app: &axum::Router,
-    method: &str,
-    uri: &str,
-    body: Option<&Value>,
-) -> (StatusCode, Value) {
-    let req = Request::builder()
-        .method(method)
-        .uri(uri)
-        .header(header::CONTENT_TYPE, "application/json")
-        .body(match body {
-            Some(b) => Body::from(serde_json::to_vec(b).unwrap()),
-            None => Body::empty(),
-        })
-        .unwrap();
-    let resp = app.clone().oneshot(req).await.unwrap();
-    let status = resp.status();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    (status, serde_json::from_slice(&bytes).unwrap())
+    common::app_with(1, Limits::default())
 }
 
 async fn post(body: &Value) -> (StatusCode, Value) {
-    let req = Request::builder()
-        .method("POST")
-        .uri("/api/v1/plan")
-        .header(header::CONTENT_TYPE, "application/json")
-        .body(Body::from(serde_json::to_vec(body).unwrap()))
-        .unwrap();
-    let resp = app().oneshot(req).await.unwrap();
-    let status = resp.status();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    (status, serde_json::from_slice(&bytes).unwrap())
+    common::post(&app(), "/api/v1/plan", body).await
 }
 
 /// The request example of the OpenAPI document.

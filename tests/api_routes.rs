@@ -1,16 +1,14 @@
 //! Route tests: the router driven with `tower::ServiceExt::oneshot`, an
 //! in-memory job store, and the worker step function to drain the queue.
 
-use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use axum::Router;
 use axum::body::Body;
 use axum::http::{Request, StatusCode, header};
-use http_body_util::BodyExt;
 use serde_json::{Value, json};
-use tetherplan::api::{self, AppState};
+use tetherplan::api::{self};
 use tetherplan::config::Limits;
 use tetherplan::contract::dto::*;
 use tetherplan::contract::run::{self, NoProgress};
@@ -18,7 +16,9 @@ use tetherplan::contract::{self};
 use tetherplan::jobs::store::{JobBackend, JobStatus, JobStore};
 use tetherplan::jobs::{JobQueue, try_execute_next};
 use tetherplan::numerics::chart::Parallelism;
-use tower::ServiceExt;
+
+mod common;
+use common::{Answer, with};
 
 /// Thesis Table A1: steel cable, F = 1000 N, m = 10 kg, L0 = 1 m.
 fn system(elements: usize) -> Value {
@@ -29,13 +29,6 @@ fn system(elements: usize) -> Value {
         "gravity_m_s2": 9.81,
         "model": {"kind": "linear_string", "elements": elements}
     })
-}
-
-fn with(mut base: Value, extra: Value) -> Value {
-    for (k, v) in extra.as_object().unwrap() {
-        base[k] = v.clone();
-    }
-    base
 }
 
 fn critical_body() -> Value {
@@ -52,50 +45,12 @@ fn chart_body(count: usize, elements: usize) -> Value {
     )
 }
 
-fn queue_with(limits: Limits) -> Arc<JobQueue> {
-    Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        2,
-        limits,
-    ))
-}
-
 fn app_with(limits: Limits) -> (Router, Arc<JobQueue>) {
-    let queue = queue_with(limits);
-    (
-        api::router(AppState::new(queue.clone()), Path::new("static")),
-        queue,
-    )
+    common::app_with(2, limits)
 }
 
 fn app() -> (Router, Arc<JobQueue>) {
     app_with(Limits::default())
-}
-
-struct Answer {
-    status: StatusCode,
-    headers: axum::http::HeaderMap,
-    text: String,
-}
-
-impl Answer {
-    fn json(&self) -> Value {
-        serde_json::from_str(&self.text).unwrap_or_else(|e| panic!("not JSON ({e}): {}", self.text))
-    }
-
-    /// The error body; asserts its shape.
-    fn error(&self) -> ErrorDetail {
-        assert_eq!(
-            self.headers[header::CONTENT_TYPE],
-            "application/json",
-            "{}",
-            self.text
-        );
-        let body: ErrorBody = serde_json::from_str(&self.text)
-            .unwrap_or_else(|e| panic!("not an error body ({e}): {}", self.text));
-        assert!(!body.error.message.is_empty());
-        body.error
-    }
 }
 
 async fn send(
@@ -109,19 +64,7 @@ async fn send(
     if let Some(ct) = content_type {
         req = req.header(header::CONTENT_TYPE, ct);
     }
-    let resp = app
-        .clone()
-        .oneshot(req.body(Body::from(body)).unwrap())
-        .await
-        .unwrap();
-    let status = resp.status();
-    let headers = resp.headers().clone();
-    let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-    Answer {
-        status,
-        headers,
-        text: String::from_utf8_lossy(&bytes).into_owned(),
-    }
+    common::request(app, req, Body::from(body)).await
 }
 
 async fn post(app: &Router, uri: &str, body: &Value) -> Answer {

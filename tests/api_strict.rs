@@ -15,40 +15,29 @@
 //! ranges (log-uniform where the range spans decades).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::path::Path;
-use std::sync::Arc;
 use std::time::Duration;
 
 use axum::Router;
-use axum::body::Body;
-use axum::http::{Request, header};
-use http_body_util::BodyExt;
 use proptest::prelude::*;
 use serde_json::{Value, json};
-use tetherplan::api::{self, AppState};
 use tetherplan::config::Limits;
 use tetherplan::contract::RequestError;
 use tetherplan::contract::dto::*;
 use tetherplan::contract::ge_charts::{AnyChartResponse, AnyFrequencyResponseResponse};
 use tetherplan::contract::run::NoProgress;
 use tetherplan::contract::simulate::AnySimulateResponse;
-use tetherplan::jobs::JobQueue;
 use tetherplan::jobs::kinds::JobSubmission;
-use tetherplan::jobs::store::JobStore;
 use tetherplan::numerics::params::{Range, ranges::*};
-use tower::ServiceExt;
+
+mod common;
+use common::with;
 
 fn app() -> Router {
     let limits = Limits {
         solve_timeout: Duration::from_secs(120),
         ..Limits::default()
     };
-    let queue = Arc::new(JobQueue::new(
-        JobStore::open_in_memory().unwrap(),
-        1,
-        limits,
-    ));
-    api::router(AppState::new(queue), Path::new("static"))
+    common::app_with(1, limits).0
 }
 
 fn post(app: &Router, route: &str, body: &Value) -> (u16, String) {
@@ -56,16 +45,8 @@ fn post(app: &Router, route: &str, body: &Value) -> (u16, String) {
         .enable_all()
         .build()
         .unwrap();
-    rt.block_on(async {
-        let req = Request::post(route)
-            .header(header::CONTENT_TYPE, "application/json")
-            .body(Body::from(serde_json::to_vec(body).unwrap()))
-            .unwrap();
-        let resp = app.clone().oneshot(req).await.unwrap();
-        let status = resp.status().as_u16();
-        let bytes = resp.into_body().collect().await.unwrap().to_bytes();
-        (status, String::from_utf8_lossy(&bytes).into_owned())
-    })
+    let (status, text) = rt.block_on(common::post_text(app, route, body));
+    (status.as_u16(), text)
 }
 
 /// A small deterministic generator (xorshift64*) driven by proptest's seed.
@@ -171,13 +152,6 @@ fn profile(g: &mut Gen) -> Value {
         }
     }
     p
-}
-
-fn with(mut base: Value, extra: Value) -> Value {
-    for (k, v) in extra.as_object().unwrap() {
-        base[k] = v.clone();
-    }
-    base
 }
 
 fn aero_body(g: &mut Gen) -> Value {

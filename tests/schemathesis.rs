@@ -8,10 +8,12 @@
 //! executable). Without it the test prints `skipped`, unless `CI` is set.
 //! Bounded: a few examples per operation, one worker, killed after 4 min.
 
-use std::io::{BufRead, BufReader};
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+
+mod common;
+use common::http::spawn_listening;
 
 fn schemathesis() -> Option<PathBuf> {
     if let Ok(p) = std::env::var("TETHERPLAN_SCHEMATHESIS") {
@@ -37,27 +39,17 @@ fn schemathesis_finds_no_server_error_and_no_schema_violation() {
     let dir = std::env::temp_dir().join(format!("tetherplan-st-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let mut server = Command::new(env!("CARGO_BIN_EXE_tetherplan"))
-        .args(["serve", "--addr", "127.0.0.1:0", "--db"])
-        .arg(dir.join("jobs.db"))
-        .current_dir(&dir)
-        .env("RUST_LOG", "error")
-        .env("TETHERPLAN_SOLVE_TIMEOUT_S", "10")
-        .env_remove("TETHERPLAN_API_TOKENS")
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(server.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let base = line
-        .trim()
-        .strip_prefix("tetherplan listening on ")
-        .unwrap_or_else(|| panic!("unexpected first line {line:?}"))
-        .to_string();
+    let (mut server, addr) = spawn_listening(
+        Command::new(env!("CARGO_BIN_EXE_tetherplan"))
+            .args(["serve", "--addr", "127.0.0.1:0", "--db"])
+            .arg(dir.join("jobs.db"))
+            .current_dir(&dir)
+            .env("RUST_LOG", "error")
+            .env("TETHERPLAN_SOLVE_TIMEOUT_S", "10")
+            .env_remove("TETHERPLAN_API_TOKENS")
+            .stderr(Stdio::inherit()),
+    );
+    let base = format!("http://{addr}");
     let start = Instant::now();
     let mut run = Command::new(&st)
         .arg("run")
