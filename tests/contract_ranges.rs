@@ -171,6 +171,93 @@ fn frequency_response(patch: Value) -> Value {
     )
 }
 
+fn equilibrium(patch: Value) -> Value {
+    merge(
+        json!({
+            "cable": {"diameter_m": 0.006, "mass_per_length_kg_m": 0.025,
+                      "normal_drag_coefficient_nondim": 1.2, "axial_stiffness_n": 850000.0,
+                      "breaking_strength_n": 30000.0},
+            "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
+                         "lift_coefficient_nondim": 0.0, "reference_area_m2": 20.0,
+                         "radius_m": 2.0, "volume_m3": 30.0},
+            "tether_length_m": 1000.0,
+            "gravity_m_s2": 9.81,
+            "required_safety_factor_nondim": 5.0,
+            "payout_rate_m_s": 1.0,
+            "integration_steps": 100,
+            "shape_samples": 51,
+            "wind": {"air_density_kg_m3": 1.225, "flow": {"kind": "uniform", "speed_m_s": 8.0}}
+        }),
+        patch,
+    )
+}
+
+/// [`equilibrium`] in the wind `flow` (replacing the uniform one).
+fn equilibrium_in(flow: Value) -> Value {
+    let mut e = equilibrium(json!({}));
+    e["wind"]["flow"] = flow;
+    e
+}
+
+fn envelope(patch: Value) -> Value {
+    merge(
+        json!({
+            "cable": {"diameter_m": 0.006, "mass_per_length_kg_m": 0.025},
+            "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
+                         "reference_area_m2": 20.0},
+            "wind": {"air_density_kg_m3": 1.225,
+                     "shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0}},
+            "wind_speeds_m_s": {"min": 0.0, "max": 30.0, "count": 3},
+            "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 3},
+            "required_safety_factor_nondim": 5.0,
+            "ceiling_m": 2500.0,
+            "gravity_m_s2": 9.81,
+            "payout_rate_m_s": 5.0,
+            "integration_steps": 100
+        }),
+        patch,
+    )
+}
+
+fn plan(patch: Value) -> Value {
+    merge(
+        json!({
+            "cable": {"mass_per_length_kg_m": 0.078},
+            "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+            "initial_length_m": 1.0,
+            "gravity_m_s2": 9.81,
+            "target_elevation_m": 1200.0,
+            "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0, "max_jerk_m_s3": 1.0},
+            "lift_reserve_nondim": 0.05,
+            "tether": {"breaking_strength_n": 20000.0, "safety_factor_nondim": 5.0},
+            "samples": 50,
+            "disturbance_tip_deflection_m": 1.0,
+            "max_amplification_nondim": 10.0,
+            "haul_down": {"forecast": [{"time_s": 0.0, "wind_speed_m_s": 5.0},
+                                       {"time_s": 3600.0, "wind_speed_m_s": 15.0}],
+                          "max_operating_wind_m_s": 12.0}
+        }),
+        patch,
+    )
+}
+
+fn bands_request(patch: Value) -> Value {
+    merge(
+        json!({
+            "cable": {"mass_per_length_kg_m": 0.078},
+            "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+            "initial_length_m": 1.0,
+            "gravity_m_s2": 9.81,
+            "rates_m_s": {"min": 5.0, "max": 30.0, "count": 4},
+            "target_elevation_m": 1200.0,
+            "uncertainty": {"samples": 10, "seed": 7, "inputs": [
+                {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 50.0}
+            ]}
+        }),
+        patch,
+    )
+}
+
 fn profile(p: Value) -> Value {
     string_with(json!({ "profile": p }))
 }
@@ -234,6 +321,23 @@ fn cases() -> Vec<Case> {
         }
         ge_chart(json!({ "wind": wind }))
     };
+    // The tether kinds and the plan state most of their bounds as literals.
+    let lit = |kind: &'static str, request: &Value, path: &'static str, min: f64, max: f64| {
+        case(kind, request.clone(), path, Range::new(min, max, ""))
+    };
+    let eq = equilibrium(json!({}));
+    let eq_power = equilibrium_in(json!({"kind": "power_law", "coefficient_m_s": 3.0,
+                                          "exponent_nondim": 0.14}));
+    let eq_table = equilibrium_in(json!({"kind": "tabulated", "points": [
+        {"elevation_m": 0.0, "speed_m_s": 2.0}, {"elevation_m": 1000.0, "speed_m_s": 10.0}]}));
+    let eq_log = equilibrium_in(json!({"kind": "log_law", "reference_speed_m_s": 8.0,
+                                        "reference_height_m": 10.0, "roughness_length_m": 0.03}));
+    let env = envelope(json!({}));
+    let mut env_log = env.clone();
+    env_log["wind"]["shape"] =
+        json!({"kind": "log_law", "roughness_length_m": 0.03, "reference_height_m": 10.0});
+    let pl = plan(json!({}));
+    let bands = bands_request(json!({}));
     vec![
         // system of the linear string
         case(
@@ -349,6 +453,218 @@ fn cases() -> Vec<Case> {
             "target_elevation_m",
             LENGTH_M,
         ),
+        // equilibrium (the tether's own bounds, `contract::equilibrium`)
+        exclusive(lit("equilibrium", &eq, "cable.diameter_m", 0.0, 1.0)),
+        exclusive(lit(
+            "equilibrium",
+            &eq,
+            "cable.mass_per_length_kg_m",
+            0.0,
+            1000.0,
+        )),
+        lit(
+            "equilibrium",
+            &eq,
+            "cable.normal_drag_coefficient_nondim",
+            0.0,
+            10.0,
+        ),
+        exclusive(lit(
+            "equilibrium",
+            &eq,
+            "cable.axial_stiffness_n",
+            0.0,
+            1e12,
+        )),
+        exclusive(lit(
+            "equilibrium",
+            &eq,
+            "cable.breaking_strength_n",
+            0.0,
+            1e9,
+        )),
+        exclusive(lit("equilibrium", &eq, "aerostat.radius_m", 0.0, 100.0)),
+        exclusive(lit("equilibrium", &eq, "aerostat.volume_m3", 0.0, 1e7)),
+        lit("equilibrium", &eq, "aerostat.mass_kg", 0.0, 1e7),
+        exclusive(lit("equilibrium", &eq, "aerostat.net_buoyancy_n", 0.0, 1e8)),
+        lit(
+            "equilibrium",
+            &eq,
+            "aerostat.drag_coefficient_nondim",
+            0.0,
+            10.0,
+        ),
+        lit(
+            "equilibrium",
+            &eq,
+            "aerostat.lift_coefficient_nondim",
+            -10.0,
+            10.0,
+        ),
+        exclusive(lit(
+            "equilibrium",
+            &eq,
+            "aerostat.reference_area_m2",
+            0.0,
+            1e5,
+        )),
+        exclusive(lit("equilibrium", &eq, "tether_length_m", 0.0, 1e5)),
+        exclusive(lit("equilibrium", &eq, "gravity_m_s2", 0.0, 100.0)),
+        lit(
+            "equilibrium",
+            &eq,
+            "required_safety_factor_nondim",
+            1.0,
+            100.0,
+        ),
+        lit("equilibrium", &eq, "payout_rate_m_s", 0.0, 1000.0),
+        lit("equilibrium", &eq, "integration_steps", 8.0, 100_000.0),
+        lit("equilibrium", &eq, "shape_samples", 2.0, 10_001.0),
+        exclusive(lit("equilibrium", &eq, "wind.air_density_kg_m3", 0.0, 5.0)),
+        lit("equilibrium", &eq, "wind.flow.speed_m_s", -150.0, 150.0),
+        lit(
+            "equilibrium",
+            &eq_power,
+            "wind.flow.coefficient_m_s",
+            -150.0,
+            150.0,
+        ),
+        lit(
+            "equilibrium",
+            &eq_power,
+            "wind.flow.exponent_nondim",
+            0.0,
+            2.0,
+        ),
+        lit(
+            "equilibrium",
+            &eq_table,
+            "wind.flow.points[0].elevation_m",
+            0.0,
+            1e5,
+        ),
+        lit(
+            "equilibrium",
+            &eq_table,
+            "wind.flow.points[1].speed_m_s",
+            -150.0,
+            150.0,
+        ),
+        lit(
+            "equilibrium",
+            &eq_log,
+            "wind.flow.reference_speed_m_s",
+            -150.0,
+            150.0,
+        ),
+        exclusive(lit(
+            "equilibrium",
+            &eq_log,
+            "wind.flow.reference_height_m",
+            0.0,
+            1e4,
+        )),
+        exclusive(lit(
+            "equilibrium",
+            &eq_log,
+            "wind.flow.roughness_length_m",
+            0.0,
+            10.0,
+        )),
+        // envelope (the tether's bounds, and the grids and limits)
+        lit("envelope", &env, "wind_speeds_m_s.min", 0.0, 150.0),
+        lit("envelope", &env, "wind_speeds_m_s.max", 0.0, 150.0),
+        lit("envelope", &env, "wind_speeds_m_s.count", 1.0, 1000.0),
+        exclusive(lit("envelope", &env, "tether_lengths_m.min", 0.0, 1e5)),
+        exclusive(lit("envelope", &env, "tether_lengths_m.max", 0.0, 1e5)),
+        lit("envelope", &env, "tether_lengths_m.count", 1.0, 1000.0),
+        exclusive(lit("envelope", &env, "cable.diameter_m", 0.0, 1.0)),
+        exclusive(lit("envelope", &env, "aerostat.net_buoyancy_n", 0.0, 1e8)),
+        exclusive(lit("envelope", &env, "wind.air_density_kg_m3", 0.0, 5.0)),
+        lit("envelope", &env, "wind.shape.exponent_nondim", 0.0, 2.0),
+        exclusive(lit(
+            "envelope",
+            &env,
+            "wind.shape.reference_height_m",
+            0.0,
+            1e4,
+        )),
+        exclusive(lit(
+            "envelope",
+            &env_log,
+            "wind.shape.roughness_length_m",
+            0.0,
+            10.0,
+        )),
+        exclusive(lit("envelope", &env, "gravity_m_s2", 0.0, 100.0)),
+        lit(
+            "envelope",
+            &env,
+            "required_safety_factor_nondim",
+            1.0,
+            100.0,
+        ),
+        exclusive(lit("envelope", &env, "ceiling_m", 0.0, 1e5)),
+        lit("envelope", &env, "payout_rate_m_s", 0.0, 1000.0),
+        lit("envelope", &env, "integration_steps", 8.0, 100_000.0),
+        // plan (the system's ranges, the plan's own bounds)
+        case(
+            "plan",
+            pl.clone(),
+            "cable.mass_per_length_kg_m",
+            MASS_PER_LENGTH_KG_M,
+        ),
+        case(
+            "plan",
+            pl.clone(),
+            "aerostat.net_buoyancy_n",
+            NET_BUOYANCY_N,
+        ),
+        case("plan", pl.clone(), "aerostat.mass_kg", AEROSTAT_MASS_KG),
+        case("plan", pl.clone(), "initial_length_m", INITIAL_LENGTH_M),
+        case("plan", pl.clone(), "gravity_m_s2", GRAVITY_M_S2),
+        lit("plan", &pl, "lift_reserve_nondim", 0.0, 0.9),
+        lit("plan", &pl, "tether.safety_factor_nondim", 1.0, 100.0),
+        exclusive(lit("plan", &pl, "tether.breaking_strength_n", 0.0, 1e9)),
+        exclusive(lit("plan", &pl, "winch.max_rate_m_s", 0.0, 1000.0)),
+        exclusive(lit("plan", &pl, "winch.max_acceleration_m_s2", 0.0, 100.0)),
+        exclusive(lit("plan", &pl, "winch.max_jerk_m_s3", 0.0, 1e4)),
+        lit("plan", &pl, "samples", 2.0, 10_000.0),
+        exclusive(lit("plan", &pl, "disturbance_tip_deflection_m", 0.0, 1e3)),
+        exclusive(lit("plan", &pl, "max_amplification_nondim", 0.0, 1e6)),
+        lit("plan", &pl, "haul_down.forecast[1].time_s", 0.0, 1e9),
+        lit(
+            "plan",
+            &pl,
+            "haul_down.forecast[0].wind_speed_m_s",
+            0.0,
+            200.0,
+        ),
+        exclusive(lit(
+            "plan",
+            &pl,
+            "haul_down.max_operating_wind_m_s",
+            0.0,
+            200.0,
+        )),
+        // bands (the system's ranges, the ensemble and the grid)
+        case(
+            "bands",
+            bands.clone(),
+            "cable.mass_per_length_kg_m",
+            MASS_PER_LENGTH_KG_M,
+        ),
+        case(
+            "bands",
+            bands.clone(),
+            "aerostat.net_buoyancy_n",
+            NET_BUOYANCY_N,
+        ),
+        case("bands", bands.clone(), "aerostat.mass_kg", AEROSTAT_MASS_KG),
+        case("bands", bands.clone(), "initial_length_m", INITIAL_LENGTH_M),
+        case("bands", bands.clone(), "gravity_m_s2", GRAVITY_M_S2),
+        lit("bands", &bands, "uncertainty.samples", 1.0, 100_000.0),
+        lit("bands", &bands, "rates_m_s.count", 1.0, 1000.0),
         // chart
         case(
             "chart",
@@ -1003,6 +1319,17 @@ fn set(v: &mut Value, path: &str, x: f64) {
     *node = json!(x);
 }
 
+fn set_integer(v: &mut Value, path: &str, x: i64) {
+    let mut node = v;
+    for s in steps(path) {
+        node = match s {
+            Step::Key(k) => &mut node[k.as_str()],
+            Step::Index(i) => &mut node[i],
+        };
+    }
+    *node = json!(x);
+}
+
 // ------------------------------------------------------------- schema walk
 
 struct Doc(Value);
@@ -1259,6 +1586,37 @@ async fn submit(app: &Router, kind: &str, request: &Value) -> (StatusCode, Value
     )
 }
 
+/// Whether `message` states the range of `c` on the side of the refused
+/// value: `must be between <min> and <max>` (the ranges of
+/// `numerics::params`), or `must be at least|above <min> and at most <max>`
+/// (the tether kinds), or on the high side `… at most <max>` and, for a
+/// minimum of zero excluded, `must be greater than zero` on the low side;
+/// bounds written compactly or in full.
+fn states_bound(message: &str, c: &Case, low: bool) -> bool {
+    let forms = |x: f64| [compact(x), x.to_string()];
+    // `pat` followed by the end or a character that cannot continue a number.
+    let has = |pat: &str| {
+        message.match_indices(pat).any(|(i, _)| {
+            !message[i + pat.len()..]
+                .starts_with(|ch: char| ch.is_ascii_digit() || ch == '.' || ch == 'e')
+        })
+    };
+    let (min, max) = (forms(c.range.min), forms(c.range.max));
+    if min.iter().any(|a| {
+        max.iter()
+            .any(|b| has(&format!("must be between {a} and {b}")))
+    }) {
+        return true;
+    }
+    if low {
+        min.iter()
+            .any(|a| has(&format!("must be at least {a}")) || has(&format!("must be above {a}")))
+            || (c.exclusive_min && c.range.min == 0.0 && has("must be greater than zero"))
+    } else {
+        max.iter().any(|b| has(&format!("at most {b}")))
+    }
+}
+
 /// Just outside a bound: a relative step of 1e-6, or 1e-12 at zero.
 fn outside(bound: f64, up: bool) -> f64 {
     let step = (bound.abs() * 1e-6).max(1e-12);
@@ -1287,19 +1645,33 @@ async fn values_just_outside_a_range_are_refused_and_its_bounds_accepted() {
             compact(c.range.min),
             compact(c.range.max)
         );
+        // Counts step by one and stay integers.
+        let integer = get(&c.request, c.path).is_u64();
+        let step = |bound: f64, up: bool| {
+            if integer {
+                bound + if up { 1.0 } else { -1.0 }
+            } else {
+                outside(bound, up)
+            }
+        };
         for (value, refused) in [
-            (outside(c.range.min, false), true),
-            (outside(c.range.max, true), true),
+            (step(c.range.min, false), true),
+            (step(c.range.max, true), true),
             (c.range.min, false),
             (c.range.max, false),
         ] {
             let mut r = c.request.clone();
-            set(&mut r, c.path, value);
+            if integer {
+                set_integer(&mut r, c.path, value as i64);
+            } else {
+                set(&mut r, c.path, value);
+            }
             let (status, v) = submit(&app, c.kind, &r).await;
             let named = v["error"]["field"] == field.as_str();
+            let low = value <= c.range.min;
             let ranged = v["error"]["message"]
                 .as_str()
-                .is_some_and(|m| m.contains(&text));
+                .is_some_and(|m| states_bound(m, &c, low));
             if refused && !(status == StatusCode::UNPROCESSABLE_ENTITY && named && ranged) {
                 failures.push(format!(
                     "{} {} = {value:e}: expected 422 naming {field} and `{text}`, got {status} {v}",

@@ -125,11 +125,11 @@ pub struct PlanRequest {
     pub aerostat: AerostatInput,
     /// Cable length now (m): where the plan starts.
     #[serde(default = "default_initial_length")]
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 0.001, maximum = 10000.0)]
     pub initial_length_m: f64,
     /// Gravitational acceleration (m/s²).
     #[serde(default = "default_gravity")]
-    #[schema(example = 9.81, exclusive_minimum = 0.0)]
+    #[schema(example = 9.81, minimum = 0.01, maximum = 100.0)]
     pub gravity_m_s2: f64,
     /// Discretisation of the transient check (the plan itself uses the
     /// converged continuum criterion).
