@@ -79,7 +79,7 @@ fn row(db: &Path, id: i64) -> (String, u32, Option<String>) {
 }
 
 fn pid_of(worker: &str) -> u32 {
-    worker.rsplitn(3, '/').nth(1).unwrap().parse().unwrap()
+    worker.rsplit('/').nth(1).unwrap().parse().unwrap()
 }
 
 #[test]

@@ -243,7 +243,7 @@ fn dechunk(mut b: &[u8]) -> Vec<u8> {
 }
 
 fn pid_of(worker: &str) -> u32 {
-    worker.rsplitn(3, '/').nth(1).unwrap().parse().unwrap()
+    worker.rsplit('/').nth(1).unwrap().parse().unwrap()
 }
 
 /// A chunk row: index, status, attempts, lease owner, finished by.

@@ -6,9 +6,10 @@
 //! **Plan.** At a fixed schedule every quantity is linear in the uncertain
 //! inputs: the effective roller tension with the sample's full buoyancy at
 //! instant k is `F − m a_k − ρA (g + a_k) L_k − ρA v_k²`. With F ~ N(μ, σ)
-//! alone, "unstable somewhere" is `F < c = max_k (m a_k + ρA (g + a_k) L_k
-//! + ρA v_k²)`, so `P = Φ((c − μ)/σ)`; "over the rating" (largest tension
-//! `F − m a_k` above `B/sf`) is `F > min_k (B/sf + m a_k)`, a normal tail.
+//! alone, "unstable somewhere" is
+//! `F < c = max_k (m a_k + ρA (g + a_k) L_k + ρA v_k²)`, so
+//! `P = Φ((c − μ)/σ)`; "over the rating" (largest tension `F − m a_k` above
+//! `B/sf`) is `F > min_k (B/sf + m a_k)`, a normal tail.
 //! With F and ρA both normal the event is a min over instants of
 //! correlated normals: the test's own Monte Carlo evaluates it.
 //!

@@ -161,11 +161,11 @@ fn stiff_cables_share_one_chart() {
         vec![100.0, 1e3, 1e5],
     ));
     let t = |s: usize, r: usize| series[s].points[r].critical_time_s.unwrap();
-    for s in 0..2 {
+    for (s, one) in series.iter().enumerate().take(2) {
         for r in 0..3 {
             println!(
                 "E* = {}: t* = {:.3} s against {:.3} s at E* = 1e5",
-                series[s].stiffness_ratio,
+                one.stiffness_ratio,
                 t(s, r),
                 t(2, r)
             );

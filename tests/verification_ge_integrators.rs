@@ -94,12 +94,9 @@ fn closed_form(scheme: Scheme, big_omega: f64) -> [[f64; 3]; 3] {
     let (am, af, b, g) = coefficients(scheme);
     let o2 = big_omega * big_omega;
     let mut a = [[0.0; 3]; 3];
-    for j in 0..3 {
-        let (x0, y0, z0) = (
-            (j == 0) as u8 as f64,
-            (j == 1) as u8 as f64,
-            (j == 2) as u8 as f64,
-        );
+    // Column j: the step from the j-th unit state.
+    let units = [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)];
+    for (j, (x0, y0, z0)) in units.into_iter().enumerate() {
         let d = x0 + big_omega * y0 + o2 * (0.5 - b) * z0;
         let z1 = -(am * z0 + (1.0 - af) * d + af * x0) / ((1.0 - am) + (1.0 - af) * b * o2);
         let x1 = d + b * o2 * z1;

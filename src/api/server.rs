@@ -69,6 +69,15 @@ impl Default for ConnectionLimits {
     }
 }
 
+/// An `rlim_t` as `u64`.
+// The cast is a no-op where `rlim_t` is `u64` (64-bit Linux, macOS), which
+// is what clippy sees; on 32-bit Linux `rlim_t` is `u32` and it is needed.
+#[cfg(unix)]
+#[allow(clippy::unnecessary_cast)]
+fn rlim_u64(v: libc::rlim_t) -> u64 {
+    v as u64
+}
+
 /// Raises the soft `RLIMIT_NOFILE` to the hard limit; returns the soft limit
 /// in force afterwards (`None` when it cannot be read).
 pub fn raise_fd_limit() -> Option<u64> {
@@ -93,7 +102,7 @@ pub fn raise_fd_limit() -> Option<u64> {
                 }
             }
         }
-        Some(lim.rlim_cur as u64)
+        Some(rlim_u64(lim.rlim_cur))
     }
     #[cfg(not(unix))]
     {
@@ -279,7 +288,7 @@ mod tests {
         };
         // SAFETY: reads into the struct.
         assert_eq!(unsafe { libc::getrlimit(libc::RLIMIT_NOFILE, &mut lim) }, 0);
-        assert_eq!(soft, lim.rlim_cur as u64);
+        assert_eq!(soft, super::rlim_u64(lim.rlim_cur));
         assert_eq!(lim.rlim_cur, lim.rlim_max);
     }
 }

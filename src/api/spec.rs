@@ -241,10 +241,9 @@ fn refine_value(v: &mut Value) {
                 path.replace('/', "~1")
             ))
             .and_then(Value::as_object_mut)
+            && let Some(schema) = media.remove("schema")
         {
-            if let Some(schema) = media.remove("schema") {
-                media.insert("schema".into(), json!({"allOf": [schema, overlay]}));
-            }
+            media.insert("schema".into(), json!({"allOf": [schema, overlay]}));
         }
     }
     for (path, note) in SYNC_LIMITS {

@@ -467,10 +467,10 @@ pub enum ConvergedError {
 /// of `converged_value` (levels are cached, so this is cheap).
 fn probe_level(converged_value: f64, value_at: impl Fn(&StringOperators) -> Option<f64>) -> usize {
     for level in 0..MAX_LEVELS {
-        if let Some(q) = value_at(&graded_operators(level)) {
-            if (q - converged_value).abs() <= 0.25 * PROBE_OFFSET * converged_value.abs() {
-                return level;
-            }
+        if let Some(q) = value_at(&graded_operators(level))
+            && (q - converged_value).abs() <= 0.25 * PROBE_OFFSET * converged_value.abs()
+        {
+            return level;
         }
     }
     MAX_LEVELS - 1

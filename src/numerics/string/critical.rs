@@ -461,7 +461,7 @@ pub(crate) fn onset_at(
     horizon_s: f64,
 ) -> Onset {
     match candidate {
-        Some(t) if t == 0.0 => {
+        Some(0.0) => {
             let k = profile.kinematics(0.0);
             Onset::Immediate(if k.rate_m_s < 0.0 {
                 ImmediateCause::Shortening

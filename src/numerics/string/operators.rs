@@ -77,10 +77,10 @@ impl StringOperators {
             let dofs = [e.checked_sub(1), Some(e)]; // node e -> dof e-1; node 0 is fixed
             for q in mesh.element_quadrature(e, 3) {
                 let s = 1.0 - q.zeta;
-                for a in 0..2 {
-                    let Some(row) = dofs[a] else { continue };
-                    for b in 0..2 {
-                        let Some(col) = dofs[b] else { continue };
+                for (a, row) in dofs.iter().enumerate() {
+                    let Some(row) = *row else { continue };
+                    for (b, col) in dofs.iter().enumerate() {
+                        let Some(col) = *col else { continue };
                         let w = q.weight;
                         ops.mass.add(row, col, w * q.shape[a] * q.shape[b]);
                         ops.conv.add(row, col, w * s * q.shape[a] * q.slope[b]);

@@ -741,13 +741,11 @@ fn run_planned(
             observer.report(step, plan.steps);
         }
         // Cancellation is polled often (bounded stop time), progress rarely.
-        if step.is_multiple_of(report_every.min(64)) {
-            if observer.cancelled() {
-                outcome = RunOutcome::Cancelled {
-                    time_s: step as f64 * dt_s,
-                };
-                break;
-            }
+        if step.is_multiple_of(report_every.min(64)) && observer.cancelled() {
+            outcome = RunOutcome::Cancelled {
+                time_s: step as f64 * dt_s,
+            };
+            break;
         }
         // Advance.
         let t_next = (step + 1) as f64 * dt_s;
