@@ -626,6 +626,7 @@ fn cases() -> Vec<Case> {
         lit("plan", &pl, "lift_reserve_nondim", 0.0, 0.9),
         lit("plan", &pl, "tether.safety_factor_nondim", 1.0, 100.0),
         exclusive(lit("plan", &pl, "tether.breaking_strength_n", 0.0, 1e9)),
+        exclusive(lit("plan", &pl, "target_elevation_m", 0.0, 1e6)),
         exclusive(lit("plan", &pl, "winch.max_rate_m_s", 0.0, 1000.0)),
         exclusive(lit("plan", &pl, "winch.max_acceleration_m_s2", 0.0, 100.0)),
         exclusive(lit("plan", &pl, "winch.max_jerk_m_s3", 0.0, 1e4)),
