@@ -16,6 +16,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, mpsc};
+
 use std::time::{Duration, Instant};
 
 use serde_json::{Value, json};
@@ -60,7 +61,7 @@ fn plan_bands(samples: usize) -> Value {
         "uncertainty": {"samples": samples, "seed": 11, "inputs": [
             {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 400.0},
             {"field": "cable.mass_per_length_kg_m", "distribution": "normal", "mean": 0.078, "std_dev": 0.002},
-            {"field": "tether.breaking_strength_n", "distribution": "lognormal", "median": 5200.0, "sigma_log": 0.1}
+            {"field": "tether.breaking_strength_n", "distribution": "lognormal", "mean": 5200.0, "std_dev": 500.0}
         ]}
     }})
 }
@@ -76,11 +77,29 @@ fn envelope_bands(samples: usize) -> Value {
         "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 6},
         "required_safety_factor_nondim": 5.0,
         "payout_rate_m_s": 5.0,
-        "uncertainty": {"samples": samples, "seed": 5, "inputs": [
-            {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 2000.0, "std_dev": 800.0},
+        "uncertainty": {"samples": samples, "seed": 7, "inputs": [
+            {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 2000.0, "std_dev": 850.0},
             {"field": "aerostat.drag_coefficient_nondim", "distribution": "uniform", "low": 0.25, "high": 0.4}
         ]}
     }})
+}
+
+/// The answer with its wall-clock field (`plan.compute_time_s` of a plan
+/// bands answer: the time the nominal plan took, different at every run,
+/// chunked or not) zeroed; everything else byte for byte.
+fn without_wall_clock(answer: &str) -> String {
+    const KEY: &str = "\"compute_time_s\":";
+    let mut out = String::with_capacity(answer.len());
+    let mut rest = answer;
+    while let Some(at) = rest.find(KEY) {
+        let (head, tail) = rest.split_at(at + KEY.len());
+        out.push_str(head);
+        out.push('0');
+        let end = tail.find([',', '}']).unwrap_or(tail.len());
+        rest = &tail[end..];
+    }
+    out.push_str(rest);
+    out
 }
 
 fn submission(v: &Value) -> JobSubmission {
@@ -108,8 +127,8 @@ fn assembled_equals_single(v: &Value, items: usize) -> String {
         }
         let plan = ChunkPlan { items, per_chunk };
         assert_eq!(
-            chunked(&sub, plan),
-            single,
+            without_wall_clock(&chunked(&sub, plan)),
+            without_wall_clock(&single),
             "{} chunks of {per_chunk}",
             plan.count()
         );
@@ -251,11 +270,15 @@ fn new_kinds_run_as_chunked_jobs_with_progress_in_chunks() {
     for (name, v) in [
         ("string_chart", string_chart()),
         ("plan_bands", plan_bands(3000)),
-        ("envelope_bands", envelope_bands(3000)),
+        ("envelope_bands", envelope_bands(600)),
     ] {
         let stored = run_as_job(name, &v);
         let single = submission(&v).run(&NoProgress).unwrap();
-        assert_eq!(stored, single, "{name}");
+        assert_eq!(
+            without_wall_clock(&stored),
+            without_wall_clock(&single),
+            "{name}"
+        );
     }
 }
 
@@ -276,6 +299,78 @@ fn long_bands() -> Value {
 #[test]
 fn cancelling_a_job_stops_its_running_chunks_promptly() {
     let db = Db::new("cancel");
+    cancel_scenario(
+        &|limits| db.queue(limits.clone()),
+        &|id| db.chunk_rows(id),
+    );
+}
+
+/// PostgreSQL (`TETHERPLAN_TEST_PG_URL`, default
+/// `postgres://postgres:postgres@127.0.0.1:5432/postgres`): the same, on a
+/// database of its own; skipped (with the reason printed) when PostgreSQL
+/// is unreachable, unless `CI` is set.
+#[test]
+fn cancelling_a_job_stops_its_running_chunks_promptly_on_postgres() {
+    let admin_url = std::env::var("TETHERPLAN_TEST_PG_URL")
+        .unwrap_or_else(|_| "postgres://postgres:postgres@127.0.0.1:5432/postgres".into());
+    let mut admin = match postgres::Client::connect(&admin_url, postgres::NoTls) {
+        Ok(c) => c,
+        Err(e) => {
+            assert!(
+                std::env::var_os("CI").is_none(),
+                "PostgreSQL unreachable at {admin_url} with CI set: {e}"
+            );
+            eprintln!("SKIPPED: PostgreSQL unreachable at {admin_url} ({e})");
+            return;
+        }
+    };
+    let name = format!("tetherplan_test_cancel_{}", std::process::id());
+    admin
+        .batch_execute(&format!("DROP DATABASE IF EXISTS {name} WITH (FORCE)"))
+        .unwrap();
+    admin
+        .batch_execute(&format!("CREATE DATABASE {name}"))
+        .unwrap();
+    let url = format!("{}/{name}", admin_url.rsplit_once('/').unwrap().0);
+    let outcome = std::panic::catch_unwind(|| {
+        let rows = |id: i64| -> Vec<(i64, String, i64)> {
+            let mut c = postgres::Client::connect(&url, postgres::NoTls).unwrap();
+            c.query(
+                "SELECT idx, status, attempts FROM job_chunks WHERE job_id = $1 ORDER BY idx",
+                &[&id],
+            )
+            .unwrap()
+            .iter()
+            .map(|r| {
+                (
+                    r.get::<_, i32>(0) as i64,
+                    r.get::<_, String>(1),
+                    r.get::<_, i32>(2) as i64,
+                )
+            })
+            .collect()
+        };
+        cancel_scenario(
+            &|limits| {
+                let store = tetherplan::jobs::postgres::PgStore::open(&url).unwrap();
+                JobQueue::new(store, 1, limits.clone())
+            },
+            &rows,
+        );
+    });
+    let _ = admin.batch_execute(&format!("DROP DATABASE IF EXISTS {name} WITH (FORCE)"));
+    if let Err(e) = outcome {
+        std::panic::resume_unwind(e);
+    }
+}
+
+/// Two worker "processes" (queues of one thread) and an API (a third
+/// queue) on one database: a long chunked job is cancelled while both
+/// workers run one of its chunks.
+fn cancel_scenario(
+    queue: &dyn Fn(&Limits) -> JobQueue,
+    chunk_rows: &dyn Fn(i64) -> Vec<(i64, String, i64)>,
+) {
     // A long lease: renewals every 20 s would be far too late.
     let limits = Limits {
         job_lease: Duration::from_secs(60),
@@ -286,24 +381,23 @@ fn cancelling_a_job_stops_its_running_chunks_promptly() {
     let sub = submission(&v);
     let plan = sub.chunk_plan().unwrap();
     assert!(plan.count() >= 4, "{plan:?}");
-    // How long one chunk takes uncancelled, on this machine now (a tenth
-    // of it: the first samples).
+    // How long one chunk takes uncancelled, on this machine now (from a
+    // tenth of it: its first samples).
     let tenth = plan.range(0).start..plan.range(0).start + plan.per_chunk / 10;
     let t = Instant::now();
     sub.run_chunk(tenth, &NoProgress).unwrap();
     let chunk_s = t.elapsed().as_secs_f64() * 10.0;
 
-    // Two worker "processes" on the database; the API is a third.
-    let stop = Arc::new(AtomicBool::new(false));
+    let stop = AtomicBool::new(false);
     let (ended_tx, ended_rx) = mpsc::channel::<Instant>();
-    let workers: Vec<_> = (0..2)
-        .map(|_| {
-            let queue = db.queue(limits.clone());
-            let (stop, ended) = (stop.clone(), ended_tx.clone());
-            std::thread::spawn(move || {
+    std::thread::scope(|scope| {
+        for _ in 0..2 {
+            let q = queue(&limits);
+            let (stop, ended) = (&stop, ended_tx.clone());
+            scope.spawn(move || {
                 while !stop.load(Ordering::Relaxed) {
                     let t = Instant::now();
-                    if work_once(&queue).unwrap() {
+                    if work_once(&q).unwrap() {
                         if t.elapsed() > Duration::from_millis(200) {
                             ended.send(Instant::now()).unwrap();
                         }
@@ -311,65 +405,123 @@ fn cancelling_a_job_stops_its_running_chunks_promptly() {
                         std::thread::sleep(Duration::from_millis(20));
                     }
                 }
-            })
-        })
-        .collect();
-    let api = db.queue(limits.clone());
-    let (id, _) = api.submit(&serde_json::to_vec(&v).unwrap()).unwrap();
-    // Wait until both workers run a chunk (the coordinator one of its own).
-    let start = Instant::now();
-    loop {
-        let rows = db.chunk_rows(id);
-        if rows.iter().filter(|r| r.1 == "running").count() == 2 {
-            break;
+            });
         }
-        assert!(start.elapsed() < Duration::from_secs(30), "{rows:?}");
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    std::thread::sleep(Duration::from_millis(300));
-    let before = db.chunk_rows(id);
-    let cancelled_at = Instant::now();
-    let rec = api.cancel(id, None).unwrap().unwrap();
-    assert_eq!(rec.status, JobStatus::Cancelled);
-    // Both workers' steps end: the coordinator (its chunk, then itself) and
-    // the other worker's chunk.
-    let mut latencies = Vec::new();
-    for _ in 0..2 {
-        let ended = ended_rx.recv_timeout(Duration::from_secs(60)).unwrap();
-        latencies.push(ended.saturating_duration_since(cancelled_at));
-    }
-    // Let the workers look for work a while longer.
-    std::thread::sleep(Duration::from_millis(500));
-    stop.store(true, Ordering::Relaxed);
-    for w in workers {
-        w.join().unwrap();
-    }
-    let slowest = latencies.iter().max().unwrap().as_secs_f64();
+        // Stops the workers however this scope ends (a failed assertion too).
+        struct StopOnDrop<'a>(&'a AtomicBool);
+        impl Drop for StopOnDrop<'_> {
+            fn drop(&mut self) {
+                self.0.store(true, Ordering::Relaxed);
+            }
+        }
+        let _stop = StopOnDrop(&stop);
+        let api = queue(&limits);
+        let (id, _) = api.submit(&serde_json::to_vec(&v).unwrap()).unwrap();
+        // Wait until both workers run a chunk (the coordinator one of its own).
+        let start = Instant::now();
+        loop {
+            let rows = chunk_rows(id);
+            if rows.iter().filter(|r| r.1 == "running").count() == 2 {
+                break;
+            }
+            assert!(start.elapsed() < Duration::from_secs(30), "{rows:?}");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        std::thread::sleep(Duration::from_millis(300));
+        let before = chunk_rows(id);
+        let cancelled_at = Instant::now();
+        let rec = api.cancel(id, None).unwrap().unwrap();
+        assert_eq!(rec.status, JobStatus::Cancelled);
+        // Both workers' steps end: the coordinator (its chunk, then itself)
+        // and the other worker's chunk.
+        let mut latencies = Vec::new();
+        for _ in 0..2 {
+            let ended = ended_rx.recv_timeout(Duration::from_secs(60)).unwrap();
+            latencies.push(ended.saturating_duration_since(cancelled_at));
+        }
+        // Let the workers look for work a while longer.
+        std::thread::sleep(Duration::from_millis(500));
+        stop.store(true, Ordering::Relaxed);
+        let slowest = latencies.iter().max().unwrap().as_secs_f64();
+        eprintln!(
+            "{}: cancel → running chunks stopped in {latencies:?}; a chunk takes about              {chunk_s:.1} s, renewal every {renewal:?}, status read every {CANCEL_POLL:?}",
+            api.store.store_kind()
+        );
+        // Bound: a status poll, the coordinator's 50 ms loop and a progress
+        // write, with margin; well under the renewal interval and under what
+        // was left of the running chunks.
+        let bound = 1.5;
+        assert!(
+            slowest < bound,
+            "the running chunks stopped {slowest:.2} s after the cancel"
+        );
+        assert!(
+            chunk_s > 2.0 * bound,
+            "a chunk ({chunk_s:.1} s) is long enough for the bound to tell"
+        );
+        assert!(bound < renewal.as_secs_f64() / 10.0);
+        let after = chunk_rows(id);
+        assert_eq!(
+            api.store.get(id).unwrap().unwrap().status,
+            JobStatus::Cancelled
+        );
+        assert!(after.iter().all(|r| r.1 != "done"), "{after:?}");
+        for (b, a) in before.iter().zip(&after) {
+            assert_eq!(
+                b.2, a.2,
+                "no chunk claimed after the cancel: {before:?} → {after:?}"
+            );
+        }
+        assert_eq!(after.iter().filter(|r| r.2 > 0).count(), 2, "{after:?}");
+    });
+}
+
+/// Prints the seconds per item of each new chunked kind on one thread
+/// (the figures behind the cost constants in `jobs/kinds.rs`):
+/// `cargo test --release --test chunks_kinds measure -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn measure_item_costs() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let time = |v: &Value, items: std::ops::Range<usize>| -> f64 {
+        let sub = submission(v);
+        let t = Instant::now();
+        pool.install(|| sub.run_chunk(items.clone(), &NoProgress).unwrap());
+        t.elapsed().as_secs_f64()
+    };
+    // string chart, 400 elements, 3 series: per element-point
+    let s = time(&string_chart(), 0..300);
     eprintln!(
-        "cancel → running chunks stopped in {latencies:?}; a chunk takes about {chunk_s:.1} s, \
-         renewal every {renewal:?}, status read every {CANCEL_POLL:?}"
+        "string chart: {:.3} s for 300 rates × 3 series × 400 elements = {:.2e} s per element-point",
+        s,
+        s / (300.0 * 3.0 * 400.0)
     );
-    // Bound: a few status polls (a poll, the coordinator's 50 ms loop and
-    // a progress write), well under the renewal interval and under what is
-    // left of a running chunk.
-    let bound = 1.5;
-    assert!(
-        slowest < bound,
-        "the running chunks stopped {slowest:.2} s after the cancel"
+    let s = time(&converged_string_chart(), 0..37);
+    eprintln!(
+        "converged string chart: {:.3} s for 37 × 2 points = {:.2e} s per point",
+        s,
+        s / 74.0
     );
-    assert!(
-        chunk_s > 2.0 * bound,
-        "a chunk ({chunk_s:.1} s) is long enough for the bound to tell"
+    let v = plan_bands(3000);
+    let sub = submission(&v);
+    let single = sub.run(&NoProgress).unwrap();
+    let instants = serde_json::from_str::<Value>(&single).unwrap()["instants"]
+        .as_array()
+        .unwrap()
+        .len();
+    let whole = time(&v, 0..3000);
+    let few = time(&v, 0..1);
+    eprintln!(
+        "plan bands: {whole:.3} s for 3000 samples × {instants} instants, {few:.3} s for 1 (the nominal plan) \
+         = {:.2e} s per sample-instant",
+        (whole - few) / (2999.0 * instants as f64)
     );
-    assert!(bound < renewal.as_secs_f64() / 10.0);
-    let after = db.chunk_rows(id);
-    assert_eq!(
-        api.store.get(id).unwrap().unwrap().status,
-        JobStatus::Cancelled
+    let s = time(&envelope_bands(200), 0..200);
+    eprintln!(
+        "envelope bands: {s:.3} s for 200 samples × 42 cells × 100 steps = {:.2e} s per cell-step",
+        s / (200.0 * 42.0 * 100.0)
     );
-    assert!(after.iter().all(|r| r.1 != "done"), "{after:?}");
-    for (b, a) in before.iter().zip(&after) {
-        assert_eq!(b.2, a.2, "no chunk claimed after the cancel: {before:?} → {after:?}");
-    }
-    assert_eq!(after.iter().filter(|r| r.2 > 0).count(), 2, "{after:?}");
 }

@@ -865,19 +865,24 @@ const BAND_ELEMENT_POINT_S: f64 = 4e-7;
 /// points in 0.06 s).
 const BAND_CONVERGED_POINT_S: f64 = 1e-5;
 /// Seconds per element of one point of a string chart on a uniform mesh
-/// (measured: MEASURE).
-const STRING_CHART_ELEMENT_POINT_S: f64 = 4e-7;
-/// Seconds per converged point of a string chart (measured: MEASURE).
+/// (measured: 300 rates × 3 buoyancies at 400 elements in 0.21-0.23 s on
+/// one core, 5.9-6.5e-7 s; test `chunks_kinds::measure_item_costs`).
+const STRING_CHART_ELEMENT_POINT_S: f64 = 7e-7;
+/// Seconds per converged point of a string chart (measured: 74 points in
+/// 0.5 ms, 6.5-7.3e-6 s, on one core; slower near the wave speed).
 const STRING_CHART_CONVERGED_POINT_S: f64 = 1e-5;
-/// Seconds per sample × schedule instant of a plan bands job (measured:
-/// MEASURE).
-const PLAN_BAND_VALUE_S: f64 = 5e-8;
+/// Seconds per sample × schedule instant of a plan bands chunk, its wire
+/// result included (measured: 3 000 samples × 2 003 instants in 1.36 s on
+/// one core, 2.2e-7 s; the nominal plan, computed again by every chunk,
+/// 0.02 s).
+const PLAN_BAND_VALUE_S: f64 = 2.5e-7;
 /// Sample × instant values of one plan bands chunk at most: its result
-/// holds every value (three traces), about 60 bytes each.
-const MAX_PLAN_BAND_CHUNK_VALUES: usize = 250_000;
+/// holds every value of three traces, about 60 bytes a value.
+const MAX_PLAN_BAND_CHUNK_VALUES: usize = 1_000_000;
 /// Seconds per sample × cell × integration step of an envelope bands job
-/// (measured: MEASURE).
-const ENVELOPE_BAND_CELL_STEP_S: f64 = 1e-7;
+/// (measured: 200 samples × 42 cells × 100 steps in 0.94 s on one core,
+/// 1.1e-6 s).
+const ENVELOPE_BAND_CELL_STEP_S: f64 = 1.2e-6;
 /// Seconds assumed for one request of a kind that is not chunked.
 const OTHER_ITEM_S: f64 = 0.05;
 
@@ -1026,8 +1031,9 @@ struct RawBatchOutcome {
 }
 
 impl JobSubmission {
-    /// How the job splits into chunks: a GE chart into its points, bands
-    /// into their samples, a batch into its requests (None: one piece).
+    /// How the job splits into chunks: a GE chart into its points, a
+    /// string chart into its rates, bands (chart, plan, envelope) into
+    /// their samples, a batch into its requests (None: one piece).
     pub fn chunk_plan(&self) -> Option<ChunkPlan> {
         match self {
             Self::One(item) => item.chunk_plan(),
