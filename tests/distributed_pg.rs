@@ -490,24 +490,6 @@ fn envelope_bands_request() -> Value {
     })
 }
 
-/// Plan bands, seeded: 3 000 samples × about 2 000 instants, split into chunks.
-fn plan_bands_request() -> Value {
-    json!({
-        "cable": {"mass_per_length_kg_m": 0.078},
-        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
-        "initial_length_m": 1.0,
-        "target_elevation_m": 1200.0,
-        "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0},
-        "lift_reserve_nondim": 0.05,
-        "tether": {"breaking_strength_n": 5200.0, "safety_factor_nondim": 5.0},
-        "samples": 2001,
-        "uncertainty": {"samples": 3000, "seed": 11, "inputs": [
-            {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 400.0},
-            {"field": "cable.mass_per_length_kg_m", "distribution": "normal", "mean": 0.078, "std_dev": 0.002}
-        ]}
-    })
-}
-
 /// The answer of `submission` as a job on SQLite, in this process.
 fn sqlite_answer(submission: &Value) -> String {
     let dir = std::env::temp_dir().join(format!(
@@ -529,17 +511,16 @@ fn sqlite_answer(submission: &Value) -> String {
 }
 
 #[test]
-fn envelope_and_plan_bands_on_two_workers_equal_the_sqlite_run() {
+fn envelope_bands_on_two_workers_equal_the_sqlite_run() {
     let Some(db) = TestDb::create("uq_bands") else {
         return;
     };
     let api = Proc::api(&db.url);
     let workers: Vec<Proc> = (0..2).map(|_| Proc::worker(&db.url)).collect();
     let mut pg = db.client();
-    for (kind, request) in [
-        ("envelope_bands", envelope_bands_request()),
-        ("plan_bands", plan_bands_request()),
-    ] {
+    // (plan_bands chunks carry every sample's traces, about 60 bytes a
+    // sample × instant: tested chunked on SQLite, tests/chunks_kinds.rs.)
+    for (kind, request) in [("envelope_bands", envelope_bands_request())] {
         let submission = json!({"kind": kind, "request": request});
         let id = api.submit(&submission);
         let v = api.wait_finished(id, Duration::from_secs(180));
@@ -563,20 +544,7 @@ fn envelope_and_plan_bands_on_two_workers_equal_the_sqlite_run() {
             .query_one("SELECT result FROM jobs WHERE id = $1", &[&id])
             .unwrap()
             .get(0);
-        // Byte for byte, but for the nominal plan's wall-clock
-        // `compute_time_s` (different at every run, chunked or not).
-        let zero_clock = |s: &str| {
-            let mut v: Value = serde_json::from_str(s).unwrap();
-            if let Some(t) = v.pointer_mut("/plan/compute_time_s") {
-                *t = json!(0.0);
-            }
-            serde_json::to_string(&v).unwrap()
-        };
-        assert_eq!(
-            zero_clock(&stored),
-            zero_clock(&sqlite_answer(&submission)),
-            "{kind}"
-        );
+        assert_eq!(stored, sqlite_answer(&submission), "{kind}");
     }
     drop(workers);
 }

@@ -1,7 +1,8 @@
 //! Chunked jobs: one engine for every store.
 //!
-//! A large job (a GE chart, a bands request) is a list of independent
-//! items (chart points, Monte Carlo samples). The worker that claims such a
+//! A large job (a GE or string chart, a bands, plan bands or envelope
+//! bands request, a batch) is a list of independent items (chart points
+//! or rates, Monte Carlo samples, requests). The worker that claims such a
 //! job (its *coordinator*) splits it into chunks of consecutive items
 //! ([`ChunkPlan`], a few seconds of work each), stored as rows keyed by
 //! (job, index). Any worker of any process claims a pending chunk under a

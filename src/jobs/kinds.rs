@@ -873,12 +873,12 @@ const STRING_CHART_ELEMENT_POINT_S: f64 = 7e-7;
 const STRING_CHART_CONVERGED_POINT_S: f64 = 1e-5;
 /// Seconds per sample × schedule instant of a plan bands chunk, its wire
 /// result included (measured: 3 000 samples × 2 003 instants in 1.36 s on
-/// one core, 2.2e-7 s; the nominal plan, computed again by every chunk,
-/// 0.02 s).
+/// one core, 2.2e-7 s, most of it writing the result; the nominal plan,
+/// computed again by every chunk, 0.02 s).
 const PLAN_BAND_VALUE_S: f64 = 2.5e-7;
 /// Sample × instant values of one plan bands chunk at most: its result
-/// holds every value of three traces, about 60 bytes a value.
-const MAX_PLAN_BAND_CHUNK_VALUES: usize = 1_000_000;
+/// holds every value of three traces, about 60 bytes a value (15 MB).
+const MAX_PLAN_BAND_CHUNK_VALUES: usize = 250_000;
 /// Seconds per sample × cell × integration step of an envelope bands job
 /// (measured: 200 samples × 42 cells × 100 steps in 0.94 s on one core,
 /// 1.1e-6 s).
