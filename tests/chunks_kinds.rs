@@ -161,7 +161,11 @@ fn chunked_plan_bands_are_the_single_process_plan_bands() {
     let single = assembled_equals_single(&plan_bands(300), 300);
     let v: Value = serde_json::from_str(&single).unwrap();
     let rejected = v["rejected_samples"][0]["count"].as_u64().unwrap_or(0);
-    assert!(rejected > 0, "some draws are rejected: {}", v["rejected_samples"]);
+    assert!(
+        rejected > 0,
+        "some draws are rejected: {}",
+        v["rejected_samples"]
+    );
     assert_eq!(v["valid_samples"].as_u64().unwrap() + rejected, 300);
     assert!(v["instants"].as_array().unwrap().len() > 2000);
 }
@@ -171,7 +175,11 @@ fn chunked_envelope_bands_are_the_single_process_envelope_bands() {
     let single = assembled_equals_single(&envelope_bands(200), 200);
     let v: Value = serde_json::from_str(&single).unwrap();
     let rejected = v["rejected_samples"][0]["count"].as_u64().unwrap_or(0);
-    assert!(rejected > 0, "some draws are rejected: {}", v["rejected_samples"]);
+    assert!(
+        rejected > 0,
+        "some draws are rejected: {}",
+        v["rejected_samples"]
+    );
     assert_eq!(v["cells"].as_array().unwrap().len(), 42);
 }
 
@@ -252,8 +260,15 @@ fn run_as_job(name: &str, v: &Value) -> String {
         (0..n as i64).collect::<Vec<_>>()
     );
     assert!(rows.iter().all(|r| r.1 == "done" && r.2 == 1), "{rows:?}");
-    let partial: Vec<f64> = seen.iter().copied().filter(|p| *p > 0.0 && *p < 1.0).collect();
-    assert!(!partial.is_empty(), "{name}: progress read mid-run: {seen:?}");
+    let partial: Vec<f64> = seen
+        .iter()
+        .copied()
+        .filter(|p| *p > 0.0 && *p < 1.0)
+        .collect();
+    assert!(
+        !partial.is_empty(),
+        "{name}: progress read mid-run: {seen:?}"
+    );
     for p in &partial {
         let k = p * n as f64;
         assert!(
@@ -299,10 +314,7 @@ fn long_bands() -> Value {
 #[test]
 fn cancelling_a_job_stops_its_running_chunks_promptly() {
     let db = Db::new("cancel");
-    cancel_scenario(
-        &|limits| db.queue(limits.clone()),
-        &|id| db.chunk_rows(id),
-    );
+    cancel_scenario(&|limits| db.queue(limits.clone()), &|id| db.chunk_rows(id));
 }
 
 /// PostgreSQL (`TETHERPLAN_TEST_PG_URL`, default

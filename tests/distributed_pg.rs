@@ -533,10 +533,7 @@ fn envelope_bands_on_two_workers_equal_the_sqlite_run() {
             rows.iter().map(|r| r.0).collect::<Vec<_>>(),
             (0..n as i32).collect::<Vec<_>>()
         );
-        assert!(
-            rows.iter().all(|r| r.1 == "done" && r.2 == 1),
-            "{rows:?}"
-        );
+        assert!(rows.iter().all(|r| r.1 == "done" && r.2 == 1), "{rows:?}");
         let finishers: std::collections::BTreeSet<_> =
             rows.iter().filter_map(|r| r.4.clone()).collect();
         eprintln!("{kind}: {n} chunks done by {finishers:?}");

@@ -259,8 +259,7 @@ pub fn execute_chunk(
             let every = limits.job_lease / 3;
             let poll = CANCEL_POLL.min(every);
             let mut renewed = Instant::now();
-            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = stopped.recv_timeout(poll)
-            {
+            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = stopped.recv_timeout(poll) {
                 if renewed.elapsed() < every {
                     // Between renewals: a cheap look at the job's status, so
                     // that a cancellation stops the chunk within `poll`.

@@ -1007,15 +1007,15 @@ impl JobItem {
                 to_json(&ge_charts::ge_chart_assemble(r, points)?)
             }
             Self::Bands(r) => to_json(&crate::contract::bands::bands_from_chunks(r, parts)?),
-            Self::Chart(AnyChartRequest::LinearString(r)) => to_json(
-                &crate::contract::chart_chunks::chart_from_chunks(r, parts)?,
-            ),
-            Self::PlanBands(r) => to_json(
-                &crate::contract::bands::plan::plan_bands_from_chunks(r, parts)?,
-            ),
-            Self::EnvelopeBands(r) => to_json(
-                &crate::contract::bands::envelope::envelope_bands_from_chunks(r, parts)?,
-            ),
+            Self::Chart(AnyChartRequest::LinearString(r)) => {
+                to_json(&crate::contract::chart_chunks::chart_from_chunks(r, parts)?)
+            }
+            Self::PlanBands(r) => to_json(&crate::contract::bands::plan::plan_bands_from_chunks(
+                r, parts,
+            )?),
+            Self::EnvelopeBands(r) => {
+                to_json(&crate::contract::bands::envelope::envelope_bands_from_chunks(r, parts)?)
+            }
             _ => parts
                 .first()
                 .cloned()
