@@ -469,3 +469,79 @@ fn killing_an_api_loses_nothing_and_two_apis_share_the_database() {
     let single = ge_charts::ge_chart(&req, Parallelism::Rayon, &NoProgress).unwrap();
     assert_eq!(v["result"], serde_json::to_value(&single).unwrap());
 }
+
+/// Envelope bands, seeded, with draws out of range (rejected and counted):
+/// about 3 s of work on one core, split into chunks.
+fn envelope_bands_request() -> Value {
+    json!({
+        "cable": {"preset": "dyneema", "diameter_m": 0.006},
+        "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
+                     "reference_area_m2": 20.0},
+        "wind": {"shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0},
+                 "air_density_kg_m3": 1.225},
+        "wind_speeds_m_s": {"min": 0.0, "max": 30.0, "count": 7},
+        "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 6},
+        "required_safety_factor_nondim": 5.0,
+        "payout_rate_m_s": 5.0,
+        "uncertainty": {"samples": 600, "seed": 5, "inputs": [
+            {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 2000.0, "std_dev": 850.0},
+            {"field": "aerostat.drag_coefficient_nondim", "distribution": "uniform", "low": 0.25, "high": 0.4}
+        ]}
+    })
+}
+
+/// The answer of `submission` as a job on SQLite, in this process.
+fn sqlite_answer(submission: &Value) -> String {
+    let dir = std::env::temp_dir().join(format!(
+        "tetherplan-pg-vs-sqlite-{}-{}",
+        std::process::id(),
+        submission["kind"].as_str().unwrap()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    let store = tetherplan::jobs::store::JobStore::open(&dir.join("jobs.db")).unwrap();
+    let queue = tetherplan::jobs::JobQueue::new(store, 2, Default::default());
+    let (id, _) = queue
+        .submit(&serde_json::to_vec(submission).unwrap())
+        .unwrap();
+    while tetherplan::jobs::work_once(&queue).unwrap() {}
+    let rec = queue.store.get(id).unwrap().unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(rec.status, tetherplan::jobs::store::JobStatus::Done);
+    rec.result.unwrap()
+}
+
+#[test]
+fn envelope_bands_on_two_workers_equal_the_sqlite_run() {
+    let Some(db) = TestDb::create("uq_bands") else {
+        return;
+    };
+    let api = Proc::api(&db.url);
+    let workers: Vec<Proc> = (0..2).map(|_| Proc::worker(&db.url)).collect();
+    let mut pg = db.client();
+    // (plan_bands chunks carry every sample's traces, about 60 bytes a
+    // sample × instant: tested chunked on SQLite, tests/chunks_kinds.rs.)
+    for (kind, request) in [("envelope_bands", envelope_bands_request())] {
+        let submission = json!({"kind": kind, "request": request});
+        let id = api.submit(&submission);
+        let v = api.wait_finished(id, Duration::from_secs(180));
+        assert_eq!(v["status"], "done", "{v}");
+        assert_eq!(v["progress"], 1.0);
+        let rows = chunks(&mut pg, id);
+        let n = rows.len();
+        assert!(n >= 2, "{kind}: split into {n} chunks");
+        assert_eq!(
+            rows.iter().map(|r| r.0).collect::<Vec<_>>(),
+            (0..n as i32).collect::<Vec<_>>()
+        );
+        assert!(rows.iter().all(|r| r.1 == "done" && r.2 == 1), "{rows:?}");
+        let finishers: std::collections::BTreeSet<_> =
+            rows.iter().filter_map(|r| r.4.clone()).collect();
+        eprintln!("{kind}: {n} chunks done by {finishers:?}");
+        let stored: String = pg
+            .query_one("SELECT result FROM jobs WHERE id = $1", &[&id])
+            .unwrap()
+            .get(0);
+        assert_eq!(stored, sqlite_answer(&submission), "{kind}");
+    }
+    drop(workers);
+}

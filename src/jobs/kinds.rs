@@ -864,6 +864,25 @@ const BAND_ELEMENT_POINT_S: f64 = 4e-7;
 /// Seconds per converged chart point of a bands sample (measured: 9 600
 /// points in 0.06 s).
 const BAND_CONVERGED_POINT_S: f64 = 1e-5;
+/// Seconds per element of one point of a string chart on a uniform mesh
+/// (measured: 300 rates × 3 buoyancies at 400 elements in 0.21-0.23 s on
+/// one core, 5.9-6.5e-7 s; test `chunks_kinds::measure_item_costs`).
+const STRING_CHART_ELEMENT_POINT_S: f64 = 7e-7;
+/// Seconds per converged point of a string chart (measured: 74 points in
+/// 0.5 ms, 6.5-7.3e-6 s, on one core; slower near the wave speed).
+const STRING_CHART_CONVERGED_POINT_S: f64 = 1e-5;
+/// Seconds per sample × schedule instant of a plan bands chunk, its wire
+/// result included (measured: 3 000 samples × 2 003 instants in 1.36 s on
+/// one core, 2.2e-7 s, most of it writing the result; the nominal plan,
+/// computed again by every chunk, 0.02 s).
+const PLAN_BAND_VALUE_S: f64 = 2.5e-7;
+/// Sample × instant values of one plan bands chunk at most: its result
+/// holds every value of three traces, about 60 bytes a value (15 MB).
+const MAX_PLAN_BAND_CHUNK_VALUES: usize = 250_000;
+/// Seconds per sample × cell × integration step of an envelope bands job
+/// (measured: 200 samples × 42 cells × 100 steps in 0.94 s on one core,
+/// 1.1e-6 s).
+const ENVELOPE_BAND_CELL_STEP_S: f64 = 1.2e-6;
 /// Seconds assumed for one request of a kind that is not chunked.
 const OTHER_ITEM_S: f64 = 0.05;
 
@@ -889,13 +908,52 @@ impl JobItem {
                 };
                 Some((samples, rates as f64 * point))
             }
+            Self::Chart(AnyChartRequest::LinearString(r)) => {
+                let series = r.params.net_buoyancies_n.len().max(1) as f64;
+                let point = match r.system.discretisation().ok()? {
+                    crate::numerics::chart::Discretisation::Elements(n) => {
+                        n as f64 * STRING_CHART_ELEMENT_POINT_S
+                    }
+                    _ => STRING_CHART_CONVERGED_POINT_S,
+                };
+                Some((
+                    crate::contract::chart_chunks::chart_rate_count(r),
+                    series * point,
+                ))
+            }
+            Self::PlanBands(r) => {
+                let samples = r.params.uncertainty.samples;
+                let values = crate::contract::bands::plan::plan_band_values(r);
+                let instants = values / samples.max(1);
+                Some((samples, instants as f64 * PLAN_BAND_VALUE_S))
+            }
+            Self::EnvelopeBands(r) => {
+                let samples = r.params.uncertainty.samples;
+                let (_, config) = r.envelope.problem().ok()?;
+                let cells = r.envelope.points() as f64;
+                let cost = cells * config.steps as f64 * ENVELOPE_BAND_CELL_STEP_S;
+                Some((samples, cost))
+            }
             _ => None,
         }
     }
 
     /// How this request splits into chunks (None: it runs as one piece).
     fn chunk_plan(&self) -> Option<ChunkPlan> {
-        self.items().map(|(n, cost)| ChunkPlan::for_cost(n, cost))
+        let plan = self.items().map(|(n, cost)| ChunkPlan::for_cost(n, cost))?;
+        match self {
+            // A split plan bands job: chunk results of bounded size.
+            Self::PlanBands(r) if plan.count() > 1 => {
+                let samples = r.params.uncertainty.samples.max(1);
+                let instants = crate::contract::bands::plan::plan_band_values(r) / samples;
+                let most = (MAX_PLAN_BAND_CHUNK_VALUES / instants.max(1)).max(1);
+                Some(ChunkPlan {
+                    per_chunk: plan.per_chunk.min(most),
+                    ..plan
+                })
+            }
+            _ => Some(plan),
+        }
     }
 
     /// Seconds one run of this request may take (sizing batch chunks).
@@ -916,6 +974,21 @@ impl JobItem {
             Self::Bands(r) => {
                 crate::contract::bands::bands_chunk(r, range, Parallelism::Rayon, progress)
             }
+            Self::Chart(AnyChartRequest::LinearString(r)) => {
+                crate::contract::chart_chunks::chart_chunk(r, range, Parallelism::Rayon, progress)
+            }
+            Self::PlanBands(r) => crate::contract::bands::plan::plan_bands_chunk(
+                r,
+                range,
+                Parallelism::Rayon,
+                progress,
+            ),
+            Self::EnvelopeBands(r) => crate::contract::bands::envelope::envelope_bands_chunk(
+                r,
+                range,
+                Parallelism::Rayon,
+                progress,
+            ),
             _ => self.run_kind(progress),
         }
     }
@@ -934,6 +1007,15 @@ impl JobItem {
                 to_json(&ge_charts::ge_chart_assemble(r, points)?)
             }
             Self::Bands(r) => to_json(&crate::contract::bands::bands_from_chunks(r, parts)?),
+            Self::Chart(AnyChartRequest::LinearString(r)) => {
+                to_json(&crate::contract::chart_chunks::chart_from_chunks(r, parts)?)
+            }
+            Self::PlanBands(r) => to_json(&crate::contract::bands::plan::plan_bands_from_chunks(
+                r, parts,
+            )?),
+            Self::EnvelopeBands(r) => {
+                to_json(&crate::contract::bands::envelope::envelope_bands_from_chunks(r, parts)?)
+            }
             _ => parts
                 .first()
                 .cloned()
@@ -949,8 +1031,9 @@ struct RawBatchOutcome {
 }
 
 impl JobSubmission {
-    /// How the job splits into chunks: a GE chart into its points, bands
-    /// into their samples, a batch into its requests (None: one piece).
+    /// How the job splits into chunks: a GE chart into its points, a
+    /// string chart into its rates, bands (chart, plan, envelope) into
+    /// their samples, a batch into its requests (None: one piece).
     pub fn chunk_plan(&self) -> Option<ChunkPlan> {
         match self {
             Self::One(item) => item.chunk_plan(),

@@ -135,8 +135,34 @@ pub fn run_ensemble<F: UncertainField, T: Send>(
     progress: &dyn Progress,
     eval: impl Fn(&[f64]) -> Option<T> + Sync,
 ) -> Result<EnsembleResults<T>, RequestError> {
+    let results = run_ensemble_range(
+        ensemble,
+        fields,
+        0..ensemble.samples,
+        parallelism,
+        progress,
+        eval,
+    )?;
+    collect_samples(fields.len(), results)
+}
+
+/// One sample's outcome: its output, or the index of the first field
+/// whose draw is out of range.
+pub type SampleOutcome<T> = Result<T, usize>;
+
+/// [`run_ensemble`] over the samples `range` only (one chunk of a
+/// distributed job): each sample's outcome, in sample order, uncounted.
+pub fn run_ensemble_range<F: UncertainField, T: Send>(
+    ensemble: &Ensemble,
+    fields: &[F],
+    range: std::ops::Range<usize>,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+    eval: impl Fn(&[f64]) -> Option<T> + Sync,
+) -> Result<Vec<SampleOutcome<T>>, RequestError> {
     let results: Vec<Result<Option<T>, usize>> = ensemble
-        .run(
+        .run_range(
+            range,
             parallelism,
             &|done, total| progress.report(done, total),
             &|| progress.cancelled(),
@@ -150,12 +176,27 @@ pub fn run_ensemble<F: UncertainField, T: Send>(
             },
         )
         .ok_or(RequestError::Cancelled)?;
-    let mut rejected = vec![0usize; fields.len()];
+    results
+        .into_iter()
+        .map(|r| match r {
+            Ok(Some(t)) => Ok(Ok(t)),
+            Ok(None) => Err(RequestError::Cancelled),
+            Err(k) => Ok(Err(k)),
+        })
+        .collect()
+}
+
+/// The valid outputs (in sample order) and the rejected counts per field
+/// from every sample's outcome; an error when no sample is valid.
+pub fn collect_samples<T>(
+    fields: usize,
+    results: Vec<SampleOutcome<T>>,
+) -> Result<EnsembleResults<T>, RequestError> {
+    let mut rejected = vec![0usize; fields];
     let mut valid = Vec::with_capacity(results.len());
     for r in results {
         match r {
-            Ok(Some(t)) => valid.push(t),
-            Ok(None) => return Err(RequestError::Cancelled),
+            Ok(t) => valid.push(t),
             Err(k) => rejected[k] += 1,
         }
     }

@@ -27,7 +27,8 @@ use crate::contract::envelope::dto::{EnvelopeRequest, EnvelopeResponse};
 use crate::contract::{Progress, RequestError, parse_value};
 use crate::numerics::chart::Parallelism;
 use crate::numerics::params::InvalidInput;
-use crate::numerics::tether::EquilibriumProblem;
+use crate::numerics::tether::envelope::EnvelopeProblem;
+use crate::numerics::tether::{EquilibriumConfig, EquilibriumProblem};
 use crate::numerics::uncertainty::{self, Distribution};
 
 /// Most sample × cell equilibria of one envelope bands request (a job).
@@ -287,12 +288,29 @@ pub fn envelope_bands(
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
+    let samples = 0..prep.ensemble.samples;
+    let cells = sample_cells(&prep, &problem, &config, samples, parallelism, progress)?;
+    let results = common::collect_samples(prep.fields.len(), cells)?;
+    Ok(summarise(req, &prep, &problem, nominal, results))
+}
+
+/// Each sample of `range`: its envelope's cells, or the first field whose
+/// draw is out of range.
+fn sample_cells(
+    prep: &PreparedEnvelopeBands,
+    problem: &EnvelopeProblem,
+    config: &EquilibriumConfig,
+    range: std::ops::Range<usize>,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<Vec<common::SampleOutcome<Vec<CellValue>>>, RequestError> {
     let required = problem.limits.required_safety_factor;
     let never = |_: usize, _: usize| {};
     let cancelled = || progress.cancelled();
-    let results = common::run_ensemble(
+    common::run_ensemble_range(
         &prep.ensemble,
         &prep.fields,
+        range,
         parallelism,
         progress,
         |values| {
@@ -303,7 +321,7 @@ pub fn envelope_bands(
             // The envelope's own validation: every draw is in range, so
             // only a cancellation ends it early.
             let env = p
-                .solve(&config, Parallelism::Serial, &never, &cancelled)
+                .solve(config, Parallelism::Serial, &never, &cancelled)
                 .ok()??;
             Some(
                 env.points
@@ -320,7 +338,114 @@ pub fn envelope_bands(
                     .collect::<Vec<_>>(),
             )
         },
+    )
+}
+
+/// One sample on the wire between a chunk and its job: per cell the
+/// largest tension as its IEEE-754 bits and the three verdicts, so that
+/// the answer put together from chunks is the single-process one exactly.
+#[derive(Serialize, Deserialize)]
+enum WireSample {
+    Ok(Vec<(u64, bool, bool, bool)>),
+    Rejected(usize),
+}
+
+/// The samples `range` of an envelope bands request as JSON text (one
+/// chunk of a distributed job; the nominal envelope is left to the
+/// assembly).
+pub fn envelope_bands_chunk(
+    req: &EnvelopeBandsRequest,
+    range: std::ops::Range<usize>,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<String, RequestError> {
+    let prep = prepare_envelope_bands(req)?;
+    let (problem, config) = req.envelope.problem()?;
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    let cells = sample_cells(&prep, &problem, &config, range, parallelism, progress)?;
+    let wire: Vec<WireSample> = cells
+        .iter()
+        .map(|r| match r {
+            Ok(cells) => WireSample::Ok(
+                cells
+                    .iter()
+                    .map(|c| {
+                        (
+                            c.max_tension_n.to_bits(),
+                            c.tension_exceeded,
+                            c.unstable,
+                            c.outside,
+                        )
+                    })
+                    .collect(),
+            ),
+            Err(k) => WireSample::Rejected(*k),
+        })
+        .collect();
+    Ok(serde_json::to_string(&wire).expect("samples serialise"))
+}
+
+/// The envelope bands answer from its chunks ([`envelope_bands_chunk`] of
+/// consecutive ranges covering every sample, in order) and the nominal
+/// envelope, computed here.
+pub fn envelope_bands_from_chunks(
+    req: &EnvelopeBandsRequest,
+    parts: &[String],
+) -> Result<EnvelopeBandsResponse, RequestError> {
+    let prep = prepare_envelope_bands(req)?;
+    let (problem, _) = req.envelope.problem()?;
+    let nominal = crate::contract::envelope::envelope(
+        &req.envelope,
+        Parallelism::Rayon,
+        &crate::contract::run::NoProgress,
     )?;
+    let cell_count = nominal.points.len();
+    let mut cells = Vec::with_capacity(prep.ensemble.samples);
+    for part in parts {
+        let wire: Vec<WireSample> = serde_json::from_str(part).map_err(|e| {
+            RequestError::Malformed(format!("a chunk of the envelope bands job: {e}"))
+        })?;
+        for w in wire {
+            cells.push(match w {
+                WireSample::Ok(values) if values.len() == cell_count => Ok(values
+                    .into_iter()
+                    .map(|(t, tension_exceeded, unstable, outside)| CellValue {
+                        max_tension_n: f64::from_bits(t),
+                        tension_exceeded,
+                        unstable,
+                        outside,
+                    })
+                    .collect()),
+                WireSample::Rejected(k) if k < prep.fields.len() => Err(k),
+                _ => {
+                    return Err(RequestError::Malformed(format!(
+                        "a chunk of the envelope bands job holds a sample that is neither {cell_count} cells nor a rejection on an input of the request"
+                    )));
+                }
+            });
+        }
+    }
+    if cells.len() != prep.ensemble.samples {
+        return Err(RequestError::Malformed(format!(
+            "the chunks of the envelope bands job hold {} samples, not {}",
+            cells.len(),
+            prep.ensemble.samples
+        )));
+    }
+    let results = common::collect_samples(prep.fields.len(), cells)?;
+    Ok(summarise(req, &prep, &problem, nominal, results))
+}
+
+/// The answer from the nominal envelope and every sample's cells.
+fn summarise(
+    req: &EnvelopeBandsRequest,
+    prep: &PreparedEnvelopeBands,
+    problem: &EnvelopeProblem,
+    nominal: EnvelopeResponse,
+    results: common::EnsembleResults<Vec<CellValue>>,
+) -> EnvelopeBandsResponse {
     let valid = &results.valid;
     let n = valid.len();
     let rated = problem.base.cable.breaking_strength_n.is_some()
@@ -349,7 +474,7 @@ pub fn envelope_bands(
         })
         .collect();
     let u = &req.params.uncertainty;
-    Ok(EnvelopeBandsResponse {
+    EnvelopeBandsResponse {
         envelope: nominal,
         cells,
         samples: u.samples,
@@ -359,7 +484,7 @@ pub fn envelope_bands(
         inputs: u.inputs.clone(),
         confidence_level_nondim: uncertainty::CONFIDENCE,
         method: METHOD.into(),
-    })
+    }
 }
 
 #[cfg(test)]

@@ -346,19 +346,15 @@ fn trace(
     out
 }
 
-/// Answers a plan bands request. Progress counts the samples (the
-/// nominal plan comes first, cancellable).
-pub fn plan_bands(
+/// The nominal plan and its schedule's instants (cancellable).
+fn nominal(
     req: &PlanBandsRequest,
-    parallelism: Parallelism,
     progress: &dyn Progress,
-) -> Result<PlanBandsResponse, RequestError> {
-    let prep = prepare_plan_bands(req)?;
+) -> Result<(PlanResponse, Vec<Instant>), RequestError> {
     let plan = crate::contract::plan::plan(&req.plan, &common::Silent(progress))?;
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
-    let reserve = req.plan.lift_reserve_nondim;
     let instants: Vec<Instant> = plan
         .schedule
         .iter()
@@ -372,10 +368,24 @@ pub fn plan_bands(
             margin: s.stability_margin_m_s,
         })
         .collect();
-    let u = &req.params.uncertainty;
-    let results = common::run_ensemble(
+    Ok((plan, instants))
+}
+
+/// Each sample of `range`: its pass over the schedule, or the first field
+/// whose draw is out of range.
+fn sample_traces(
+    req: &PlanBandsRequest,
+    prep: &PreparedPlanBands,
+    instants: &[Instant],
+    range: std::ops::Range<usize>,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<Vec<common::SampleOutcome<SampleTrace>>, RequestError> {
+    let reserve = req.plan.lift_reserve_nondim;
+    common::run_ensemble_range(
         &prep.ensemble,
         &prep.fields,
+        range,
         parallelism,
         progress,
         |values| {
@@ -390,9 +400,134 @@ pub fn plan_bands(
             let sys = raw
                 .system()
                 .expect("the base system is valid and every draw is in range");
-            Some(trace(&prep, &instants, reserve, &sys, breaking))
+            Some(trace(prep, instants, reserve, &sys, breaking))
         },
-    )?;
+    )
+}
+
+/// Answers a plan bands request. Progress counts the samples (the
+/// nominal plan comes first, cancellable).
+pub fn plan_bands(
+    req: &PlanBandsRequest,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<PlanBandsResponse, RequestError> {
+    let prep = prepare_plan_bands(req)?;
+    let (plan, instants) = nominal(req, progress)?;
+    let samples = 0..prep.ensemble.samples;
+    let traces = sample_traces(req, &prep, &instants, samples, parallelism, progress)?;
+    let results = common::collect_samples(prep.fields.len(), traces)?;
+    Ok(summarise(req, &prep, plan, &instants, results))
+}
+
+/// One sample's pass on the wire between a chunk and its job: every
+/// number as its IEEE-754 bits, so that the answer put together from
+/// chunks is the single-process one exactly.
+#[derive(Serialize, Deserialize)]
+enum WireTrace {
+    /// winch, max, margin per instant; min effective, peak; unstable,
+    /// below reserve, over rating.
+    Ok(Vec<u64>, Vec<u64>, Vec<u64>, u64, u64, [bool; 3]),
+    Rejected(usize),
+}
+
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+fn floats(v: Vec<u64>) -> Vec<f64> {
+    v.into_iter().map(f64::from_bits).collect()
+}
+
+/// The samples `range` of a plan bands request as JSON text (one chunk of
+/// a distributed job). Each chunk computes the nominal plan again (it is
+/// deterministic) for the schedule its samples follow.
+pub fn plan_bands_chunk(
+    req: &PlanBandsRequest,
+    range: std::ops::Range<usize>,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<String, RequestError> {
+    let prep = prepare_plan_bands(req)?;
+    let (_, instants) = nominal(req, progress)?;
+    let traces = sample_traces(req, &prep, &instants, range, parallelism, progress)?;
+    let wire: Vec<WireTrace> = traces
+        .iter()
+        .map(|r| match r {
+            Ok(t) => WireTrace::Ok(
+                bits(&t.winch),
+                bits(&t.max),
+                bits(&t.margin),
+                t.min_effective.to_bits(),
+                t.peak.to_bits(),
+                [t.unstable, t.below_reserve, t.over_rating],
+            ),
+            Err(k) => WireTrace::Rejected(*k),
+        })
+        .collect();
+    Ok(serde_json::to_string(&wire).expect("samples serialise"))
+}
+
+/// The plan bands answer from its chunks ([`plan_bands_chunk`] of
+/// consecutive ranges covering every sample, in order).
+pub fn plan_bands_from_chunks(
+    req: &PlanBandsRequest,
+    parts: &[String],
+) -> Result<PlanBandsResponse, RequestError> {
+    let prep = prepare_plan_bands(req)?;
+    let (plan, instants) = nominal(req, &crate::contract::run::NoProgress)?;
+    let mut traces = Vec::with_capacity(prep.ensemble.samples);
+    for part in parts {
+        let wire: Vec<WireTrace> = serde_json::from_str(part)
+            .map_err(|e| RequestError::Malformed(format!("a chunk of the plan bands job: {e}")))?;
+        for w in wire {
+            traces.push(match w {
+                WireTrace::Ok(winch, max, margin, min_effective, peak, [u, b, o]) => {
+                    if [winch.len(), max.len(), margin.len()] != [instants.len(); 3] {
+                        return Err(RequestError::Malformed(format!(
+                            "a chunk of the plan bands job has traces of another length than the {} instants of the schedule",
+                            instants.len()
+                        )));
+                    }
+                    Ok(SampleTrace {
+                        winch: floats(winch),
+                        max: floats(max),
+                        margin: floats(margin),
+                        min_effective: f64::from_bits(min_effective),
+                        peak: f64::from_bits(peak),
+                        unstable: u,
+                        below_reserve: b,
+                        over_rating: o,
+                    })
+                }
+                WireTrace::Rejected(k) if k < prep.fields.len() => Err(k),
+                WireTrace::Rejected(k) => {
+                    return Err(RequestError::Malformed(format!(
+                        "a chunk of the plan bands job rejects a sample on input {k}, which does not exist"
+                    )));
+                }
+            });
+        }
+    }
+    if traces.len() != prep.ensemble.samples {
+        return Err(RequestError::Malformed(format!(
+            "the chunks of the plan bands job hold {} samples, not {}",
+            traces.len(),
+            prep.ensemble.samples
+        )));
+    }
+    let results = common::collect_samples(prep.fields.len(), traces)?;
+    Ok(summarise(req, &prep, plan, &instants, results))
+}
+
+/// The answer from the nominal plan and every sample's pass.
+fn summarise(
+    req: &PlanBandsRequest,
+    prep: &PreparedPlanBands,
+    plan: PlanResponse,
+    instants: &[Instant],
+    results: common::EnsembleResults<SampleTrace>,
+) -> PlanBandsResponse {
     let valid = &results.valid;
     let n = valid.len();
     let feasible = plan.feasible && !instants.is_empty();
@@ -420,7 +555,8 @@ pub fn plan_bands(
     let min_effective = feasible.then(|| band(&|t| t.min_effective));
     let peak = feasible.then(|| band(&|t| t.peak));
     let p = |k: usize| feasible.then(|| common::probability_output(k, n));
-    Ok(PlanBandsResponse {
+    let u = &req.params.uncertainty;
+    PlanBandsResponse {
         instants: bands,
         probability_unstable: p(count(|t| t.unstable)),
         probability_below_reserve: p(count(|t| t.below_reserve)),
@@ -440,7 +576,7 @@ pub fn plan_bands(
         confidence_level_nondim: uncertainty::CONFIDENCE,
         method: METHOD.into(),
         plan,
-    })
+    }
 }
 
 #[cfg(test)]
