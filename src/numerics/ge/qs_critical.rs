@@ -158,23 +158,35 @@ struct Searcher<'a, K: Fn(f64) -> Kinematics> {
     kin: K,
     qep_solves: usize,
     equilibria: usize,
-    /// Last equilibrium found (warm start of the next).
+    /// Last equilibrium found.
     last: Option<Vec<f64>>,
+    /// Every equilibrium found, by parameter: the next one starts from the
+    /// nearest (a start far along the parameter, e.g. the end of the scan
+    /// when the QEP bisection goes back to its beginning, can converge in
+    /// wind to a spurious buckled equilibrium with almost no tension).
+    known: Vec<(f64, Vec<f64>)>,
 }
 
 impl<K: Fn(f64) -> Kinematics> Searcher<'_, K> {
     fn equilibrium(&mut self, p: f64) -> Result<Vec<f64>, NewtonFailure> {
         self.equilibria += 1;
         let kin = (self.kin)(p);
+        let start = self
+            .known
+            .iter()
+            .min_by(|a, b| (a.0 - p).abs().total_cmp(&(b.0 - p).abs()))
+            .map(|k| k.1.as_slice())
+            .or(self.last.as_deref());
         let eq = wind_equilibrium(
             self.model,
             kin,
             self.load,
             self.air,
             &self.config.state,
-            self.last.as_deref(),
+            start,
         )?;
         self.last = Some(eq.q.clone());
+        self.known.push((p, eq.q.clone()));
         Ok(eq.q)
     }
 
@@ -276,6 +288,7 @@ pub fn search_onset(
         qep_solves: 0,
         equilibria: 0,
         last: None,
+        known: Vec::new(),
     };
     let mut out = QsSearch {
         onset: QsOnset::Cancelled,
