@@ -93,6 +93,15 @@ pub async fn compute_envelope(
                 ),
             ));
         }
+        if req.uses_ge() && points > envelope::MAX_SYNC_GE_ENVELOPE_POINTS {
+            return Err(ApiError::too_large(
+                "tether_lengths_m.count",
+                format!(
+                    "the envelope has {points} points; synchronous envelopes with the quasi-static GE stability have at most {} (submit a job with \"kind\": \"envelope\")",
+                    envelope::MAX_SYNC_GE_ENVELOPE_POINTS
+                ),
+            ));
+        }
         to_json(&envelope::envelope(&req, Parallelism::Rayon, &Deadline::after(ctx))?)
     })
     .await

@@ -27,11 +27,17 @@
 //! slow transverse eigenvalues is larger still: calm-air states that are
 //! stable by the Kelvin–Tait–Chetaev theorem come out with spurious growth
 //! rates of 0.05–0.2 1/s (measured, 10–40 elements). The envelope
-//! therefore uses the rotary inertia of the thesis's Table 7.1 convention,
-//! `I_ρ = ρA · (1 m)²` ([`ROTARY_INERTIA_RADIUS_M`]); the slow transverse
-//! modes that decide stability (wavelengths ≥ the tether length ≫ 1 m)
-//! change by `O((2π · 1 m/L)²)`, and a divergence boundary (calm air) does
-//! not depend on the inertia at all.
+//! therefore uses `I_ρ = ρA r²` with `r = 0.1 m` ([`ROTARY_INERTIA_RADIUS_M`]):
+//! the tolerance drops to 4·10⁻⁴ 1/s and the calm-air verdicts follow the
+//! Kelvin–Tait–Chetaev divergence root; the slow transverse modes that
+//! decide stability (wavelengths ≥ the tether length ≫ r) change by
+//! `O((2π r/L)²)`, and a divergence boundary (calm air) does not depend on
+//! the inertia at all. The price is the rotation wave speed
+//! `c_r = √(EI/I_ρ)`: a sliding beam paid out near it is unstable for that
+//! reason alone (measured with `r = 1 m`, EI = 1 N m²: `c_r` = 3.6 m/s, a
+//! 100 m tether paid out at 30 m/s grows at 3 1/s). Payout rates at or
+//! above [`ROTATION_WAVE_FRACTION`] `· c_r` are refused, and the rate
+//! search stops there.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -55,7 +61,17 @@ use crate::numerics::tether::equilibrium::EquilibriumConfig;
 
 /// Radius of gyration (m) of the rotary inertia `I_ρ = ρA r²` of the
 /// envelope's GE model (see the module docs).
-pub const ROTARY_INERTIA_RADIUS_M: f64 = 1.0;
+pub const ROTARY_INERTIA_RADIUS_M: f64 = 0.1;
+/// Fastest payout (and top of the rate search) as a fraction of the rotation
+/// wave speed `√(EI/I_ρ)` (see the module docs).
+pub const ROTATION_WAVE_FRACTION: f64 = 0.5;
+
+/// The rotation wave speed `√(EI/I_ρ)` of the envelope's GE model (m/s).
+pub fn rotation_wave_speed_m_s(bending_stiffness_n_m2: f64, mass_per_length_kg_m: f64) -> f64 {
+    (bending_stiffness_n_m2
+        / (mass_per_length_kg_m * ROTARY_INERTIA_RADIUS_M * ROTARY_INERTIA_RADIUS_M))
+        .sqrt()
+}
 /// Default elements of the envelope's GE model.
 pub const DEFAULT_ELEMENTS: usize = 20;
 /// Largest elements of the envelope's GE model.
@@ -106,6 +122,26 @@ pub struct GeRow {
 }
 
 impl GeStabilitySpec {
+    /// Refuses a payout rate at or above [`ROTATION_WAVE_FRACTION`] of the
+    /// rotation wave speed of the model.
+    pub fn validate_rate(
+        &self,
+        mass_per_length_kg_m: f64,
+        rate_m_s: f64,
+    ) -> Result<(), InvalidInput> {
+        let cap = ROTATION_WAVE_FRACTION
+            * rotation_wave_speed_m_s(self.bending_stiffness_n_m2, mass_per_length_kg_m);
+        if rate_m_s.abs() >= cap {
+            return Err(InvalidInput::new(
+                "payout_rate_m_s",
+                format!(
+                    "must be below {cap:.4} m/s with the quasi-static GE stability: {ROTATION_WAVE_FRACTION} of the rotation wave speed √(EI/I_ρ) of the model (I_ρ = ρA·({ROTARY_INERTIA_RADIUS_M} m)²); raise stability.bending_stiffness_n_m2 or lower the rate"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     pub fn validate(&self) -> Result<(), InvalidInput> {
         require_positive(
             "stability.bending_stiffness_n_m2",
@@ -186,7 +222,10 @@ fn rate_search_max(model: &GeModel, air: &AirLoads, load: TipLoad, length_m: f64
         + q * (air.aerostat_lift_area_m2.abs() + air.aerostat_drag_area_m2)
         + model.section.mass_per_length_kg_m * model.gravity_m_s2 * length_m
         + q * air.cable_diameter_m * air.cable_normal_drag_coefficient * length_m;
-    2.0 * (bound / model.section.mass_per_length_kg_m).sqrt()
+    let rotation =
+        (model.section.bending_stiffness_n_m2 / model.section.rotary_inertia_kg_m).sqrt();
+    (2.0 * (bound / model.section.mass_per_length_kg_m).sqrt())
+        .min(ROTATION_WAVE_FRACTION * rotation)
 }
 
 /// The two searches of one wind speed.
@@ -257,6 +296,7 @@ pub fn ge_row(
             "the quasi-static GE stability needs the payout rate",
         )
     })?;
+    spec.validate_rate(problem.base.cable.mass_per_length_kg_m, rate)?;
     let config = EquilibriumConfig {
         keep_shape: false,
         ..*config
