@@ -109,6 +109,9 @@ pub struct GeWindLimitOutput {
     pub critical_downwind_m: Option<f64>,
     /// Upper end of the length search (m): the static lift limit or the longest grid length.
     pub length_search_max_m: f64,
+    /// With `never`: altitude of the blown-down aerostat at `length_search_max_m` (m),
+    /// stable up to there.
+    pub stable_up_to_altitude_m: Option<f64>,
     /// Length of the rate search (m).
     pub critical_rate_length_m: f64,
     /// As `critical_length_outcome`, along the payout rate.
@@ -163,6 +166,10 @@ pub fn ge_output(
                 critical_altitude_m: state.map(|s| s.tip_altitude_m),
                 critical_downwind_m: state.map(|s| s.tip_downwind_m),
                 length_search_max_m: w.length_search_max_m,
+                stable_up_to_altitude_m: match w.critical_length.onset {
+                    QsOnset::Never { .. } => w.critical_length.at_onset.map(|s| s.tip_altitude_m),
+                    _ => None,
+                },
                 critical_rate_length_m: spec.critical_rate_length_m,
                 critical_rate_outcome: ro.into(),
                 critical_rate_m_s: rate,

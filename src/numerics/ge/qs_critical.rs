@@ -258,6 +258,35 @@ pub fn search_onset(
     kin: impl Fn(f64) -> Kinematics,
     cancel: &dyn Fn() -> bool,
 ) -> Result<QsSearch, InvalidInput> {
+    search_onset_from(
+        model,
+        net_buoyancy_n,
+        air,
+        motion,
+        config,
+        range,
+        kin,
+        cancel,
+        None,
+    )
+}
+
+/// [`search_onset`] with the first equilibrium's Newton started from
+/// `start` (an equilibrium near the lower end, e.g. continued along the
+/// length: in strong wind on a long tether the start from the straight
+/// calm state can land on a compressed branch).
+#[allow(clippy::too_many_arguments)]
+pub fn search_onset_from(
+    model: &GeModel,
+    net_buoyancy_n: f64,
+    air: &AirLoads,
+    motion: StateMotion,
+    config: &QsSearchConfig,
+    range: (f64, f64),
+    kin: impl Fn(f64) -> Kinematics,
+    cancel: &dyn Fn() -> bool,
+    start: Option<&[f64]>,
+) -> Result<QsSearch, InvalidInput> {
     config.validate()?;
     require_positive("net_buoyancy_n", net_buoyancy_n)?;
     if !config.confirm_with_qep && !air.is_calm() {
@@ -287,7 +316,7 @@ pub fn search_onset(
         kin,
         qep_solves: 0,
         equilibria: 0,
-        last: None,
+        last: start.map(<[f64]>::to_vec),
         known: Vec::new(),
     };
     let mut out = QsSearch {
@@ -588,11 +617,38 @@ pub fn critical_rate(
     config: &QsSearchConfig,
     cancel: &dyn Fn() -> bool,
 ) -> Result<QsSearch, InvalidInput> {
+    critical_rate_from(
+        model,
+        net_buoyancy_n,
+        air,
+        length_m,
+        max_rate_m_s,
+        motion,
+        config,
+        cancel,
+        None,
+    )
+}
+
+/// [`critical_rate`] with the first Newton started from `start` (see
+/// [`search_onset_from`]).
+#[allow(clippy::too_many_arguments)]
+pub fn critical_rate_from(
+    model: &GeModel,
+    net_buoyancy_n: f64,
+    air: &AirLoads,
+    length_m: f64,
+    max_rate_m_s: f64,
+    motion: StateMotion,
+    config: &QsSearchConfig,
+    cancel: &dyn Fn() -> bool,
+    start: Option<&[f64]>,
+) -> Result<QsSearch, InvalidInput> {
     require_positive("length_m", length_m)?;
     require_positive("max_rate_m_s", max_rate_m_s)?;
     // At zero rate the calm cable has no damping (purely imaginary
     // spectrum); the search starts at a small fraction of the cap.
-    search_onset(
+    search_onset_from(
         model,
         net_buoyancy_n,
         air,
@@ -605,6 +661,7 @@ pub fn critical_rate(
             acceleration_m_s2: 0.0,
         },
         cancel,
+        start,
     )
 }
 

@@ -48,7 +48,7 @@ use crate::numerics::ge::GeModel;
 use crate::numerics::ge::air_load::AirLoads;
 use crate::numerics::ge::element::TipLoad;
 use crate::numerics::ge::qs_critical::{
-    QsSearch, QsSearchConfig, critical_length, critical_rate, lift_limit_length_m,
+    QsSearch, QsSearchConfig, critical_length, critical_rate_from, lift_limit_length_m,
 };
 use crate::numerics::ge::quasi_static::{QsConfig, WindStateStability, wind_stability};
 use crate::numerics::ge::stability::{GeStateFailure, StateMotion};
@@ -234,6 +234,7 @@ pub fn wind_limits(
     sys: &GeTetherSystem,
     spec: &GeStabilitySpec,
     rate_m_s: f64,
+    rate_start: Option<&[f64]>,
     cancel: &dyn Fn() -> bool,
 ) -> Result<GeWindLimits, InvalidInput> {
     let config = QsSearchConfig::default();
@@ -263,7 +264,7 @@ pub fn wind_limits(
         sys.tip_load,
         spec.critical_rate_length_m,
     );
-    let critical_rate = critical_rate(
+    let critical_rate = critical_rate_from(
         &sys.model,
         sys.net_buoyancy_n,
         &sys.air,
@@ -272,6 +273,7 @@ pub fn wind_limits(
         StateMotion::AtRest,
         &config,
         cancel,
+        rate_start,
     )?;
     Ok(GeWindLimits {
         critical_length,
@@ -304,6 +306,7 @@ pub fn ge_row(
     let sys = ge_system(problem, spec, wind_speed_m_s)?;
     let rho_a = problem.base.cable.mass_per_length_kg_m;
     let mut start: Option<Vec<f64>> = None;
+    let mut rate_seed: Option<Vec<f64>> = None;
     let mut points = Vec::with_capacity(problem.tether_lengths_m.len());
     let mut growth = Vec::with_capacity(problem.tether_lengths_m.len());
     for &l in &problem.tether_lengths_m {
@@ -318,6 +321,9 @@ pub fn ge_row(
                 Ok(w) => {
                     let s = w.spectrum.is_stable();
                     let m = w.spectrum.max_real;
+                    if l <= spec.critical_rate_length_m {
+                        rate_seed = Some(w.state.q.clone());
+                    }
                     start = Some(w.state.q);
                     (Some(s), Some(m))
                 }
@@ -336,7 +342,9 @@ pub fn ge_row(
         });
         growth.push(g);
     }
-    let wind_limits = wind_limits(problem, &sys, spec, rate, cancel)?;
+    // The rate search starts from the row's tensioned branch: the GE
+    // equilibrium of the longest cell at or below its length.
+    let wind_limits = wind_limits(problem, &sys, spec, rate, rate_seed.as_deref(), cancel)?;
     Ok(GeRow {
         points,
         max_growth_rate_1_s: growth,
