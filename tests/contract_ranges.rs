@@ -962,23 +962,6 @@ fn cases() -> Vec<Case> {
             "gravity_m_s2",
             GE_GRAVITY_M_S2,
         ),
-        // the envelope's quasi-static GE stability
-        case(
-            "envelope",
-            json!({
-                "cable": {"preset": "dyneema", "diameter_m": 0.006},
-                "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0,
-                             "drag_coefficient_nondim": 0.3, "reference_area_m2": 20.0},
-                "wind": {"shape": {"kind": "uniform"}},
-                "wind_speeds_m_s": {"min": 0.0, "max": 10.0, "count": 2},
-                "tether_lengths_m": {"min": 100.0, "max": 1000.0, "count": 2},
-                "payout_rate_m_s": 5.0,
-                "stability": {"method": "quasi_static_ge", "bending_stiffness_n_m2": 1.0,
-                              "elements": 20}
-            }),
-            "stability.elements",
-            Range::new(2.0, 80.0, ""),
-        ),
     ]
 }
 
