@@ -1,12 +1,14 @@
 //! Speed of the static tether in wind (issue 12 targets in brackets): one
 //! equilibrium with tether drag in a uniform and a log-law wind, 100 RK4
 //! steps (the default) [≤ 100 µs]; an envelope of 40 winds × 50 lengths without stability,
-//! power-law wind, on rayon [≤ 0.5 s on 2 cores].
+//! power-law wind, on rayon [≤ 0.5 s on 2 cores]; the same envelope with
+//! the quasi-static GE stability [≤ 30 s on 2 cores].
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use tetherplan::numerics::chart::Parallelism;
 use tetherplan::numerics::tether::envelope::{EnvelopeProblem, Limits, WindShape};
+use tetherplan::numerics::tether::envelope_ge::{DEFAULT_ELEMENTS, GeStabilitySpec, solve_ge};
 use tetherplan::numerics::tether::presets::CablePreset;
 use tetherplan::numerics::tether::{
     Body, Cable, EquilibriumConfig, EquilibriumProblem, WindProfile,
@@ -66,6 +68,35 @@ fn benches(c: &mut Criterion) {
             env.solve(&config, Parallelism::Rayon, &|_, _| {}, &|| false)
                 .unwrap()
                 .unwrap()
+        })
+    });
+    group.finish();
+    // Issue 12: the same envelope judged by the quasi-static GE stability
+    // at 5 m/s payout (EI = 1 N m², 20 elements, the default mesh): one GE
+    // cell per point, continued along the length, plus per wind the
+    // critical length and rate [≤ 30 s on 2 cores].
+    let mut ge_env = env.clone();
+    ge_env.limits.payout_rate_m_s = Some(5.0);
+    let spec = GeStabilitySpec {
+        bending_stiffness_n_m2: 1.0,
+        aerostat_mass_kg: 100.0,
+        elements: DEFAULT_ELEMENTS,
+        critical_rate_length_m: 3000.0,
+    };
+    let mut group = c.benchmark_group("envelope_qs_ge");
+    group.sample_size(10);
+    group.bench_function("envelope_40x50_qs_ge_stability_rayon", |b| {
+        b.iter(|| {
+            solve_ge(
+                &ge_env,
+                &spec,
+                &config,
+                Parallelism::Rayon,
+                &|_, _| {},
+                &|| false,
+            )
+            .unwrap()
+            .unwrap()
         })
     });
     group.finish();

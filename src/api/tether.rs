@@ -56,6 +56,15 @@ solve_path!(
                 ),
             ));
         }
+        if req.uses_ge() && points > envelope::MAX_SYNC_GE_ENVELOPE_POINTS {
+            return Err(ApiError::too_large(
+                "tether_lengths_m.count",
+                format!(
+                    "the envelope has {points} points; synchronous envelopes with the quasi-static GE stability have at most {} (submit a job with \"kind\": \"envelope\")",
+                    envelope::MAX_SYNC_GE_ENVELOPE_POINTS
+                ),
+            ));
+        }
         to_json(&envelope::envelope(&req, Parallelism::Rayon, &Deadline::after(ctx))?)
     }
 );

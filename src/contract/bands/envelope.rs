@@ -230,6 +230,13 @@ pub fn prepare_envelope_bands(
     req: &EnvelopeBandsRequest,
 ) -> Result<PreparedEnvelopeBands, RequestError> {
     let (problem, _) = req.envelope.problem()?;
+    if req.envelope.uses_ge() {
+        return Err(InvalidInput::new(
+            "stability.method",
+            "envelope bands judge stability by the string criterion only; quasi_static_ge is not supported here",
+        )
+        .into());
+    }
     let u = &req.params.uncertainty;
     let ensemble = common::ensemble_of(u)?;
     let total = envelope_band_evaluations(req);

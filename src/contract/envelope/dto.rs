@@ -110,6 +110,9 @@ pub struct EnvelopeRequest {
     #[serde(default = "default_steps")]
     #[schema(example = 100, minimum = 8, maximum = 100000)]
     pub integration_steps: usize,
+    /// How stability is judged at `payout_rate_m_s`; absent: the string criterion.
+    #[serde(default)]
+    pub stability: Option<super::stability::EnvelopeStabilityInput>,
 }
 
 /// One grid point.
@@ -131,6 +134,11 @@ pub struct EnvelopePointOutput {
     pub stability_margin_n: Option<f64>,
     /// With a payout rate: stable or not; null without one.
     pub stable: Option<bool>,
+    /// With the quasi-static GE stability: max Re λ of the cell's local QEP
+    /// (1/s); absent with the string criterion and for cells not solved
+    /// (slack, not converged) or whose GE equilibrium failed (unstable).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_growth_rate_1_s: Option<f64>,
     /// Inside every limit.
     pub feasible: bool,
     /// The first limit violated: `slack`, `tension`, `ceiling`, `stability`, `not_converged`.
@@ -175,4 +183,8 @@ pub struct EnvelopeResponse {
     pub cable: ResolvedCableOutput,
     pub aerostat: ResolvedAerostatOutput,
     pub integration_steps: usize,
+    /// With `stability.method = quasi_static_ge`: the model and, per wind
+    /// speed, the maximum safe length/altitude and the critical payout rate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quasi_static_ge: Option<super::stability::GeStabilityOutput>,
 }

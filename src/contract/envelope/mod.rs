@@ -4,6 +4,7 @@
 //! `POST /api/v1/equilibrium` for the same inputs (a test checks it).
 
 pub mod dto;
+pub mod stability;
 
 use crate::contract::equilibrium::dto::{ResolvedAerostatOutput, ResolvedCableOutput};
 use crate::contract::equilibrium::{require_count, require_range};
@@ -16,6 +17,12 @@ use dto::*;
 
 /// Points a synchronous envelope may have (about 0.1 s of CPU at 100 steps).
 pub const MAX_SYNC_ENVELOPE_POINTS: usize = 5_000;
+
+/// What "stable" means with `stability.method = quasi_static_ge`.
+pub const GE_STABILITY_CRITERION: &str = "quasi-static GE stability of the blown-down tether at the payout rate (geometrically exact beam, blown-down equilibrium, local QEP with the payout's rate terms and the linearised air loads): stable iff max Re λ ≤ the spectrum tolerance; slack cells count as unstable";
+
+/// Points a synchronous envelope with the quasi-static GE stability may have.
+pub const MAX_SYNC_GE_ENVELOPE_POINTS: usize = 500;
 
 /// What "stable" means in the envelope.
 pub const STABILITY_CRITERION: &str = "continuum linear-string criterion of SPEC §1 applied to the blown-down tether: stable while the smallest tension exceeds the kinematic term ρA v² (calm air: h* = (F/ρA − v²)/g)";
@@ -168,8 +175,40 @@ impl EnvelopeRequest {
     }
 
     pub fn validate(&self) -> Result<(), RequestError> {
-        self.problem()?;
+        self.ge_problem()?;
         Ok(())
+    }
+
+    /// The sweep, its configuration and the GE settings (`None`: the string criterion).
+    #[allow(clippy::type_complexity)]
+    pub fn ge_problem(
+        &self,
+    ) -> Result<
+        (
+            EnvelopeProblem,
+            EquilibriumConfig,
+            Option<crate::numerics::tether::envelope_ge::GeStabilitySpec>,
+        ),
+        InvalidInput,
+    > {
+        let (problem, config) = self.problem()?;
+        let longest = problem.tether_lengths_m.iter().copied().fold(0.0, f64::max);
+        let spec = match &self.stability {
+            Some(s) => s.spec(self.aerostat.mass_kg, longest, self.payout_rate_m_s)?,
+            None => None,
+        };
+        if let (Some(spec), Some(v)) = (&spec, self.payout_rate_m_s) {
+            spec.validate_rate(problem.base.cable.mass_per_length_kg_m, v)?;
+        }
+        Ok((problem, config, spec))
+    }
+
+    /// Whether the quasi-static GE judges stability.
+    pub fn uses_ge(&self) -> bool {
+        matches!(
+            self.stability,
+            Some(stability::EnvelopeStabilityInput::QuasiStaticGe { .. })
+        )
     }
 }
 
@@ -179,18 +218,35 @@ pub fn envelope(
     parallelism: Parallelism,
     progress: &dyn Progress,
 ) -> Result<EnvelopeResponse, RequestError> {
-    let (problem, config) = req.problem()?;
+    let (problem, config, spec) = req.ge_problem()?;
     let report = |done: usize, total: usize| progress.report(done, total);
     let cancelled = || progress.cancelled();
-    let Some(env) = problem.solve(&config, parallelism, &report, &cancelled)? else {
-        return Err(RequestError::Cancelled);
+    let (env, ge) = match &spec {
+        None => match problem.solve(&config, parallelism, &report, &cancelled)? {
+            Some(env) => (env, None),
+            None => return Err(RequestError::Cancelled),
+        },
+        Some(spec) => {
+            match crate::numerics::tether::envelope_ge::solve_ge(
+                &problem,
+                spec,
+                &config,
+                parallelism,
+                &report,
+                &cancelled,
+            )? {
+                Some(ge) => (ge.envelope.clone(), Some(ge)),
+                None => return Err(RequestError::Cancelled),
+            }
+        }
     };
     let name =
         |l: Option<crate::numerics::tether::envelope::Limit>| l.map(|l| l.name().to_string());
     let points: Vec<EnvelopePointOutput> = env
         .points
         .iter()
-        .map(|p| {
+        .enumerate()
+        .map(|(k, p)| {
             let e = &p.equilibrium;
             EnvelopePointOutput {
                 wind_speed_m_s: p.wind_speed_m_s,
@@ -208,6 +264,7 @@ pub fn envelope(
                 stable: p.verdict.stable,
                 feasible: p.verdict.limit.is_none(),
                 binding_limit: name(p.verdict.limit),
+                max_growth_rate_1_s: ge.as_ref().and_then(|g| g.max_growth_rate_1_s[k]),
             }
         })
         .collect();
@@ -254,7 +311,12 @@ pub fn envelope(
         required_safety_factor_nondim: req.required_safety_factor_nondim,
         ceiling_m: req.ceiling_m,
         payout_rate_m_s: req.payout_rate_m_s,
-        stability_criterion: STABILITY_CRITERION.to_string(),
+        stability_criterion: if spec.is_some() {
+            GE_STABILITY_CRITERION
+        } else {
+            STABILITY_CRITERION
+        }
+        .to_string(),
         cable: ResolvedCableOutput {
             mass_per_length_kg_m: c.mass_per_length_kg_m,
             diameter_m: c.diameter_m,
@@ -269,5 +331,13 @@ pub fn envelope(
             reference_area_m2: b.reference_area_m2,
         },
         integration_steps: config.steps,
+        quasi_static_ge: spec.as_ref().zip(ge.as_ref()).map(|(spec, ge)| {
+            stability::ge_output(
+                spec,
+                problem.base.cable.mass_per_length_kg_m,
+                &problem.wind_speeds_m_s,
+                ge,
+            )
+        }),
     })
 }

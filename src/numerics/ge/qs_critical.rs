@@ -158,23 +158,35 @@ struct Searcher<'a, K: Fn(f64) -> Kinematics> {
     kin: K,
     qep_solves: usize,
     equilibria: usize,
-    /// Last equilibrium found (warm start of the next).
+    /// Last equilibrium found.
     last: Option<Vec<f64>>,
+    /// Every equilibrium found, by parameter: the next one starts from the
+    /// nearest (a start far along the parameter, e.g. the end of the scan
+    /// when the QEP bisection goes back to its beginning, can converge in
+    /// wind to a spurious buckled equilibrium with almost no tension).
+    known: Vec<(f64, Vec<f64>)>,
 }
 
 impl<K: Fn(f64) -> Kinematics> Searcher<'_, K> {
     fn equilibrium(&mut self, p: f64) -> Result<Vec<f64>, NewtonFailure> {
         self.equilibria += 1;
         let kin = (self.kin)(p);
+        let start = self
+            .known
+            .iter()
+            .min_by(|a, b| (a.0 - p).abs().total_cmp(&(b.0 - p).abs()))
+            .map(|k| k.1.as_slice())
+            .or(self.last.as_deref());
         let eq = wind_equilibrium(
             self.model,
             kin,
             self.load,
             self.air,
             &self.config.state,
-            self.last.as_deref(),
+            start,
         )?;
         self.last = Some(eq.q.clone());
+        self.known.push((p, eq.q.clone()));
         Ok(eq.q)
     }
 
@@ -246,6 +258,35 @@ pub fn search_onset(
     kin: impl Fn(f64) -> Kinematics,
     cancel: &dyn Fn() -> bool,
 ) -> Result<QsSearch, InvalidInput> {
+    search_onset_from(
+        model,
+        net_buoyancy_n,
+        air,
+        motion,
+        config,
+        range,
+        kin,
+        cancel,
+        None,
+    )
+}
+
+/// [`search_onset`] with the first equilibrium's Newton started from
+/// `start` (an equilibrium near the lower end, e.g. continued along the
+/// length: in strong wind on a long tether the start from the straight
+/// calm state can land on a compressed branch).
+#[allow(clippy::too_many_arguments)]
+pub fn search_onset_from(
+    model: &GeModel,
+    net_buoyancy_n: f64,
+    air: &AirLoads,
+    motion: StateMotion,
+    config: &QsSearchConfig,
+    range: (f64, f64),
+    kin: impl Fn(f64) -> Kinematics,
+    cancel: &dyn Fn() -> bool,
+    start: Option<&[f64]>,
+) -> Result<QsSearch, InvalidInput> {
     config.validate()?;
     require_positive("net_buoyancy_n", net_buoyancy_n)?;
     if !config.confirm_with_qep && !air.is_calm() {
@@ -275,7 +316,8 @@ pub fn search_onset(
         kin,
         qep_solves: 0,
         equilibria: 0,
-        last: None,
+        last: start.map(<[f64]>::to_vec),
+        known: Vec::new(),
     };
     let mut out = QsSearch {
         onset: QsOnset::Cancelled,
@@ -575,11 +617,38 @@ pub fn critical_rate(
     config: &QsSearchConfig,
     cancel: &dyn Fn() -> bool,
 ) -> Result<QsSearch, InvalidInput> {
+    critical_rate_from(
+        model,
+        net_buoyancy_n,
+        air,
+        length_m,
+        max_rate_m_s,
+        motion,
+        config,
+        cancel,
+        None,
+    )
+}
+
+/// [`critical_rate`] with the first Newton started from `start` (see
+/// [`search_onset_from`]).
+#[allow(clippy::too_many_arguments)]
+pub fn critical_rate_from(
+    model: &GeModel,
+    net_buoyancy_n: f64,
+    air: &AirLoads,
+    length_m: f64,
+    max_rate_m_s: f64,
+    motion: StateMotion,
+    config: &QsSearchConfig,
+    cancel: &dyn Fn() -> bool,
+    start: Option<&[f64]>,
+) -> Result<QsSearch, InvalidInput> {
     require_positive("length_m", length_m)?;
     require_positive("max_rate_m_s", max_rate_m_s)?;
     // At zero rate the calm cable has no damping (purely imaginary
     // spectrum); the search starts at a small fraction of the cap.
-    search_onset(
+    search_onset_from(
         model,
         net_buoyancy_n,
         air,
@@ -592,6 +661,7 @@ pub fn critical_rate(
             acceleration_m_s2: 0.0,
         },
         cancel,
+        start,
     )
 }
 

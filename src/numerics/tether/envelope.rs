@@ -80,6 +80,19 @@ pub enum Limit {
 }
 
 impl Limit {
+    /// The limit of a [`Limit::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        [
+            Self::Slack,
+            Self::Tension,
+            Self::Ceiling,
+            Self::Stability,
+            Self::NotConverged,
+        ]
+        .into_iter()
+        .find(|l| l.name() == name)
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Self::Slack => "slack",
@@ -118,6 +131,18 @@ pub fn judge(eq: &Equilibrium, mass_per_length_kg_m: f64, limits: &Limits) -> Ve
         .payout_rate_m_s
         .map(|v| eq.min_tension_n - mass_per_length_kg_m * v * v);
     let stable = stability_margin_n.map(|m| m > 0.0 && !eq.slack);
+    judge_with(eq, limits, stability_margin_n, stable)
+}
+
+/// Judges one equilibrium with a stability verdict made elsewhere (the
+/// quasi-static GE of [`super::envelope_ge`]): the static limits first, in
+/// the order of the module docs, then `stable`.
+pub fn judge_with(
+    eq: &Equilibrium,
+    limits: &Limits,
+    stability_margin_n: Option<f64>,
+    stable: Option<bool>,
+) -> Verdict {
     let limit = if !eq.converged {
         Some(Limit::NotConverged)
     } else if eq.slack || eq.min_tension_n <= 0.0 {
@@ -272,7 +297,8 @@ impl EnvelopeProblem {
     }
 }
 
-fn summarise(rows: Vec<Vec<EnvelopePoint>>, winds: &[f64], lengths: usize) -> Envelope {
+/// The envelope from its rows (one per wind speed, in grid order).
+pub fn summarise(rows: Vec<Vec<EnvelopePoint>>, winds: &[f64], lengths: usize) -> Envelope {
     // Winds in increasing order for "every wind up to".
     let mut order: Vec<usize> = (0..winds.len()).collect();
     order.sort_by(|&a, &b| winds[a].abs().total_cmp(&winds[b].abs()));

@@ -6,6 +6,7 @@
 //! operating envelope over wind speed × tether length ([`envelope`]).
 
 pub mod envelope;
+pub mod envelope_ge;
 pub mod equilibrium;
 pub mod presets;
 pub mod string_tension;
