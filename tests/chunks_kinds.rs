@@ -183,6 +183,73 @@ fn chunked_envelope_bands_are_the_single_process_envelope_bands() {
     assert_eq!(v["cells"].as_array().unwrap().len(), 42);
 }
 
+/// The operating envelope (string criterion) over 9 winds × 8 lengths,
+/// with a ceiling and a tension limit so that the per-length limits differ.
+fn string_envelope() -> Value {
+    json!({"kind": "envelope", "request": {
+        "cable": {"preset": "dyneema", "diameter_m": 0.006},
+        "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
+                     "reference_area_m2": 20.0},
+        "wind": {"shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0},
+                 "air_density_kg_m3": 1.225},
+        "wind_speeds_m_s": {"min": 0.0, "max": 40.0, "count": 9},
+        "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 8},
+        "required_safety_factor_nondim": 5.0,
+        "ceiling_m": 2500.0,
+        "payout_rate_m_s": 5.0
+    }})
+}
+
+/// The envelope judged by the quasi-static GE (Table 7.1 cable, as
+/// tests/verification_envelope_ge.rs), 3 winds × 4 lengths across the
+/// calm-air onset near 1252 m.
+fn ge_envelope() -> Value {
+    json!({"kind": "envelope", "request": {
+        "cable": {"mass_per_length_kg_m": 0.078, "diameter_m": 0.0036,
+                  "normal_drag_coefficient_nondim": 1.2},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.3,
+                     "reference_area_m2": 3.0},
+        "wind": {"shape": {"kind": "uniform"}, "air_density_kg_m3": 1.225},
+        "wind_speeds_m_s": {"min": 0.0, "max": 10.0, "count": 3},
+        "tether_lengths_m": {"min": 1150.0, "max": 1300.0, "count": 4},
+        "required_safety_factor_nondim": 1.0,
+        "payout_rate_m_s": 30.0,
+        "stability": {"method": "quasi_static_ge", "bending_stiffness_n_m2": 10.0,
+                      "elements": 10, "critical_rate_length_m": 1150.0}
+    }})
+}
+
+#[test]
+fn chunked_envelopes_are_the_single_process_envelope() {
+    let single = assembled_equals_single(&string_envelope(), 9);
+    let v: Value = serde_json::from_str(&single).unwrap();
+    assert_eq!(v["points"].as_array().unwrap().len(), 72);
+    // The per-length limits need every row: some lengths are limited by a
+    // wind in the grid, others are inside up to the strongest wind or
+    // outside at calm air.
+    let limits = v["max_wind_per_length"].as_array().unwrap();
+    let winds: Vec<Option<f64>> = limits
+        .iter()
+        .map(|l| l["max_wind_speed_m_s"].as_f64())
+        .collect();
+    assert!(
+        winds.iter().any(|w| w.is_some_and(|w| w > 0.0 && w < 40.0)),
+        "{winds:?}"
+    );
+    assert!(limits.iter().any(|l| l["binding_limit"].is_string()));
+
+    let single = assembled_equals_single(&ge_envelope(), 3);
+    let v: Value = serde_json::from_str(&single).unwrap();
+    assert_eq!(v["quasi_static_ge"]["per_wind"].as_array().unwrap().len(), 3);
+    // In calm air the 10-element onset (1288.6 m) lies inside the grid:
+    // the calm row has stable and unstable cells.
+    let calm: Vec<bool> = v["points"].as_array().unwrap()[..4]
+        .iter()
+        .map(|p| p["stable"].as_bool().unwrap())
+        .collect();
+    assert_eq!(calm, [true, true, true, false], "{calm:?}");
+}
+
 struct Db {
     dir: std::path::PathBuf,
 }

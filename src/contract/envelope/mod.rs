@@ -3,6 +3,7 @@
 //! ([`crate::numerics::tether::envelope`]). Each point is the answer of
 //! `POST /api/v1/equilibrium` for the same inputs (a test checks it).
 
+pub mod chunks;
 pub mod dto;
 pub mod stability;
 
@@ -219,18 +220,30 @@ pub fn envelope(
     progress: &dyn Progress,
 ) -> Result<EnvelopeResponse, RequestError> {
     let (problem, config, spec) = req.ge_problem()?;
+    envelope_of(req, &problem, &config, spec.as_ref(), parallelism, progress)
+}
+
+/// The envelope of `problem` (the request's, or its rows of one chunk).
+pub(crate) fn envelope_of(
+    req: &EnvelopeRequest,
+    problem: &EnvelopeProblem,
+    config: &EquilibriumConfig,
+    spec: Option<&crate::numerics::tether::envelope_ge::GeStabilitySpec>,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<EnvelopeResponse, RequestError> {
     let report = |done: usize, total: usize| progress.report(done, total);
     let cancelled = || progress.cancelled();
-    let (env, ge) = match &spec {
-        None => match problem.solve(&config, parallelism, &report, &cancelled)? {
+    let (env, ge) = match spec {
+        None => match problem.solve(config, parallelism, &report, &cancelled)? {
             Some(env) => (env, None),
             None => return Err(RequestError::Cancelled),
         },
         Some(spec) => {
             match crate::numerics::tether::envelope_ge::solve_ge(
-                &problem,
+                problem,
                 spec,
-                &config,
+                config,
                 parallelism,
                 &report,
                 &cancelled,
@@ -268,28 +281,8 @@ pub fn envelope(
             }
         })
         .collect();
-    let nl = problem.tether_lengths_m.len();
-    let max_wind_per_length = problem
-        .tether_lengths_m
-        .iter()
-        .zip(&env.max_wind_per_length)
-        .enumerate()
-        .map(|(j, (&l, &(wind, limit)))| {
-            let altitude = wind.and_then(|w| {
-                problem
-                    .wind_speeds_m_s
-                    .iter()
-                    .position(|&u| u == w)
-                    .map(|i| points[i * nl + j].aerostat_altitude_m)
-            });
-            LengthLimitOutput {
-                tether_length_m: l,
-                max_wind_speed_m_s: wind,
-                altitude_at_max_wind_m: altitude,
-                binding_limit: name(limit),
-            }
-        })
-        .collect();
+    let max_wind_per_length =
+        length_limits(&problem.wind_speeds_m_s, &problem.tether_lengths_m, &points);
     let max_altitude_per_wind = problem
         .wind_speeds_m_s
         .iter()
@@ -331,7 +324,7 @@ pub fn envelope(
             reference_area_m2: b.reference_area_m2,
         },
         integration_steps: config.steps,
-        quasi_static_ge: spec.as_ref().zip(ge.as_ref()).map(|(spec, ge)| {
+        quasi_static_ge: spec.zip(ge.as_ref()).map(|(spec, ge)| {
             stability::ge_output(
                 spec,
                 problem.base.cable.mass_per_length_kg_m,
@@ -340,4 +333,49 @@ pub fn envelope(
             )
         }),
     })
+}
+
+/// The largest operating wind per length from the points (row by row, one
+/// row per wind): the winds are taken in increasing `|U|` and a length's
+/// limit is the last wind before the first point outside the envelope (the
+/// same rule as [`crate::numerics::tether::envelope::summarise`]).
+pub(crate) fn length_limits(
+    winds: &[f64],
+    lengths: &[f64],
+    points: &[EnvelopePointOutput],
+) -> Vec<LengthLimitOutput> {
+    let nl = lengths.len();
+    let mut order: Vec<usize> = (0..winds.len()).collect();
+    order.sort_by(|&a, &b| winds[a].abs().total_cmp(&winds[b].abs()));
+    lengths
+        .iter()
+        .enumerate()
+        .map(|(j, &l)| {
+            let mut best: Option<usize> = None;
+            let mut binding = None;
+            for &i in &order {
+                let p = &points[i * nl + j];
+                if p.feasible {
+                    best = Some(i);
+                } else {
+                    binding = p.binding_limit.clone();
+                    break;
+                }
+            }
+            let wind = best.map(|i| winds[i]);
+            // The altitude is read at the first grid row of that wind speed.
+            let altitude = wind.and_then(|w| {
+                winds
+                    .iter()
+                    .position(|&u| u == w)
+                    .map(|i| points[i * nl + j].aerostat_altitude_m)
+            });
+            LengthLimitOutput {
+                tether_length_m: l,
+                max_wind_speed_m_s: wind,
+                altitude_at_max_wind_m: altitude,
+                binding_limit: binding,
+            }
+        })
+        .collect()
 }
