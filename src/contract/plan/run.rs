@@ -11,6 +11,7 @@ use crate::contract::run::{Progress, RequestError, groups};
 use crate::numerics::params::{InvalidInput, require_finite, require_positive};
 use crate::numerics::plan::air::{Air, SteadyWind};
 use crate::numerics::plan::deadline::{self, Forecast};
+use crate::numerics::plan::ge_stability::{self as ge_plan, GeCriterion, GeStabilityOptions};
 use crate::numerics::plan::retrieval::{self, TransientCheck};
 use crate::numerics::plan::schedule::{self, PlanOptions, PlanOutcome, Schedule};
 use crate::numerics::plan::{BindingLimit, PlanProblem, STABILITY_MARGIN, Winch, validate_jerk};
@@ -108,6 +109,66 @@ fn steady_wind(w: &PlanWindInput) -> Result<SteadyWind, InvalidInput> {
     ))
 }
 
+/// Density of the tether's material assumed for its diameter in calm air
+/// (the GE rotary inertia ρA d²/16 needs one; about that of aramid/UHMWPE).
+pub const CALM_GE_MATERIAL_DENSITY_KG_M3: f64 = 1000.0;
+
+/// Calm air for the GE criterion: the wind path with no wind (the
+/// equilibrium is the straight tether), the diameter from ρA at
+/// [`CALM_GE_MATERIAL_DENSITY_KG_M3`].
+fn calm_wind(mass_per_length_kg_m: f64) -> SteadyWind {
+    let d = (4.0 * mass_per_length_kg_m / (std::f64::consts::PI * CALM_GE_MATERIAL_DENSITY_KG_M3)).sqrt();
+    SteadyWind::new(
+        Cable {
+            mass_per_length_kg_m: 1.0,
+            diameter_m: d,
+            normal_drag_coefficient: 0.0,
+            axial_stiffness_n: None,
+            breaking_strength_n: None,
+        },
+        Body {
+            net_buoyancy_n: 1.0,
+            drag_coefficient: 0.0,
+            lift_coefficient: 0.0,
+            reference_area_m2: 1.0,
+        },
+        crate::numerics::tether::WindProfile::calm(),
+        1.225,
+    )
+}
+
+/// The GE options of the request, if it asks for the GE criterion.
+fn ge_options(req: &PlanRequest) -> Result<Option<GeStabilityOptions>, InvalidInput> {
+    let Some(st) = &req.stability else {
+        return Ok(None);
+    };
+    crate::numerics::params::ranges::BENDING_STIFFNESS_N_M2
+        .check("stability.bending_stiffness_n_m2", st.bending_stiffness_n_m2)?;
+    let o = GeStabilityOptions {
+        bending_stiffness_n_m2: st.bending_stiffness_n_m2,
+        elements: st.elements,
+        check_elements: st.check_elements,
+        table_lengths: st.table_lengths,
+        min_length_m: req.initial_length_m.min(req.target_elevation_m),
+    };
+    o.validate()?;
+    if !(2..=MAX_GE_CHECK_SAMPLES).contains(&st.check_samples) {
+        return Err(InvalidInput::new(
+            "stability.check_samples",
+            format!(
+                "must be between 2 and {MAX_GE_CHECK_SAMPLES}, got {}",
+                st.check_samples
+            ),
+        ));
+    }
+    Ok((st.method == PlanStabilityMethod::QuasiStaticGe).then_some(o))
+}
+
+/// Most schedule samples checked by the GE QEP.
+pub const MAX_GE_CHECK_SAMPLES: usize = 2000;
+/// Re-plans with a lowered GE criterion after a failed check.
+pub const MAX_GE_TIGHTENINGS: usize = 3;
+
 fn bounded(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64, InvalidInput> {
     require_finite(field, value)?;
     if !(lo..=hi).contains(&value) {
@@ -120,6 +181,13 @@ fn bounded(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64, InvalidInpu
 }
 
 fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
+    validate_with(req, true)
+}
+
+/// `resolve`: find the wind target (equilibria; with the GE criterion its
+/// table). Without it (job submission) a GE request's target is only
+/// range-checked.
+fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidInput> {
     let system_input = SystemInput {
         cable: req.cable.clone(),
         aerostat: req.aerostat.clone(),
@@ -131,9 +199,19 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
     let model = system_input.model()?;
     let winch = Winch::new(req.winch.max_rate_m_s, req.winch.max_acceleration_m_s2)?;
     let max_jerk_m_s3 = req.winch.max_jerk_m_s3.map(validate_jerk).transpose()?;
-    let air = match &req.wind {
-        Some(w) => Air::Wind(Box::new(steady_wind(w)?)),
-        None => Air::Calm,
+    let ge = ge_options(req)?;
+    let air = match (&req.wind, ge) {
+        (Some(w), None) => Air::Wind(Box::new(steady_wind(w)?)),
+        (None, None) => Air::Calm,
+        (w, Some(o)) => {
+            let mut sw = match w {
+                Some(w) => steady_wind(w)?,
+                None => calm_wind(model.system.mass_per_length_kg_m),
+            };
+            sw.ge = Some(GeCriterion::new(o));
+            sw.criterion_name = ge_plan::QS_GE_CRITERION;
+            Air::Wind(Box::new(sw))
+        }
     };
     let (allowable, breaking) = match &req.tether {
         Some(t) => {
@@ -151,7 +229,7 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
     };
     require_finite("target_elevation_m", req.target_elevation_m)?;
     // In wind the target is an altitude: the length that flies there.
-    let (target_length, wind) = if air.is_calm() {
+    let (target_length, wind) = if air.is_calm() || (!resolve && air.has_ge()) {
         (req.target_elevation_m, None)
     } else {
         bounded("target_elevation_m", req.target_elevation_m, 0.0, 1e6)?;
@@ -272,7 +350,7 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
 
 /// Checks a plan request without computing it (job submission).
 pub fn validate_plan(req: &PlanRequest) -> Result<(), RequestError> {
-    validate(req)?;
+    validate_with(req, false)?;
     Ok(())
 }
 
@@ -475,6 +553,7 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         limits,
         wind: wind_out.clone(),
         jerk: None,
+        ge_stability: ge_output(&p, &opts.air, None, 0),
         method: method(opts),
         compute_time_s: started.elapsed().as_secs_f64(),
         inputs: inputs.clone(),
@@ -484,6 +563,9 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         return Ok(infeasible(b, limits_base));
     }
 
+    let mut ge_check = None;
+    let mut ge_tightenings = 0;
+    let mut tightened_options: Option<PlanOptions> = None;
     // The schedule (slowed for an amplification limit when retrieving).
     let (sched, check, rate_used, slowed) = match (retrieving, v.amplification_limit) {
         (true, Some(limit)) => {
@@ -507,20 +589,56 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
                 }
             }
         }
-        _ => match schedule::fastest_with(&p, opts) {
-            PlanOutcome::Infeasible(b) => return Ok(infeasible(b, limits_base)),
-            PlanOutcome::Feasible(s) => {
-                let c = retrieval::check_transient(
-                    &v.model,
-                    &s,
-                    req.disturbance_tip_deflection_m,
-                    &observer,
-                )
-                .map_err(from_transient)?;
-                (s, c, p.winch.max_rate_m_s, false)
-            }
-        },
+        _ => {
+            // With the GE criterion: check the schedule by the GE QEP and
+            // re-plan with a lowered criterion while a sample fails.
+            let mut tightened = v.options.clone();
+            let mut tightenings = 0;
+            let s = loop {
+                let s = match schedule::fastest_with(&p, &tightened) {
+                    PlanOutcome::Infeasible(b) => return Ok(infeasible(b, limits_base)),
+                    PlanOutcome::Feasible(s) => s,
+                };
+                let Some(chk) = ge_check_of(&tightened.air, &s, ge_check_count(req)) else {
+                    break s;
+                };
+                if chk.failed == 0 {
+                    ge_check = Some(chk);
+                    break s;
+                }
+                if tightenings >= MAX_GE_TIGHTENINGS {
+                    return Ok(infeasible(ge_binding(&chk), limits_base));
+                }
+                tightenings += 1;
+                let offset = 0.02 * 4f64.powi(tightenings as i32 - 1) * p.reserve_buoyancy_n();
+                if let Air::Wind(w) = &mut tightened.air
+                    && let Some(ge) = &w.ge
+                {
+                    w.ge = Some(ge.with_offset(offset));
+                }
+            };
+            ge_tightenings = tightenings;
+            tightened_options = Some(tightened);
+            let c = retrieval::check_transient(
+                &v.model,
+                &s,
+                req.disturbance_tip_deflection_m,
+                &observer,
+            )
+            .map_err(from_transient)?;
+            (s, c, p.winch.max_rate_m_s, false)
+        }
     };
+    if ge_check.is_none()
+        && let Some(chk) = ge_check_of(&opts.air, &sched, ge_check_count(req))
+    {
+        // The amplification-bounded retrieval: checked, not tightened.
+        if chk.failed > 0 {
+            return Ok(infeasible(ge_binding(&chk), limits_base));
+        }
+        ge_check = Some(chk);
+    }
+    let opts = tightened_options.as_ref().unwrap_or(opts);
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
@@ -665,9 +783,96 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
             peak_jerk_m_s3: peak_jerk(&sched),
             averaging_window_s: sched.averaging_window_s,
         }),
+        ge_stability: ge_output(&p, &opts.air, ge_check.as_ref(), ge_tightenings),
         method: method(opts),
         compute_time_s: started.elapsed().as_secs_f64(),
         inputs,
         groups: groups(&v.model.system),
+    })
+}
+
+/// Samples checked by the GE QEP.
+fn ge_check_count(req: &PlanRequest) -> usize {
+    req.stability.as_ref().map_or(2, |s| s.check_samples)
+}
+
+/// The GE check of a schedule, when the criterion is the GE one and its
+/// table was made.
+fn ge_check_of(air: &Air, s: &Schedule, count: usize) -> Option<ge_plan::ScheduleCheck> {
+    let Air::Wind(w) = air else { return None };
+    let (_, gm) = w.ge.as_ref()?.made_table()?;
+    Some(ge_plan::check_samples(gm, &s.samples(count)))
+}
+
+/// The binding limit of a failed GE check: its worst failing sample.
+fn ge_binding(chk: &ge_plan::ScheduleCheck) -> BindingLimit {
+    let bad = chk
+        .samples
+        .iter()
+        .filter(|c| !c.ok)
+        .max_by(|a, b| a.max_real_1_s.total_cmp(&b.max_real_1_s))
+        .copied();
+    match bad {
+        Some(c) => BindingLimit::QuasiStaticGeCheck {
+            time_s: c.time_s,
+            length_m: c.kinematics.length_m,
+            rate_m_s: c.kinematics.rate_m_s,
+            max_real_1_s: c.max_real_1_s,
+        },
+        None => BindingLimit::QuasiStaticGeCheck {
+            time_s: f64::NAN,
+            length_m: f64::NAN,
+            rate_m_s: f64::NAN,
+            max_real_1_s: f64::NAN,
+        },
+    }
+}
+
+/// The GE block of the answer.
+fn ge_output(
+    p: &PlanProblem,
+    air: &Air,
+    chk: Option<&ge_plan::ScheduleCheck>,
+    tightenings: usize,
+) -> Option<PlanGeStabilityOutput> {
+    let Air::Wind(w) = air else { return None };
+    let ge = w.ge.as_ref()?;
+    let (t, _) = ge.made_table()?;
+    let rho_a = p.system.mass_per_length_kg_m;
+    let margin = STABILITY_MARGIN * p.reserve_buoyancy_n();
+    Some(PlanGeStabilityOutput {
+        bending_stiffness_n_m2: ge.options.bending_stiffness_n_m2,
+        elements: ge.options.elements,
+        max_safe_length_m: t.max_safe_length_m,
+        rate_cap_m_s: t.rate_cap_m_s,
+        interpolation_error_n: t.interpolation_error_n,
+        interpolation_error_length_m: t.interpolation_error_n / (rho_a * p.system.gravity_m_s2),
+        table: t
+            .rows
+            .iter()
+            .map(|r| PlanGeTableRowOutput {
+                length_m: r.length_m,
+                critical_rate_m_s: r.critical_rate_m_s,
+                capped: r.capped,
+                unstable: r.unstable,
+                plan_rate_ceiling_m_s: ((ge.stability_tension_n(w, p, r.length_m) - margin) / rho_a)
+                    .max(0.0)
+                    .sqrt(),
+            })
+            .collect(),
+        check: chk.map(|c| PlanGeCheckOutput {
+            checked_samples: c.samples.len(),
+            unstable_samples: c.failed,
+            worst_max_real_1_s: c.worst.map(|x| x.max_real_1_s),
+            worst_tolerance_1_s: c.worst.map(|x| x.tolerance_1_s),
+            worst_time_s: c.worst.map(|x| x.time_s),
+            worst_length_m: c.worst.map(|x| x.kinematics.length_m),
+            worst_rate_m_s: c.worst.map(|x| x.kinematics.rate_m_s),
+            worst_acceleration_m_s2: c.worst.map(|x| x.kinematics.acceleration_m_s2),
+        }),
+        tightenings,
+        offset_n: ge.offset_n,
+        qep_solves: t.qep_solves,
+        equilibria: t.equilibria,
     })
 }
