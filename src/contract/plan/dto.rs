@@ -130,7 +130,7 @@ pub struct PlanStabilityInput {
     /// `quasi_static_ge`: finite elements of the GE tether for the critical-rate table and the divergence
     /// check (the inertia of the stiffness, O(elements) per state).
     #[serde(default = "default_ge_elements")]
-    #[schema(example = 80, minimum = 4, maximum = 2000)]
+    #[schema(example = 40, minimum = 4, maximum = 2000)]
     pub elements: usize,
     /// `quasi_static_ge`: finite elements of the QEP (flutter) check of the schedule's samples.
     #[serde(default = "default_ge_check_elements")]
@@ -150,7 +150,7 @@ fn default_bending_stiffness() -> f64 {
     1000.0
 }
 fn default_ge_elements() -> usize {
-    80
+    40
 }
 fn default_ge_check_elements() -> usize {
     16

@@ -265,9 +265,16 @@ fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidI
                 Some(WindTarget {
                     lift_limit_m: lift,
                     reachable_altitude_m: top,
-                    unreachable: Some(BindingLimit::WindAltitude {
-                        altitude_m: req.target_elevation_m,
-                        reachable_m: top,
+                    unreachable: Some(if air.has_ge() && req.target_elevation_m > lift {
+                        BindingLimit::QuasiStaticGe {
+                            length_m: req.target_elevation_m,
+                            limit_m: lift,
+                        }
+                    } else {
+                        BindingLimit::WindAltitude {
+                            altitude_m: req.target_elevation_m,
+                            reachable_m: top,
+                        }
                     }),
                 }),
             ),
@@ -498,6 +505,21 @@ fn method(opts: &PlanOptions) -> String {
              check runs the schedule on the calm-air string.",
             w.criterion_name
         ));
+        if let Some(ge) = &w.ge {
+            m.push_str(&format!(
+                " Quasi-static GE: {} elements for the critical-rate table ({} lengths, each by a scan of {} rates \
+                 and {} bisections, divergence by the inertia of the stiffness) and the divergence check, {} \
+                 elements for the QEP (flutter) check of the samples; a failed check lowers S by 2 %, 8 %, 32 % of \
+                 (1−r)F and re-plans. Without wind the GE criterion runs on the straight tether in still air, the \
+                 tether diameter (for its rotary inertia ρA d²/16) from ρA at {} kg/m³.",
+                ge.options.elements,
+                ge.options.table_lengths,
+                ge_plan::SCAN_POINTS,
+                ge_plan::BISECTIONS,
+                ge.options.check_elements,
+                CALM_GE_MATERIAL_DENSITY_KG_M3
+            ));
+        }
     }
     m
 }
