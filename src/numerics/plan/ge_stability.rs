@@ -43,6 +43,7 @@ use std::sync::{Arc, OnceLock};
 
 use rayon::prelude::*;
 
+use crate::numerics::ge::GeModel;
 use crate::numerics::ge::air_load::AirLoads;
 use crate::numerics::ge::element::TipLoad;
 use crate::numerics::ge::qs_critical::lift_limit_length_m;
@@ -51,7 +52,6 @@ use crate::numerics::ge::quasi_static::{
 };
 use crate::numerics::ge::stability::StateMotion;
 use crate::numerics::ge::tether_system::{GeTetherOptions, ge_tether_system};
-use crate::numerics::ge::GeModel;
 use crate::numerics::params::{InvalidInput, Kinematics};
 use crate::numerics::plan::PlanProblem;
 use crate::numerics::plan::air::SteadyWind;
@@ -548,7 +548,13 @@ pub fn check_samples(gm: &GePlanModel, samples: &[(f64, Kinematics)]) -> Schedul
     let worst = pool
         .into_iter()
         .max_by(|a, b| {
-            let key = |c: &SampleCheck| if c.max_real_1_s.is_nan() { f64::INFINITY } else { c.max_real_1_s };
+            let key = |c: &SampleCheck| {
+                if c.max_real_1_s.is_nan() {
+                    f64::INFINITY
+                } else {
+                    c.max_real_1_s
+                }
+            };
             key(a).total_cmp(&key(b))
         })
         .copied();
