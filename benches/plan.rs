@@ -68,7 +68,7 @@ fn bench(c: &mut Criterion) {
     // the GE QEP on 16 elements.
     let mut ge: serde_json::Value = serde_json::to_value(&windy).unwrap();
     ge["stability"] = json!({"method": "quasi_static_ge", "bending_stiffness_n_m2": 1000.0,
-                             "elements": 40, "check_elements": 16, "table_lengths": 12,
+                             "elements": 40, "check_elements": 16, "table_samples": 12,
                              "check_samples": 41});
     let ge: PlanRequest = serde_json::from_value(ge).unwrap();
     assert!(plan(&ge, &NoProgress).unwrap().feasible);

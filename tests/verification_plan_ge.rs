@@ -43,7 +43,7 @@ fn calm_body(target: f64, ei: f64, elements: usize) -> Value {
         "lift_reserve_nondim": 0.05,
         "samples": 41,
         "stability": {"method": "quasi_static_ge", "bending_stiffness_n_m2": ei,
-                      "elements": elements, "table_lengths": 12}
+                      "elements": elements, "table_samples": 12}
     })
 }
 
@@ -61,7 +61,7 @@ fn wind_body(target: f64) -> Value {
                  "cable_diameter_m": 0.006, "aerostat_drag_coefficient_nondim": 0.47,
                  "aerostat_reference_area_m2": 3.0},
         "stability": {"method": "quasi_static_ge", "bending_stiffness_n_m2": 1000.0,
-                      "elements": 40, "check_elements": 16, "table_lengths": 12, "check_samples": 41}
+                      "elements": 40, "check_elements": 16, "table_samples": 12, "check_samples": 41}
     })
 }
 
@@ -359,7 +359,7 @@ fn ge_options_are_validated() {
         (json!({"elements": 3}), "stability.elements"),
         (json!({"elements": 2001}), "stability.elements"),
         (json!({"check_elements": 101}), "stability.check_elements"),
-        (json!({"table_lengths": 2}), "stability.table_lengths"),
+        (json!({"table_samples": 2}), "stability.table_samples"),
         (json!({"check_samples": 1}), "stability.check_samples"),
         (
             json!({"bending_stiffness_n_m2": 0.0}),

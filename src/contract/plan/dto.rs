@@ -137,9 +137,9 @@ pub struct PlanStabilityInput {
     #[schema(example = 16, minimum = 4, maximum = 100)]
     pub check_elements: usize,
     /// `quasi_static_ge`: lengths of the critical-rate table (the last one is the GE maximum safe length).
-    #[serde(default = "default_table_lengths")]
+    #[serde(default = "default_table_samples")]
     #[schema(example = 12, minimum = 3, maximum = 400)]
-    pub table_lengths: usize,
+    pub table_samples: usize,
     /// `quasi_static_ge`: schedule samples checked by the local GE QEP (evenly spaced plus every phase boundary).
     #[serde(default = "default_check_samples")]
     #[schema(example = 41, minimum = 2, maximum = 2000)]
@@ -155,7 +155,7 @@ fn default_ge_elements() -> usize {
 fn default_ge_check_elements() -> usize {
     16
 }
-fn default_table_lengths() -> usize {
+fn default_table_samples() -> usize {
     12
 }
 fn default_check_samples() -> usize {
@@ -471,11 +471,11 @@ pub struct PlanGeStabilityOutput {
     pub table: Vec<PlanGeTableRowOutput>,
     pub check: Option<PlanGeCheckOutput>,
     /// Re-plans with a lowered GE criterion after a failed check.
-    pub tightenings: usize,
+    pub tightening_steps: usize,
     /// Taken off S by the tightenings (N).
     pub offset_n: f64,
     pub qep_solves: usize,
-    pub equilibria: usize,
+    pub equilibrium_solves: usize,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]

@@ -117,7 +117,8 @@ pub const CALM_GE_MATERIAL_DENSITY_KG_M3: f64 = 1000.0;
 /// equilibrium is the straight tether), the diameter from ρA at
 /// [`CALM_GE_MATERIAL_DENSITY_KG_M3`].
 fn calm_wind(mass_per_length_kg_m: f64) -> SteadyWind {
-    let d = (4.0 * mass_per_length_kg_m / (std::f64::consts::PI * CALM_GE_MATERIAL_DENSITY_KG_M3)).sqrt();
+    let d = (4.0 * mass_per_length_kg_m / (std::f64::consts::PI * CALM_GE_MATERIAL_DENSITY_KG_M3))
+        .sqrt();
     SteadyWind::new(
         Cable {
             mass_per_length_kg_m: 1.0,
@@ -142,13 +143,15 @@ fn ge_options(req: &PlanRequest) -> Result<Option<GeStabilityOptions>, InvalidIn
     let Some(st) = &req.stability else {
         return Ok(None);
     };
-    crate::numerics::params::ranges::BENDING_STIFFNESS_N_M2
-        .check("stability.bending_stiffness_n_m2", st.bending_stiffness_n_m2)?;
+    crate::numerics::params::ranges::BENDING_STIFFNESS_N_M2.check(
+        "stability.bending_stiffness_n_m2",
+        st.bending_stiffness_n_m2,
+    )?;
     let o = GeStabilityOptions {
         bending_stiffness_n_m2: st.bending_stiffness_n_m2,
         elements: st.elements,
         check_elements: st.check_elements,
-        table_lengths: st.table_lengths,
+        table_lengths: st.table_samples,
         min_length_m: req.initial_length_m.min(req.target_elevation_m),
     };
     o.validate()?;
@@ -877,7 +880,8 @@ fn ge_output(
                 critical_rate_m_s: r.critical_rate_m_s,
                 capped: r.capped,
                 unstable: r.unstable,
-                plan_rate_ceiling_m_s: ((ge.stability_tension_n(w, p, r.length_m) - margin) / rho_a)
+                plan_rate_ceiling_m_s: ((ge.stability_tension_n(w, p, r.length_m) - margin)
+                    / rho_a)
                     .max(0.0)
                     .sqrt(),
             })
@@ -892,9 +896,9 @@ fn ge_output(
             worst_rate_m_s: c.worst.map(|x| x.kinematics.rate_m_s),
             worst_acceleration_m_s2: c.worst.map(|x| x.kinematics.acceleration_m_s2),
         }),
-        tightenings,
+        tightening_steps: tightenings,
         offset_n: ge.offset_n,
         qep_solves: t.qep_solves,
-        equilibria: t.equilibria,
+        equilibrium_solves: t.equilibria,
     })
 }

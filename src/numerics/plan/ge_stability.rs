@@ -102,7 +102,7 @@ impl GeStabilityOptions {
         }
         if !(MIN_TABLE_LENGTHS..=MAX_TABLE_LENGTHS).contains(&self.table_lengths) {
             return Err(InvalidInput::new(
-                "stability.table_lengths",
+                "stability.table_samples",
                 format!(
                     "must be between {MIN_TABLE_LENGTHS} and {MAX_TABLE_LENGTHS}, got {}",
                     self.table_lengths
