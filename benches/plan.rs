@@ -62,6 +62,20 @@ fn bench(c: &mut Criterion) {
     group.bench_function("plan_request_1000m_log_law_wind_jerk_rated", |b| {
         b.iter(|| plan(std::hint::black_box(&windy), &NoProgress).unwrap())
     });
+    // The same request with quasi-static GE stability (issue 13 target
+    // ≤ 5 s): a 12-length critical-rate table on 40 elements (divergence by
+    // the inertia of the stiffness), the schedule's 41 samples checked by
+    // the GE QEP on 16 elements.
+    let mut ge: serde_json::Value = serde_json::to_value(&windy).unwrap();
+    ge["stability"] = json!({"method": "quasi_static_ge", "bending_stiffness_n_m2": 1000.0,
+                             "elements": 40, "check_elements": 16, "table_samples": 12,
+                             "check_samples": 41});
+    let ge: PlanRequest = serde_json::from_value(ge).unwrap();
+    assert!(plan(&ge, &NoProgress).unwrap().feasible);
+    group.bench_function(
+        "plan_request_1000m_log_law_wind_jerk_rated_quasi_static_ge",
+        |b| b.iter(|| plan(std::hint::black_box(&ge), &NoProgress).unwrap()),
+    );
     group.finish();
 }
 

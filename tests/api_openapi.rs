@@ -197,6 +197,7 @@ fn numeric_fields_name_their_unit() {
     // Counts, ids and fractions; RateGrid's bounds are described in m/s by its parent `rates_m_s`.
     const UNITLESS: &[&str] = &[
         "elements",
+        "check_elements",
         "modes",
         "count",
         "id",

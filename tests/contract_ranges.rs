@@ -338,7 +338,21 @@ fn cases() -> Vec<Case> {
         json!({"kind": "log_law", "roughness_length_m": 0.03, "reference_height_m": 10.0});
     let pl = plan(json!({}));
     let bands = bands_request(json!({}));
+    let plan_ge = json!({
+        "cable": {"mass_per_length_kg_m": 0.078},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+        "target_elevation_m": 1000.0,
+        "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0},
+        "stability": {"method": "quasi_static_ge", "bending_stiffness_n_m2": 1000.0}
+    });
     vec![
+        // the plan's quasi-static GE stability
+        case(
+            "plan",
+            plan_ge.clone(),
+            "stability.bending_stiffness_n_m2",
+            BENDING_STIFFNESS_N_M2,
+        ),
         // system of the linear string
         case(
             "stability",

@@ -103,6 +103,65 @@ pub struct HaulDownInput {
     pub max_operating_wind_m_s: f64,
 }
 
+/// How the plan judges stability.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanStabilityMethod {
+    /// The string criterion: in calm air the closed form (1−r)F − ρA g L − ρA L̇² − (m + ρA L)L̈
+    /// at the roller; in wind the smallest tension of the blown-down tether (as the envelope).
+    #[default]
+    String,
+    /// The quasi-static geometrically exact tether: the largest stable payout rate of the local GE QEP
+    /// about the (blown-down) equilibrium, tabulated over length; the schedule is checked by the GE QEP
+    /// at its samples.
+    QuasiStaticGe,
+}
+
+/// The stability criterion of the plan (default: the string criterion).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PlanStabilityInput {
+    #[serde(default)]
+    pub method: PlanStabilityMethod,
+    /// `quasi_static_ge`: bending stiffness EI of the tether (N m²); default 1000 (thesis Table 7.1).
+    #[serde(default = "default_bending_stiffness")]
+    #[schema(example = 1000.0, minimum = 1e-6, maximum = 1e12)]
+    pub bending_stiffness_n_m2: f64,
+    /// `quasi_static_ge`: finite elements of the GE tether for the critical-rate table and the divergence
+    /// check (the inertia of the stiffness, O(elements) per state).
+    #[serde(default = "default_ge_elements")]
+    #[schema(example = 40, minimum = 4, maximum = 2000)]
+    pub elements: usize,
+    /// `quasi_static_ge`: finite elements of the QEP (flutter) check of the schedule's samples.
+    #[serde(default = "default_ge_check_elements")]
+    #[schema(example = 16, minimum = 4, maximum = 100)]
+    pub check_elements: usize,
+    /// `quasi_static_ge`: lengths of the critical-rate table (the last one is the GE maximum safe length).
+    #[serde(default = "default_table_samples")]
+    #[schema(example = 12, minimum = 3, maximum = 400)]
+    pub table_samples: usize,
+    /// `quasi_static_ge`: schedule samples checked by the local GE QEP (evenly spaced plus every phase boundary).
+    #[serde(default = "default_check_samples")]
+    #[schema(example = 41, minimum = 2, maximum = 2000)]
+    pub check_samples: usize,
+}
+
+fn default_bending_stiffness() -> f64 {
+    1000.0
+}
+fn default_ge_elements() -> usize {
+    40
+}
+fn default_ge_check_elements() -> usize {
+    16
+}
+fn default_table_samples() -> usize {
+    12
+}
+fn default_check_samples() -> usize {
+    41
+}
+
 /// `POST /api/v1/plan`: the fastest safe deployment (or retrieval) schedule.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
@@ -159,6 +218,9 @@ pub struct PlanRequest {
     /// Steady wind during the plan; absent: calm air.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wind: Option<PlanWindInput>,
+    /// Stability criterion; absent: the string criterion.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stability: Option<PlanStabilityInput>,
     /// Tip deflection of the first-mode disturbance of the transient check (m).
     #[serde(default = "default_disturbance")]
     #[schema(example = 0.1, exclusive_minimum = 0.0, maximum = 1e3)]
@@ -363,6 +425,59 @@ pub struct JerkOutput {
     pub averaging_window_s: f64,
 }
 
+/// One length of the GE critical-rate table.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct PlanGeTableRowOutput {
+    pub length_m: f64,
+    /// Largest stable constant payout rate of the local GE QEP (m/s; stable end of the search bracket).
+    pub critical_rate_m_s: f64,
+    /// Every rate up to the search cap was stable (the rate is the cap).
+    pub capped: bool,
+    /// Not even the slowest rate was stable.
+    pub unstable: bool,
+    /// The pass's rate ceiling at rest at this length, √((S − ε(1−r)F)/ρA) (m/s).
+    pub plan_rate_ceiling_m_s: f64,
+}
+
+/// The check of the schedule by the local GE QEP at its samples.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct PlanGeCheckOutput {
+    pub checked_samples: usize,
+    /// Samples found unstable (hauling in: divergent).
+    pub unstable_samples: usize,
+    /// Largest max Re λ over the checked (payout) samples (1/s): ≤ its roundoff tolerance is stable.
+    pub worst_max_real_1_s: Option<f64>,
+    /// Its roundoff tolerance (1/s).
+    pub worst_tolerance_1_s: Option<f64>,
+    pub worst_time_s: Option<f64>,
+    pub worst_length_m: Option<f64>,
+    pub worst_rate_m_s: Option<f64>,
+    pub worst_acceleration_m_s2: Option<f64>,
+}
+
+/// The quasi-static GE stability of the plan.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct PlanGeStabilityOutput {
+    pub bending_stiffness_n_m2: f64,
+    pub elements: usize,
+    /// QS GE maximum safe length with the reserve, at a vanishing payout rate (m).
+    pub max_safe_length_m: f64,
+    /// Cap of the critical-rate searches (m/s).
+    pub rate_cap_m_s: f64,
+    /// Largest change of S − S₀ between table rows (N): the most the lower-neighbour interpolation takes off.
+    pub interpolation_error_n: f64,
+    /// The same as a critical length, interpolation_error_n / (ρA g) (m).
+    pub interpolation_error_length_m: f64,
+    pub table: Vec<PlanGeTableRowOutput>,
+    pub check: Option<PlanGeCheckOutput>,
+    /// Re-plans with a lowered GE criterion after a failed check.
+    pub tightening_steps: usize,
+    /// Taken off S by the tightenings (N).
+    pub offset_n: f64,
+    pub qep_solves: usize,
+    pub equilibrium_solves: usize,
+}
+
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
 pub struct PlanResponse {
     /// Whether a schedule exists within every limit.
@@ -394,6 +509,9 @@ pub struct PlanResponse {
     /// With a jerk limit only.
     #[serde(default)]
     pub jerk: Option<JerkOutput>,
+    /// With `stability.method = quasi_static_ge` only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ge_stability: Option<PlanGeStabilityOutput>,
     /// How the schedule was found and checked.
     pub method: String,
     /// Computation time of the plan (s).

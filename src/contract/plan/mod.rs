@@ -3,6 +3,7 @@
 //! [`crate::numerics::plan`].
 
 pub mod dto;
+pub mod ge;
 pub mod run;
 
 pub use dto::{PlanRequest, PlanResponse};

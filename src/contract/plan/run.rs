@@ -7,10 +7,12 @@ use std::time::Instant;
 
 use crate::contract::dto::SystemInput;
 use crate::contract::plan::dto::*;
+use crate::contract::plan::ge::*;
 use crate::contract::run::{Progress, RequestError, groups};
 use crate::numerics::params::{InvalidInput, require_finite, require_positive};
 use crate::numerics::plan::air::{Air, SteadyWind};
 use crate::numerics::plan::deadline::{self, Forecast};
+use crate::numerics::plan::ge_stability::{self as ge_plan, GeCriterion};
 use crate::numerics::plan::retrieval::{self, TransientCheck};
 use crate::numerics::plan::schedule::{self, PlanOptions, PlanOutcome, Schedule};
 use crate::numerics::plan::{BindingLimit, PlanProblem, STABILITY_MARGIN, Winch, validate_jerk};
@@ -120,6 +122,13 @@ fn bounded(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64, InvalidInpu
 }
 
 fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
+    validate_with(req, true)
+}
+
+/// `resolve`: find the wind target (equilibria; with the GE criterion its
+/// table). Without it (job submission) a GE request's target is only
+/// range-checked.
+fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidInput> {
     let system_input = SystemInput {
         cable: req.cable.clone(),
         aerostat: req.aerostat.clone(),
@@ -131,9 +140,19 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
     let model = system_input.model()?;
     let winch = Winch::new(req.winch.max_rate_m_s, req.winch.max_acceleration_m_s2)?;
     let max_jerk_m_s3 = req.winch.max_jerk_m_s3.map(validate_jerk).transpose()?;
-    let air = match &req.wind {
-        Some(w) => Air::Wind(Box::new(steady_wind(w)?)),
-        None => Air::Calm,
+    let ge = ge_options(req)?;
+    let air = match (&req.wind, ge) {
+        (Some(w), None) => Air::Wind(Box::new(steady_wind(w)?)),
+        (None, None) => Air::Calm,
+        (w, Some(o)) => {
+            let mut sw = match w {
+                Some(w) => steady_wind(w)?,
+                None => calm_wind(model.system.mass_per_length_kg_m),
+            };
+            sw.ge = Some(GeCriterion::new(o));
+            sw.criterion_name = ge_plan::QS_GE_CRITERION;
+            Air::Wind(Box::new(sw))
+        }
     };
     let (allowable, breaking) = match &req.tether {
         Some(t) => {
@@ -151,7 +170,7 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
     };
     require_finite("target_elevation_m", req.target_elevation_m)?;
     // In wind the target is an altitude: the length that flies there.
-    let (target_length, wind) = if air.is_calm() {
+    let (target_length, wind) = if air.is_calm() || (!resolve && air.has_ge()) {
         (req.target_elevation_m, None)
     } else {
         bounded("target_elevation_m", req.target_elevation_m, 0.0, 1e6)?;
@@ -187,9 +206,16 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
                 Some(WindTarget {
                     lift_limit_m: lift,
                     reachable_altitude_m: top,
-                    unreachable: Some(BindingLimit::WindAltitude {
-                        altitude_m: req.target_elevation_m,
-                        reachable_m: top,
+                    unreachable: Some(if air.has_ge() && req.target_elevation_m > lift {
+                        BindingLimit::QuasiStaticGe {
+                            length_m: req.target_elevation_m,
+                            limit_m: lift,
+                        }
+                    } else {
+                        BindingLimit::WindAltitude {
+                            altitude_m: req.target_elevation_m,
+                            reachable_m: top,
+                        }
                     }),
                 }),
             ),
@@ -272,7 +298,7 @@ fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
 
 /// Checks a plan request without computing it (job submission).
 pub fn validate_plan(req: &PlanRequest) -> Result<(), RequestError> {
-    validate(req)?;
+    validate_with(req, false)?;
     Ok(())
 }
 
@@ -420,6 +446,21 @@ fn method(opts: &PlanOptions) -> String {
              check runs the schedule on the calm-air string.",
             w.criterion_name
         ));
+        if let Some(ge) = &w.ge {
+            m.push_str(&format!(
+                " Quasi-static GE: {} elements for the critical-rate table ({} lengths, each by a scan of {} rates \
+                 and {} bisections, divergence by the inertia of the stiffness) and the divergence check, {} \
+                 elements for the QEP (flutter) check of the samples; a failed check lowers S by 2 %, 8 %, 32 % of \
+                 (1−r)F and re-plans. Without wind the GE criterion runs on the straight tether in still air, the \
+                 tether diameter (for its rotary inertia ρA d²/16) from ρA at {} kg/m³.",
+                ge.options.elements,
+                ge.options.table_lengths,
+                ge_plan::SCAN_POINTS,
+                ge_plan::BISECTIONS,
+                ge.options.check_elements,
+                CALM_GE_MATERIAL_DENSITY_KG_M3
+            ));
+        }
     }
     m
 }
@@ -475,6 +516,7 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         limits,
         wind: wind_out.clone(),
         jerk: None,
+        ge_stability: ge_output(&p, &opts.air, None, 0),
         method: method(opts),
         compute_time_s: started.elapsed().as_secs_f64(),
         inputs: inputs.clone(),
@@ -484,6 +526,9 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         return Ok(infeasible(b, limits_base));
     }
 
+    let mut ge_check = None;
+    let mut ge_tightenings = 0;
+    let mut tightened_options: Option<PlanOptions> = None;
     // The schedule (slowed for an amplification limit when retrieving).
     let (sched, check, rate_used, slowed) = match (retrieving, v.amplification_limit) {
         (true, Some(limit)) => {
@@ -507,20 +552,56 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
                 }
             }
         }
-        _ => match schedule::fastest_with(&p, opts) {
-            PlanOutcome::Infeasible(b) => return Ok(infeasible(b, limits_base)),
-            PlanOutcome::Feasible(s) => {
-                let c = retrieval::check_transient(
-                    &v.model,
-                    &s,
-                    req.disturbance_tip_deflection_m,
-                    &observer,
-                )
-                .map_err(from_transient)?;
-                (s, c, p.winch.max_rate_m_s, false)
-            }
-        },
+        _ => {
+            // With the GE criterion: check the schedule by the GE QEP and
+            // re-plan with a lowered criterion while a sample fails.
+            let mut tightened = v.options.clone();
+            let mut tightenings = 0;
+            let s = loop {
+                let s = match schedule::fastest_with(&p, &tightened) {
+                    PlanOutcome::Infeasible(b) => return Ok(infeasible(b, limits_base)),
+                    PlanOutcome::Feasible(s) => s,
+                };
+                let Some(chk) = ge_check_of(&tightened.air, &s, ge_check_count(req)) else {
+                    break s;
+                };
+                if chk.failed == 0 {
+                    ge_check = Some(chk);
+                    break s;
+                }
+                if tightenings >= MAX_GE_TIGHTENINGS {
+                    return Ok(infeasible(ge_binding(&chk), limits_base));
+                }
+                tightenings += 1;
+                let offset = 0.02 * 4f64.powi(tightenings as i32 - 1) * p.reserve_buoyancy_n();
+                if let Air::Wind(w) = &mut tightened.air
+                    && let Some(ge) = &w.ge
+                {
+                    w.ge = Some(ge.with_offset(offset));
+                }
+            };
+            ge_tightenings = tightenings;
+            tightened_options = Some(tightened);
+            let c = retrieval::check_transient(
+                &v.model,
+                &s,
+                req.disturbance_tip_deflection_m,
+                &observer,
+            )
+            .map_err(from_transient)?;
+            (s, c, p.winch.max_rate_m_s, false)
+        }
     };
+    if ge_check.is_none()
+        && let Some(chk) = ge_check_of(&opts.air, &sched, ge_check_count(req))
+    {
+        // The amplification-bounded retrieval: checked, not tightened.
+        if chk.failed > 0 {
+            return Ok(infeasible(ge_binding(&chk), limits_base));
+        }
+        ge_check = Some(chk);
+    }
+    let opts = tightened_options.as_ref().unwrap_or(opts);
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
@@ -665,6 +746,7 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
             peak_jerk_m_s3: peak_jerk(&sched),
             averaging_window_s: sched.averaging_window_s,
         }),
+        ge_stability: ge_output(&p, &opts.air, ge_check.as_ref(), ge_tightenings),
         method: method(opts),
         compute_time_s: started.elapsed().as_secs_f64(),
         inputs,

@@ -126,6 +126,9 @@ pub struct SteadyWind {
     pub criterion: StabilityCriterion,
     /// Its description.
     pub criterion_name: &'static str,
+    /// The quasi-static GE criterion, which replaces `criterion` when set
+    /// ([`super::ge_stability`]).
+    pub ge: Option<super::ge_stability::GeCriterion>,
     /// Answers already computed, by (length, buoyancy, kind) bits: the
     /// pass, the bound, the constant-rate plan and the jerk check of one
     /// request share their grid's lengths.
@@ -146,6 +149,7 @@ impl SteadyWind {
             },
             criterion: string_tension_criterion,
             criterion_name: STRING_TENSION_CRITERION,
+            ge: None,
             cache: Arc::default(),
         }
     }
@@ -189,6 +193,9 @@ impl SteadyWind {
 
     /// `S(L)` with the reserve buoyancy (N).
     pub fn stability_tension_n(&self, p: &PlanProblem, length_m: f64) -> f64 {
+        if let Some(ge) = &self.ge {
+            return ge.stability_tension_n(self, p, length_m);
+        }
         let b = p.reserve_buoyancy_n();
         let key = key(&p.system, length_m, b, self.criterion as usize, 0);
         self.cached(key, || {
@@ -243,6 +250,11 @@ pub const LENGTH_BISECTIONS: usize = 48;
 impl Air {
     pub fn is_calm(&self) -> bool {
         matches!(self, Self::Calm)
+    }
+
+    /// Whether stability is judged by the quasi-static GE criterion.
+    pub fn has_ge(&self) -> bool {
+        matches!(self, Self::Wind(w) if w.ge.is_some())
     }
 
     /// The loads at rest at one length.
@@ -317,6 +329,11 @@ impl Air {
         };
         let need = STABILITY_MARGIN * p.reserve_buoyancy_n();
         let ok = |l: f64| w.stability_tension_n(p, l) >= need;
+        // The GE criterion may allow more than the calm string (bending).
+        let calm = match &w.ge {
+            Some(ge) => ge.search_upper_m(w, p).map_or(calm, |u| u.max(calm)),
+            None => calm,
+        };
         if ok(calm) {
             return calm;
         }

@@ -29,6 +29,7 @@
 
 pub mod air;
 pub mod deadline;
+pub mod ge_stability;
 pub mod jerk;
 pub mod retrieval;
 pub mod schedule;
@@ -253,6 +254,17 @@ pub enum BindingLimit {
     /// In wind the target altitude is above the highest the aerostat
     /// reaches within the lift limit (the tether is blown down).
     WindAltitude { altitude_m: f64, reachable_m: f64 },
+    /// The end (or start) length exceeds the quasi-static GE maximum safe
+    /// length with the reserve (the GE criterion's static limit).
+    QuasiStaticGe { length_m: f64, limit_m: f64 },
+    /// The local GE QEP found a checked sample unstable after the
+    /// tightenings of the GE criterion.
+    QuasiStaticGeCheck {
+        time_s: f64,
+        length_m: f64,
+        rate_m_s: f64,
+        max_real_1_s: f64,
+    },
 }
 
 impl BindingLimit {
@@ -264,6 +276,8 @@ impl BindingLimit {
             Self::Amplification { .. } => "amplification_limit",
             Self::Jerk { .. } => "jerk_limit",
             Self::WindAltitude { .. } => "wind_blowdown",
+            Self::QuasiStaticGe { .. } => "quasi_static_ge_limit",
+            Self::QuasiStaticGeCheck { .. } => "quasi_static_ge_check",
         }
     }
 
@@ -306,6 +320,22 @@ impl BindingLimit {
                 "in this wind the tether is blown down: {altitude_m:.1} m is above the highest altitude reached \
                  within the lift limit with a {:.1} % lift reserve, {reachable_m:.1} m",
                 100.0 * reserve
+            ),
+            Self::QuasiStaticGe { length_m, limit_m } => format!(
+                "{length_m:.1} m exceeds the quasi-static GE maximum safe length with a {:.1} % lift reserve, \
+                 {limit_m:.1} m: beyond it the geometrically exact tether is unstable even at rest (at a vanishing \
+                 payout rate) in this air",
+                100.0 * reserve
+            ),
+            Self::QuasiStaticGeCheck {
+                time_s,
+                length_m,
+                rate_m_s,
+                max_real_1_s,
+            } => format!(
+                "the local quasi-static GE check of the schedule found it unstable at t = {time_s:.2} s \
+                 (L = {length_m:.1} m, L̇ = {rate_m_s:.2} m/s, growth rate {max_real_1_s:.3e} 1/s) even after \
+                 tightening the GE criterion"
             ),
         }
     }

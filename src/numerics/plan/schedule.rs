@@ -375,6 +375,12 @@ pub(crate) fn static_check(p: &PlanProblem, air: &Air) -> Option<BindingLimit> {
     let high = p.target_length_m.max(p.system.initial_length_m);
     let limit = air.lift_limit_m(p);
     if high > limit {
+        if air.has_ge() {
+            return Some(BindingLimit::QuasiStaticGe {
+                length_m: high,
+                limit_m: limit,
+            });
+        }
         return Some(BindingLimit::StaticLift {
             length_m: high,
             limit_m: limit,
