@@ -240,7 +240,10 @@ fn chunked_envelopes_are_the_single_process_envelope() {
 
     let single = assembled_equals_single(&ge_envelope(), 3);
     let v: Value = serde_json::from_str(&single).unwrap();
-    assert_eq!(v["quasi_static_ge"]["per_wind"].as_array().unwrap().len(), 3);
+    assert_eq!(
+        v["quasi_static_ge"]["per_wind"].as_array().unwrap().len(),
+        3
+    );
     // In calm air the 10-element onset (1288.6 m) lies inside the grid:
     // the calm row has stable and unstable cells.
     let calm: Vec<bool> = v["points"].as_array().unwrap()[..4]
@@ -556,54 +559,4 @@ fn cancel_scenario(
         }
         assert_eq!(after.iter().filter(|r| r.2 > 0).count(), 2, "{after:?}");
     });
-}
-
-/// Prints the seconds per item of each new chunked kind on one thread
-/// (the figures behind the cost constants in `jobs/kinds.rs`):
-/// `cargo test --release --test chunks_kinds measure -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn measure_item_costs() {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap();
-    let time = |v: &Value, items: std::ops::Range<usize>| -> f64 {
-        let sub = submission(v);
-        let t = Instant::now();
-        pool.install(|| sub.run_chunk(items.clone(), &NoProgress).unwrap());
-        t.elapsed().as_secs_f64()
-    };
-    // string chart, 400 elements, 3 series: per element-point
-    let s = time(&string_chart(), 0..300);
-    eprintln!(
-        "string chart: {:.3} s for 300 rates × 3 series × 400 elements = {:.2e} s per element-point",
-        s,
-        s / (300.0 * 3.0 * 400.0)
-    );
-    let s = time(&converged_string_chart(), 0..37);
-    eprintln!(
-        "converged string chart: {:.3} s for 37 × 2 points = {:.2e} s per point",
-        s,
-        s / 74.0
-    );
-    let v = plan_bands(3000);
-    let sub = submission(&v);
-    let single = sub.run(&NoProgress).unwrap();
-    let instants = serde_json::from_str::<Value>(&single).unwrap()["instants"]
-        .as_array()
-        .unwrap()
-        .len();
-    let whole = time(&v, 0..3000);
-    let few = time(&v, 0..1);
-    eprintln!(
-        "plan bands: {whole:.3} s for 3000 samples × {instants} instants, {few:.3} s for 1 (the nominal plan) \
-         = {:.2e} s per sample-instant",
-        (whole - few) / (2999.0 * instants as f64)
-    );
-    let s = time(&envelope_bands(200), 0..200);
-    eprintln!(
-        "envelope bands: {s:.3} s for 200 samples × 42 cells × 100 steps = {:.2e} s per cell-step",
-        s / (200.0 * 42.0 * 100.0)
-    );
 }

@@ -866,7 +866,7 @@ const BAND_ELEMENT_POINT_S: f64 = 4e-7;
 const BAND_CONVERGED_POINT_S: f64 = 1e-5;
 /// Seconds per element of one point of a string chart on a uniform mesh
 /// (measured: 300 rates × 3 buoyancies at 400 elements in 0.21-0.23 s on
-/// one core, 5.9-6.5e-7 s; test `chunks_kinds::measure_item_costs`).
+/// one core, 5.9-6.5e-7 s, timing `run_chunk` on one rayon thread).
 const STRING_CHART_ELEMENT_POINT_S: f64 = 7e-7;
 /// Seconds per converged point of a string chart (measured: 74 points in
 /// 0.5 ms, 6.5-7.3e-6 s, on one core; slower near the wave speed).
@@ -887,7 +887,8 @@ const ENVELOPE_BAND_CELL_STEP_S: f64 = 1.2e-6;
 const OTHER_ITEM_S: f64 = 0.05;
 /// Seconds per envelope cell per element of the quasi-static GE verdict,
 /// the row's critical length and rate searches included (measured: 40 ×
-/// 50 cells at 20 elements in 12.1 s on 2 cores, 12 ms a cell on one).
+/// 50 cells at 20 elements in 12.1 s on 2 loaded cores, 5.8 s quiet;
+/// costed at the loaded figure, 12 ms a cell on one core).
 const GE_ENVELOPE_CELL_ELEMENT_S: f64 = 6e-4;
 
 impl JobItem {
@@ -1036,9 +1037,9 @@ impl JobItem {
             Self::PlanBands(r) => to_json(&crate::contract::bands::plan::plan_bands_from_chunks(
                 r, parts,
             )?),
-            Self::Envelope(r) => to_json(
-                &crate::contract::envelope::chunks::envelope_from_chunks(r, parts)?,
-            ),
+            Self::Envelope(r) => to_json(&crate::contract::envelope::chunks::envelope_from_chunks(
+                r, parts,
+            )?),
             Self::EnvelopeBands(r) => {
                 to_json(&crate::contract::bands::envelope::envelope_bands_from_chunks(r, parts)?)
             }
