@@ -207,11 +207,10 @@ fn the_cli_prints_the_same_answer() {
 
 fn plan_body(samples: usize) -> Value {
     json!({
-        "cable": {"mass_per_length_kg_m": 0.078},
+        "cable": {"mass_per_length_kg_m": 0.078, "breaking_strength_n": 5200.0},
         "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
         "target_elevation_m": 1200.0,
         "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0},
-        "tether": {"breaking_strength_n": 5200.0},
         "samples": 41,
         "uncertainty": {"samples": samples, "seed": 5, "inputs": [
             {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 50.0}
@@ -224,7 +223,7 @@ fn envelope_body(samples: usize) -> Value {
         "cable": {"preset": "dyneema", "diameter_m": 0.006},
         "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
                      "reference_area_m2": 20.0},
-        "wind": {"shape": {"kind": "uniform"}},
+        "wind": {"flow": {"kind": "uniform", "speed_m_s": 0.0}},
         "wind_speeds_m_s": {"min": 0.0, "max": 20.0, "count": 3},
         "tether_lengths_m": {"min": 100.0, "max": 2000.0, "count": 4},
         "payout_rate_m_s": 5.0,

@@ -177,12 +177,12 @@ fn slack_is_an_answer() {
 #[test]
 fn envelope_points_equal_single_point_answers() {
     for shape in [
-        json!({"kind": "uniform"}),
-        json!({"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0}),
-        json!({"kind": "log_law", "roughness_length_m": 0.03, "reference_height_m": 10.0}),
+        json!({"kind": "uniform", "speed_m_s": 0.0}),
+        json!({"kind": "power_law", "coefficient_m_s": 0.0, "exponent_nondim": 0.14, "reference_height_m": 10.0}),
+        json!({"kind": "log_law", "speed_m_s": 0.0, "roughness_length_m": 0.03, "reference_height_m": 10.0}),
     ] {
         let mut v = example::<EnvelopeRequest>();
-        v["wind"]["shape"] = shape.clone();
+        v["wind"]["flow"] = shape.clone();
         v["wind_speeds_m_s"] = json!({"min": 0.0, "max": 30.0, "count": 7});
         v["tether_lengths_m"] = json!({"min": 200.0, "max": 6000.0, "count": 6});
         let req: EnvelopeRequest = contract::parse_plain(&serde_json::to_vec(&v).unwrap()).unwrap();

@@ -50,18 +50,18 @@ fn converged_string_chart() -> Value {
 /// (rejected and counted), so the assembly must carry rejections too.
 fn plan_bands(samples: usize) -> Value {
     json!({"kind": "plan_bands", "request": {
-        "cable": {"mass_per_length_kg_m": 0.078},
+        "cable": {"mass_per_length_kg_m": 0.078, "breaking_strength_n": 5200.0},
         "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
         "initial_length_m": 1.0,
         "target_elevation_m": 1200.0,
         "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0},
         "lift_reserve_nondim": 0.05,
-        "tether": {"breaking_strength_n": 5200.0, "safety_factor_nondim": 5.0},
+        "required_safety_factor_nondim": 5.0,
         "samples": 2001,
         "uncertainty": {"samples": samples, "seed": 11, "inputs": [
             {"field": "aerostat.net_buoyancy_n", "distribution": "normal", "mean": 1000.0, "std_dev": 400.0},
             {"field": "cable.mass_per_length_kg_m", "distribution": "normal", "mean": 0.078, "std_dev": 0.002},
-            {"field": "tether.breaking_strength_n", "distribution": "lognormal", "mean": 5200.0, "std_dev": 500.0}
+            {"field": "cable.breaking_strength_n", "distribution": "lognormal", "mean": 5200.0, "std_dev": 500.0}
         ]}
     }})
 }
@@ -71,7 +71,7 @@ fn envelope_bands(samples: usize) -> Value {
         "cable": {"preset": "dyneema", "diameter_m": 0.006},
         "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
                      "reference_area_m2": 20.0},
-        "wind": {"shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0},
+        "wind": {"flow": {"kind": "power_law", "coefficient_m_s": 0.0, "exponent_nondim": 0.14, "reference_height_m": 10.0},
                  "air_density_kg_m3": 1.225},
         "wind_speeds_m_s": {"min": 0.0, "max": 30.0, "count": 7},
         "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 6},
@@ -190,7 +190,7 @@ fn string_envelope() -> Value {
         "cable": {"preset": "dyneema", "diameter_m": 0.006},
         "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
                      "reference_area_m2": 20.0},
-        "wind": {"shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0},
+        "wind": {"flow": {"kind": "power_law", "coefficient_m_s": 0.0, "exponent_nondim": 0.14, "reference_height_m": 10.0},
                  "air_density_kg_m3": 1.225},
         "wind_speeds_m_s": {"min": 0.0, "max": 40.0, "count": 9},
         "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 8},
@@ -209,7 +209,7 @@ fn ge_envelope() -> Value {
                   "normal_drag_coefficient_nondim": 1.2},
         "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.3,
                      "reference_area_m2": 3.0},
-        "wind": {"shape": {"kind": "uniform"}, "air_density_kg_m3": 1.225},
+        "wind": {"flow": {"kind": "uniform", "speed_m_s": 0.0}, "air_density_kg_m3": 1.225},
         "wind_speeds_m_s": {"min": 0.0, "max": 10.0, "count": 3},
         "tether_lengths_m": {"min": 1150.0, "max": 1300.0, "count": 4},
         "required_safety_factor_nondim": 1.0,

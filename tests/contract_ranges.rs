@@ -206,7 +206,7 @@ fn envelope(patch: Value) -> Value {
             "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
                          "reference_area_m2": 20.0},
             "wind": {"air_density_kg_m3": 1.225,
-                     "shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0}},
+                     "flow": {"kind": "power_law", "coefficient_m_s": 0.0, "exponent_nondim": 0.14, "reference_height_m": 10.0}},
             "wind_speeds_m_s": {"min": 0.0, "max": 30.0, "count": 3},
             "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 3},
             "required_safety_factor_nondim": 5.0,
@@ -222,14 +222,14 @@ fn envelope(patch: Value) -> Value {
 fn plan(patch: Value) -> Value {
     merge(
         json!({
-            "cable": {"mass_per_length_kg_m": 0.078},
             "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
             "initial_length_m": 1.0,
             "gravity_m_s2": 9.81,
             "target_elevation_m": 1200.0,
             "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0, "max_jerk_m_s3": 1.0},
             "lift_reserve_nondim": 0.05,
-            "tether": {"breaking_strength_n": 20000.0, "safety_factor_nondim": 5.0},
+            "cable": {"mass_per_length_kg_m": 0.078, "breaking_strength_n": 20000.0},
+            "required_safety_factor_nondim": 5.0,
             "samples": 50,
             "disturbance_tip_deflection_m": 1.0,
             "max_amplification_nondim": 10.0,
@@ -330,12 +330,12 @@ fn cases() -> Vec<Case> {
                                           "exponent_nondim": 0.14}));
     let eq_table = equilibrium_in(json!({"kind": "tabulated", "points": [
         {"elevation_m": 0.0, "speed_m_s": 2.0}, {"elevation_m": 1000.0, "speed_m_s": 10.0}]}));
-    let eq_log = equilibrium_in(json!({"kind": "log_law", "reference_speed_m_s": 8.0,
+    let eq_log = equilibrium_in(json!({"kind": "log_law", "speed_m_s": 8.0,
                                         "reference_height_m": 10.0, "roughness_length_m": 0.03}));
     let env = envelope(json!({}));
     let mut env_log = env.clone();
-    env_log["wind"]["shape"] =
-        json!({"kind": "log_law", "roughness_length_m": 0.03, "reference_height_m": 10.0});
+    env_log["wind"]["flow"] = json!({"kind": "log_law", "speed_m_s": 0.0, "roughness_length_m": 0.03,
+                                     "reference_height_m": 10.0});
     let pl = plan(json!({}));
     let bands = bands_request(json!({}));
     let plan_ge = json!({
@@ -469,13 +469,12 @@ fn cases() -> Vec<Case> {
         ),
         // equilibrium (the tether's own bounds, `contract::equilibrium`)
         exclusive(lit("equilibrium", &eq, "cable.diameter_m", 0.0, 1.0)),
-        exclusive(lit(
+        case(
             "equilibrium",
-            &eq,
+            eq.clone(),
             "cable.mass_per_length_kg_m",
-            0.0,
-            1000.0,
-        )),
+            MASS_PER_LENGTH_KG_M,
+        ),
         lit(
             "equilibrium",
             &eq,
@@ -499,8 +498,18 @@ fn cases() -> Vec<Case> {
         )),
         exclusive(lit("equilibrium", &eq, "aerostat.radius_m", 0.0, 100.0)),
         exclusive(lit("equilibrium", &eq, "aerostat.volume_m3", 0.0, 1e7)),
-        lit("equilibrium", &eq, "aerostat.mass_kg", 0.0, 1e7),
-        exclusive(lit("equilibrium", &eq, "aerostat.net_buoyancy_n", 0.0, 1e8)),
+        case(
+            "equilibrium",
+            eq.clone(),
+            "aerostat.mass_kg",
+            AEROSTAT_MASS_KG,
+        ),
+        case(
+            "equilibrium",
+            eq.clone(),
+            "aerostat.net_buoyancy_n",
+            NET_BUOYANCY_N,
+        ),
         lit(
             "equilibrium",
             &eq,
@@ -564,13 +573,7 @@ fn cases() -> Vec<Case> {
             -150.0,
             150.0,
         ),
-        lit(
-            "equilibrium",
-            &eq_log,
-            "wind.flow.reference_speed_m_s",
-            -150.0,
-            150.0,
-        ),
+        lit("equilibrium", &eq_log, "wind.flow.speed_m_s", -150.0, 150.0),
         exclusive(lit(
             "equilibrium",
             &eq_log,
@@ -593,20 +596,25 @@ fn cases() -> Vec<Case> {
         exclusive(lit("envelope", &env, "tether_lengths_m.max", 0.0, 1e5)),
         lit("envelope", &env, "tether_lengths_m.count", 1.0, 1000.0),
         exclusive(lit("envelope", &env, "cable.diameter_m", 0.0, 1.0)),
-        exclusive(lit("envelope", &env, "aerostat.net_buoyancy_n", 0.0, 1e8)),
+        case(
+            "envelope",
+            env.clone(),
+            "aerostat.net_buoyancy_n",
+            NET_BUOYANCY_N,
+        ),
         exclusive(lit("envelope", &env, "wind.air_density_kg_m3", 0.0, 5.0)),
-        lit("envelope", &env, "wind.shape.exponent_nondim", 0.0, 2.0),
+        lit("envelope", &env, "wind.flow.exponent_nondim", 0.0, 2.0),
         exclusive(lit(
             "envelope",
             &env,
-            "wind.shape.reference_height_m",
+            "wind.flow.reference_height_m",
             0.0,
             1e4,
         )),
         exclusive(lit(
             "envelope",
             &env_log,
-            "wind.shape.roughness_length_m",
+            "wind.flow.roughness_length_m",
             0.0,
             10.0,
         )),
@@ -638,8 +646,8 @@ fn cases() -> Vec<Case> {
         case("plan", pl.clone(), "initial_length_m", INITIAL_LENGTH_M),
         case("plan", pl.clone(), "gravity_m_s2", GRAVITY_M_S2),
         lit("plan", &pl, "lift_reserve_nondim", 0.0, 0.9),
-        lit("plan", &pl, "tether.safety_factor_nondim", 1.0, 100.0),
-        exclusive(lit("plan", &pl, "tether.breaking_strength_n", 0.0, 1e9)),
+        lit("plan", &pl, "required_safety_factor_nondim", 1.0, 100.0),
+        exclusive(lit("plan", &pl, "cable.breaking_strength_n", 0.0, 1e9)),
         exclusive(lit("plan", &pl, "target_elevation_m", 0.0, 1e6)),
         exclusive(lit("plan", &pl, "winch.max_rate_m_s", 0.0, 1000.0)),
         exclusive(lit("plan", &pl, "winch.max_acceleration_m_s2", 0.0, 100.0)),

@@ -477,7 +477,7 @@ fn envelope_bands_request() -> Value {
         "cable": {"preset": "dyneema", "diameter_m": 0.006},
         "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
                      "reference_area_m2": 20.0},
-        "wind": {"shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0},
+        "wind": {"flow": {"kind": "power_law", "coefficient_m_s": 0.0, "exponent_nondim": 0.14, "reference_height_m": 10.0},
                  "air_density_kg_m3": 1.225},
         "wind_speeds_m_s": {"min": 0.0, "max": 30.0, "count": 7},
         "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 6},

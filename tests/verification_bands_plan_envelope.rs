@@ -85,13 +85,13 @@ const M: f64 = 10.0;
 
 fn plan_body(inputs: Value, samples: usize, seed: u64) -> Value {
     json!({
-        "cable": {"mass_per_length_kg_m": 0.078},
+        "cable": {"mass_per_length_kg_m": 0.078, "breaking_strength_n": 5200.0},
         "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": M},
         "initial_length_m": 1.0,
         "target_elevation_m": 1200.0,
         "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0},
         "lift_reserve_nondim": 0.05,
-        "tether": {"breaking_strength_n": 5200.0, "safety_factor_nondim": 5.0},
+        "required_safety_factor_nondim": 5.0,
         "samples": 61,
         "uncertainty": {"samples": samples, "seed": seed, "inputs": inputs}
     })
@@ -212,7 +212,7 @@ fn the_same_seed_is_identical_at_one_and_two_threads() {
         json!([
             {"field": "aerostat.net_buoyancy_n", "distribution": "lognormal", "mean": 1000.0, "std_dev": 40.0},
             {"field": "aerostat.mass_kg", "distribution": "uniform", "low": 8.0, "high": 12.0},
-            {"field": "tether.breaking_strength_n", "distribution": "normal", "mean": 5200.0, "std_dev": 200.0}
+            {"field": "cable.breaking_strength_n", "distribution": "normal", "mean": 5200.0, "std_dev": 200.0}
         ]),
         600,
         42,
@@ -251,7 +251,7 @@ fn envelope_body(samples: usize, seed: u64) -> Value {
         "cable": {"mass_per_length_kg_m": 0.1, "diameter_m": 0.006, "breaking_strength_n": 5500.0},
         "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 50.0, "drag_coefficient_nondim": 0.3,
                      "reference_area_m2": 20.0},
-        "wind": {"shape": {"kind": "uniform"}},
+        "wind": {"flow": {"kind": "uniform", "speed_m_s": 0.0}},
         "wind_speeds_m_s": {"min": 0.0, "max": 0.0, "count": 1},
         "tether_lengths_m": {"min": 100.0, "max": 1000.0, "count": 3},
         "required_safety_factor_nondim": 5.0,
@@ -338,7 +338,7 @@ fn envelope_probabilities_in_calm_air_are_normal_tails() {
 #[test]
 fn envelope_bands_are_identical_at_one_and_two_threads() {
     let mut body = envelope_body(300, 3);
-    body["wind"] = json!({"shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0}});
+    body["wind"] = json!({"flow": {"kind": "power_law", "coefficient_m_s": 0.0, "exponent_nondim": 0.14, "reference_height_m": 10.0}});
     body["wind_speeds_m_s"] = json!({"min": 0.0, "max": 20.0, "count": 3});
     let at = |threads: usize| {
         rayon::ThreadPoolBuilder::new()

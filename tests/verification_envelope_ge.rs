@@ -28,7 +28,7 @@ fn request(winds: (f64, f64, usize), lengths: (f64, f64, usize), elements: usize
                   "normal_drag_coefficient_nondim": 1.2},
         "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.3,
                      "reference_area_m2": 3.0},
-        "wind": {"shape": {"kind": "uniform"}, "air_density_kg_m3": 1.225},
+        "wind": {"flow": {"kind": "uniform", "speed_m_s": 0.0}, "air_density_kg_m3": 1.225},
         "wind_speeds_m_s": {"min": winds.0, "max": winds.1, "count": winds.2},
         "tether_lengths_m": {"min": lengths.0, "max": lengths.1, "count": lengths.2},
         "required_safety_factor_nondim": 1.0,

@@ -56,13 +56,13 @@ fn cases() -> Vec<Case> {
         Case {
             name: "heavy tether, slow winch",
             body: json!({
-                "cable": {"mass_per_length_kg_m": 0.25},
+                "cable": {"mass_per_length_kg_m": 0.25, "breaking_strength_n": 20000.0},
                 "aerostat": {"net_buoyancy_n": 3000.0, "mass_kg": 40.0},
                 "initial_length_m": 5.0,
                 "target_elevation_m": 1000.0,
                 "winch": {"max_rate_m_s": 8.0, "max_acceleration_m_s2": 0.3},
                 "lift_reserve_nondim": 0.1,
-                "tether": {"breaking_strength_n": 20000.0, "safety_factor_nondim": 5.0},
+                "required_safety_factor_nondim": 5.0,
                 "samples": 61
             }),
             rho_a: 0.25,
@@ -107,9 +107,9 @@ fn every_sample_is_qep_stable_within_the_limits_and_near_the_bound() {
         let r = run(c.body.clone());
         assert!(r.feasible, "{}: {}", c.name, r.reason);
         let l0 = c.body["initial_length_m"].as_f64().unwrap();
-        let allow = c.body["tether"]["breaking_strength_n"]
+        let allow = c.body["cable"]["breaking_strength_n"]
             .as_f64()
-            .map(|b| b / c.body["tether"]["safety_factor_nondim"].as_f64().unwrap());
+            .map(|b| b / c.body["required_safety_factor_nondim"].as_f64().unwrap());
         let mut tightest = (f64::INFINITY, Kinematics::default());
         for s in &r.schedule {
             let k = Kinematics {
@@ -225,7 +225,8 @@ fn the_tension_rating_limits_braking() {
     // Allowable 1010 N: braking may add at most m|L̈| = 10 N at the
     // aerostat, so |L̈| ≤ 1 m/s² while braking.
     let mut body = thesis_body(1200.0, 0.05);
-    body["tether"] = json!({"breaking_strength_n": 5050.0, "safety_factor_nondim": 5.0});
+    body["cable"]["breaking_strength_n"] = json!(5050.0);
+    body["required_safety_factor_nondim"] = json!(5.0);
     let r = run(body);
     assert!(r.feasible, "{}", r.reason);
     for s in &r.schedule {
@@ -242,7 +243,8 @@ fn the_tension_rating_limits_braking() {
     assert!(d > 59.0, "{d}");
     // Below the static tension: nothing works.
     let mut body = thesis_body(1200.0, 0.05);
-    body["tether"] = json!({"breaking_strength_n": 4000.0, "safety_factor_nondim": 5.0});
+    body["cable"]["breaking_strength_n"] = json!(4000.0);
+    body["required_safety_factor_nondim"] = json!(5.0);
     assert_eq!(run(body).binding_limit.as_deref(), Some("tension_limit"));
 }
 
@@ -447,9 +449,9 @@ fn jerk_limited_plans_are_qep_stable_within_every_limit() {
         let r = run(body.clone());
         assert!(r.feasible, "{}: {}", c.name, r.reason);
         let l0 = body["initial_length_m"].as_f64().unwrap();
-        let allow = body["tether"]["breaking_strength_n"]
+        let allow = body["cable"]["breaking_strength_n"]
             .as_f64()
-            .map(|b| b / body["tether"]["safety_factor_nondim"].as_f64().unwrap());
+            .map(|b| b / body["required_safety_factor_nondim"].as_f64().unwrap());
         for s in &r.schedule {
             let k = Kinematics {
                 length_m: s.length_m,
@@ -493,12 +495,10 @@ fn jerk_limited_plans_are_qep_stable_within_every_limit() {
 
 fn windy(target_altitude: f64, wind_m_s: f64) -> Value {
     let mut b = thesis_body(target_altitude, 0.05);
-    b["wind"] = json!({
-        "flow": {"kind": "uniform", "speed_m_s": wind_m_s},
-        "cable_diameter_m": 0.006,
-        "aerostat_drag_coefficient_nondim": 0.47,
-        "aerostat_reference_area_m2": 3.0
-    });
+    b["wind"] = json!({"flow": {"kind": "uniform", "speed_m_s": wind_m_s}});
+    b["cable"]["diameter_m"] = json!(0.006);
+    b["aerostat"]["drag_coefficient_nondim"] = json!(0.47);
+    b["aerostat"]["reference_area_m2"] = json!(3.0);
     b
 }
 

@@ -35,8 +35,9 @@ const RESERVE_F: f64 = 950.0;
 
 fn calm_body(target: f64, ei: f64, elements: usize) -> Value {
     json!({
-        "cable": {"mass_per_length_kg_m": RHO_A},
-        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+        "cable": {"mass_per_length_kg_m": RHO_A, "breaking_strength_n": 20000.0, "diameter_m": 0.006},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.47,
+                     "reference_area_m2": 3.0},
         "initial_length_m": 1.0,
         "target_elevation_m": target,
         "winch": {"max_rate_m_s": 100.0, "max_acceleration_m_s2": 5.0},
@@ -49,17 +50,16 @@ fn calm_body(target: f64, ei: f64, elements: usize) -> Value {
 
 fn wind_body(target: f64) -> Value {
     json!({
-        "cable": {"mass_per_length_kg_m": RHO_A},
-        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+        "cable": {"mass_per_length_kg_m": RHO_A, "breaking_strength_n": 20000.0, "diameter_m": 0.006},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.47,
+                     "reference_area_m2": 3.0},
         "initial_length_m": 1.0,
         "target_elevation_m": target,
         "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0, "max_jerk_m_s3": 1.0},
         "lift_reserve_nondim": 0.05,
-        "tether": {"breaking_strength_n": 20000.0, "safety_factor_nondim": 5.0},
+        "required_safety_factor_nondim": 5.0,
         "samples": 41,
-        "wind": {"flow": {"kind": "log_law", "reference_speed_m_s": 3.0, "roughness_length_m": 0.03},
-                 "cable_diameter_m": 0.006, "aerostat_drag_coefficient_nondim": 0.47,
-                 "aerostat_reference_area_m2": 3.0},
+        "wind": {"flow": {"kind": "log_law", "reference_speed_m_s": 3.0, "roughness_length_m": 0.03}},
         "stability": {"method": "quasi_static_ge", "bending_stiffness_n_m2": 1000.0,
                       "elements": 40, "check_elements": 16, "table_samples": 12, "check_samples": 41}
     })

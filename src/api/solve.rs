@@ -163,7 +163,7 @@ pub fn check_sync_chart(req: &ChartRequest, limits: &Limits) -> Result<(), ApiEr
     let work = points.saturating_mul(req.system.model.mesh_elements());
     if points > limits.max_sync_chart_points {
         return Err(ApiError::too_large(
-            "rates_m_s.count",
+            &req.params.rates_m_s.count_field("rates_m_s"),
             format!(
                 "the chart has {points} points; synchronous charts have at most {}",
                 limits.max_sync_chart_points
@@ -172,7 +172,7 @@ pub fn check_sync_chart(req: &ChartRequest, limits: &Limits) -> Result<(), ApiEr
     }
     if work > limits.max_sync_chart_work {
         return Err(ApiError::too_large(
-            "rates_m_s.count",
+            &req.params.rates_m_s.count_field("rates_m_s"),
             format!(
                 "the chart has {points} points × {} elements = {work}; synchronous charts have at most {}",
                 req.system.model.mesh_elements(),

@@ -19,8 +19,7 @@ use crate::numerics::params::AerostatSystem;
 
 /// The rates of the chart, in order.
 fn rates(req: &ChartRequest) -> Result<Vec<f64>, RequestError> {
-    let grid = &req.params.rates_m_s;
-    Ok(chart::rate_grid(grid.min, grid.max, grid.count)?)
+    Ok(req.params.rates_m_s.rates("rates_m_s")?)
 }
 
 /// The buoyancies of the series: the request's list, else the aerostat's.
@@ -34,7 +33,7 @@ fn buoyancies(req: &ChartRequest, sys: &AerostatSystem) -> Vec<f64> {
 
 /// Items of a chunked chart: its rates.
 pub fn chart_rate_count(req: &ChartRequest) -> usize {
-    req.params.rates_m_s.count
+    req.params.rates_m_s.count()
 }
 
 /// One series of a chunk on the wire: the buoyancy and, per point, its

@@ -279,20 +279,9 @@ pub struct SafeRateParams {
     pub target_elevation_m: f64,
 }
 
-/// An evenly spaced grid of rates.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct RateGrid {
-    /// Smallest rate (m/s).
-    #[schema(example = 1.0, minimum = 1e-6, maximum = 1000.0)]
-    pub min: f64,
-    /// Largest rate (m/s).
-    #[schema(example = 100.0, minimum = 1e-6, maximum = 1000.0)]
-    pub max: f64,
-    /// Number of rates.
-    #[schema(example = 100, minimum = 1, maximum = 1000000)]
-    pub count: usize,
-}
+/// The rates of a chart (m/s, each above 0 and at most 1000): a list, or
+/// `{min, max, count}` evenly spaced (the one [`GridInput`] of every grid).
+pub type RateGrid = crate::contract::system::GridInput;
 
 /// `POST /api/v1/charts`: t* and h* against rate, one series per buoyancy.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]

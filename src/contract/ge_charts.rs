@@ -443,8 +443,7 @@ pub fn prepare_chart(req: &GeChartRequest) -> Result<CoreChart, InvalidInput> {
         gravity_m_s2: g,
         elements: m.elements,
     };
-    let grid = &req.rates_m_s;
-    let rates = rate_grid(grid.min, grid.max, grid.count)?;
+    let rates = req.rates_m_s.rates("rates_m_s")?;
     let buoyancies = if req.net_buoyancies_n.is_empty() {
         vec![req.aerostat.net_buoyancy("aerostat")?]
     } else {
@@ -530,7 +529,7 @@ pub fn prepare_chart(req: &GeChartRequest) -> Result<CoreChart, InvalidInput> {
 pub fn chart_points(req: &GeChartRequest) -> usize {
     let n = |v: usize| v.max(1);
     req.rates_m_s
-        .count
+        .count()
         .saturating_mul(n(req.stiffness_ratios.len()))
         .saturating_mul(n(req.perturbation.as_ref().map_or(1, |p| p.forces_n.len())))
         .saturating_mul(n(req.net_buoyancies_n.len()))

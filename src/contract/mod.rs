@@ -129,6 +129,19 @@ pub fn parse_value<T: serde::de::DeserializeOwned>(
             .find_map(|p| message.strip_prefix(p))
             .and_then(|rest| rest.split('`').next());
         let unknown = message.starts_with("unknown field `");
+        // A hand-written deserialiser names the part at fault: "in `key`: …".
+        if let Some(rest) = message.strip_prefix("in `")
+            && let Some((key, reason)) = rest.split_once("`: ")
+        {
+            let field = if path == "." || path.is_empty() {
+                key.to_string()
+            } else if key.starts_with('[') {
+                format!("{path}{key}")
+            } else {
+                format!("{path}.{key}")
+            };
+            return RequestError::Invalid(InvalidInput::new(field, reason));
+        }
         let field = match named {
             // serde_path_to_error already ends the path with an unknown key
             // of a plain struct (not inside a tagged enum).
@@ -240,5 +253,9 @@ pub fn plain_words(message: &str) -> String {
         }
         e => format!("must be {e}"),
     };
+    if got == "null" {
+        // An empty input: say what belongs there.
+        return format!("is empty: it {}", need.replacen("must be", "needs", 1));
+    }
     format!("{need}, got {got}")
 }

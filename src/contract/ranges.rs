@@ -151,10 +151,13 @@ impl CheckRanges for SafeRateParams {
 }
 
 fn check_rate_grid(grid: &RateGrid, prefix: &str) -> Checked {
-    POSITIVE_RATE_M_S.check(&at(prefix, "min"), grid.min)?;
-    POSITIVE_RATE_M_S
-        .check(&at(prefix, "max"), grid.max)
-        .map(drop)
+    match grid {
+        RateGrid::Range(r) => {
+            POSITIVE_RATE_M_S.check(&at(prefix, "min"), r.min)?;
+            POSITIVE_RATE_M_S.check(&at(prefix, "max"), r.max).map(drop)
+        }
+        RateGrid::List(v) => each(POSITIVE_RATE_M_S, prefix, v),
+    }
 }
 
 impl CheckRanges for ChartParams {
@@ -336,6 +339,7 @@ fn check_ge_system(
     gravity_m_s2: f64,
 ) -> Checked {
     cable.check_ranges()?;
+    cable.check_given("cable")?;
     if let Some(a) = aerostat {
         a.net_buoyancy_ge("aerostat")?;
         a.mass("aerostat")?;

@@ -566,7 +566,7 @@ pub fn safe_rate(req: &SafeRateRequest) -> Result<SafeRateResponse, RequestError
 pub fn chart_points(req: &ChartRequest) -> usize {
     req.params
         .rates_m_s
-        .count
+        .count()
         .saturating_mul(req.params.net_buoyancies_n.len().max(1))
 }
 
@@ -588,11 +588,7 @@ pub fn chart(
         )
         .into());
     }
-    let rates = chart::rate_grid(
-        req.params.rates_m_s.min,
-        req.params.rates_m_s.max,
-        req.params.rates_m_s.count,
-    )?;
+    let rates = req.params.rates_m_s.rates("rates_m_s")?;
     let buoyancies = if req.params.net_buoyancies_n.is_empty() {
         vec![sys.net_buoyancy_n]
     } else {

@@ -98,8 +98,8 @@ pub fn check(e: &Estimate, limit: u64) -> Result<(), RequestError> {
     Err(InvalidInput::new(
         e.field.clone(),
         format!(
-            "the answer would take about {} ({} bytes), more than the job limit of {} \
-             (TETHERPLAN_JOB_MAX_RESULT_BYTES): ask for fewer points or split the job",
+            "the answer would take about {} ({} bytes), more than this server keeps for one job ({}): \
+             ask for fewer points or split the job",
             human_bytes(e.result_bytes),
             e.result_bytes,
             human_bytes(limit)
@@ -130,9 +130,8 @@ pub fn check_batch(items: impl Iterator<Item = Estimate>, limit: u64) -> Result<
     Err(InvalidInput::new(
         "request",
         format!(
-            "the batch's {} answers would take about {} ({total} bytes) together, more than the job \
-             limit of {} (TETHERPLAN_JOB_MAX_RESULT_BYTES); the limit is passed at request[{first}]: \
-             split the batch",
+            "the batch's {} answers would take about {} ({total} bytes) together, more than this server \
+             keeps for one job ({}); the limit is passed at request[{first}]: split the batch",
             estimates.len(),
             human_bytes(total),
             human_bytes(limit)

@@ -151,9 +151,7 @@ impl JobKind for ChartRequest {
             )
             .into());
         }
-        let grid = &self.params.rates_m_s;
-        chart::rate_grid(grid.min, grid.max, grid.count.min(2))?;
-        chart::rate_grid(grid.min, grid.max, grid.count).map(drop)?;
+        self.params.rates_m_s.rates("rates_m_s").map(drop)?;
         chart::deployment_chart_with(
             &model.system,
             self.system.discretisation()?,
@@ -172,8 +170,7 @@ impl JobKind for ChartRequest {
         self.validate()?;
         let model = self.system.model()?;
         let sys = model.system;
-        let grid = &self.params.rates_m_s;
-        let rates = chart::rate_grid(grid.min, grid.max, grid.count)?;
+        let rates = self.params.rates_m_s.rates("rates_m_s")?;
         let buoyancies = self.buoyancies(&sys);
         let total = rates.len() * buoyancies.len();
         let chunk_rates = (CHART_CHUNK_POINTS / buoyancies.len()).max(1);
@@ -226,7 +223,7 @@ impl JobKind for ChartRequest {
     }
     fn estimate(&self) -> Estimate {
         let series = self.params.net_buoyancies_n.len().max(1) as f64;
-        let points = series * self.params.rates_m_s.count as f64;
+        let points = series * self.params.rates_m_s.count() as f64;
         E::bytes(
             "rates_m_s.count",
             (est::CHART_BASE as f64)

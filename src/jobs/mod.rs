@@ -550,7 +550,7 @@ pub fn try_execute_next(queue: &JobQueue) -> Result<Option<Executed>, StoreError
                 "result_too_large",
                 None,
                 format!(
-                    "the answer has {} bytes, more than the limit of {} bytes (TETHERPLAN_JOB_MAX_RESULT_BYTES); \
+                    "the answer has {} bytes, more than this server keeps for one job ({} bytes): \
                  ask for fewer points",
                     result.len(),
                     limits.max_job_result_bytes
@@ -576,7 +576,7 @@ pub fn try_execute_next(queue: &JobQueue) -> Result<Option<Executed>, StoreError
             "run_time_exceeded",
             None,
             format!(
-                "the job ran longer than the limit of {} s (TETHERPLAN_JOB_MAX_RUN_S) and was stopped",
+                "the job ran longer than this server allows one job ({} s) and was stopped",
                 limits.max_job_run_time.as_secs_f64()
             ),
         ))?,

@@ -218,3 +218,32 @@ pub fn replaced(v: &Value, path: &[String], new: Value) -> Value {
     replace(&mut out, path, new);
     out
 }
+
+/// The router over an in-memory store with API `tokens` (as
+/// `TETHERPLAN_API_TOKENS=alpha,beta` configures it), and the queue.
+pub fn app_with_tokens(tokens: &[&str]) -> (Router, Arc<JobQueue>) {
+    let queue = queue_with(1, Limits::default());
+    let tokens: Vec<String> = tokens.iter().map(|t| t.to_string()).collect();
+    (
+        api::router(
+            AppState::new(queue.clone()).with_tokens(&tokens),
+            Path::new("static"),
+        ),
+        queue,
+    )
+}
+
+/// `method uri` as the holder of `token`, with `body` as JSON when given;
+/// the status and the answer as text.
+pub async fn send_as(
+    app: &Router,
+    token: &str,
+    method: &str,
+    uri: &str,
+    body: Option<&Value>,
+) -> (StatusCode, String) {
+    let (req, body) = json_request(method, uri, body);
+    let req = req.header(header::AUTHORIZATION, format!("Bearer {token}"));
+    let answer = request(app, req, body).await;
+    (answer.status, answer.text)
+}

@@ -57,6 +57,7 @@ impl EnvelopeRequest {
             WindFlowInput::PowerLaw {
                 coefficient_m_s,
                 exponent_nondim,
+                reference_height_m,
             } => (
                 WindShape::PowerLaw {
                     exponent: require_range(
@@ -66,8 +67,13 @@ impl EnvelopeRequest {
                         false,
                         2.0,
                     )?,
-                    // U = a z^p: the grid speed is the speed at 1 m.
-                    reference_height_m: 1.0,
+                    reference_height_m: require_range(
+                        "wind.flow.reference_height_m",
+                        *reference_height_m,
+                        0.0,
+                        true,
+                        1e4,
+                    )?,
                 },
                 *coefficient_m_s,
             ),

@@ -9,7 +9,11 @@ use utoipa::ToSchema;
 use crate::numerics::params::{InvalidInput, compact};
 
 /// Values: a list `[..]`, or `{min, max, count}` evenly spaced, ends included.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+///
+/// Deserialised by hand (not `untagged`), so that an error names the part
+/// at fault (`in \`count\`: …`, lifted into the field path by
+/// [`crate::contract::parse_value`]) instead of "matches no variant".
+#[derive(Clone, Debug, Serialize, ToSchema, PartialEq)]
 #[serde(untagged)]
 pub enum GridInput {
     /// The values, in the order given.
@@ -19,8 +23,7 @@ pub enum GridInput {
 }
 
 /// An evenly spaced grid.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[derive(Clone, Debug, Serialize, ToSchema, PartialEq)]
 pub struct GridRangeInput {
     #[schema(example = 1.0)]
     pub min: f64,
@@ -28,6 +31,60 @@ pub struct GridRangeInput {
     pub max: f64,
     #[schema(example = 10, minimum = 1)]
     pub count: usize,
+}
+
+impl<'de> Deserialize<'de> for GridInput {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        use serde_json::Value;
+        let describe = crate::contract::describe_json;
+        let number = |key: &str, v: &Value| -> Result<f64, D::Error> {
+            v.as_f64().ok_or_else(|| {
+                D::Error::custom(format!("in `{key}`: must be a number, got {}", describe(v)))
+            })
+        };
+        match Value::deserialize(d)? {
+            Value::Array(items) => items
+                .iter()
+                .enumerate()
+                .map(|(i, x)| number(&format!("[{i}]"), x))
+                .collect::<Result<_, _>>()
+                .map(Self::List),
+            Value::Object(m) => {
+                for k in m.keys() {
+                    if !matches!(k.as_str(), "min" | "max" | "count") {
+                        return Err(D::Error::custom(format!(
+                            "unknown field `{k}`, expected one of `min`, `max`, `count`"
+                        )));
+                    }
+                }
+                let get = |k: &str| {
+                    m.get(k)
+                        .ok_or_else(|| D::Error::custom(format!("missing field `{k}`")))
+                };
+                let count = get("count")?;
+                // A whole number, also when written as 1e9.
+                let n = match count.as_f64() {
+                    Some(c) if c >= 0.0 && c.fract() == 0.0 => c.min(usize::MAX as f64) as usize,
+                    _ => {
+                        return Err(D::Error::custom(format!(
+                            "in `count`: must be a whole number (1 or more), got {}",
+                            describe(count)
+                        )));
+                    }
+                };
+                Ok(Self::Range(GridRangeInput {
+                    min: number("min", get("min")?)?,
+                    max: number("max", get("max")?)?,
+                    count: n,
+                }))
+            }
+            other => Err(D::Error::custom(format!(
+                "give a list of numbers, like [1, 2, 5], or an even grid {{\"min\", \"max\", \"count\"}}, got {}",
+                describe(&other)
+            ))),
+        }
+    }
 }
 
 /// The bounds a grid's values and count must respect.
@@ -128,6 +185,28 @@ impl GridInput {
                 }
                 Ok(evenly_spaced(lo, hi, r.count))
             }
+        }
+    }
+}
+
+impl GridInput {
+    /// Rates (m/s): a range through [`crate::numerics::chart::rate_grid`]
+    /// (its checks and values), a list checked value by value (each above
+    /// 0 and at most 1000, at most `MAX_CHART_POINTS`); `at` names the grid.
+    pub fn rates(&self, at: &str) -> Result<Vec<f64>, InvalidInput> {
+        match self {
+            Self::Range(r) => crate::numerics::chart::rate_grid(r.min, r.max, r.count)
+                .map_err(|e| InvalidInput::new(e.field.replacen("rates_m_s", at, 1), e.reason)),
+            Self::List(_) => self.values(
+                at,
+                GridBounds {
+                    min: 0.0,
+                    exclusive_min: true,
+                    max: 1000.0,
+                    max_count: crate::numerics::chart::MAX_CHART_POINTS,
+                    unit: "m/s",
+                },
+            ),
         }
     }
 }

@@ -165,12 +165,16 @@ pub enum WindFlowInput {
         #[schema(example = 6.0, minimum = -150.0, maximum = 150.0)]
         speed_m_s: f64,
     },
-    /// U = a z^p; a is the speed at z = 1 m.
+    /// U = a (z/z_ref)^p; a is the speed at the reference height (default 1 m).
     PowerLaw {
         #[schema(example = 3.0, minimum = -150.0, maximum = 150.0)]
         coefficient_m_s: f64,
         #[schema(example = 0.14, minimum = 0.0, maximum = 2.0)]
         exponent_nondim: f64,
+        /// Height of the speed `coefficient_m_s` (m), default 1.
+        #[serde(default = "one_metre")]
+        #[schema(example = 10.0, exclusive_minimum = 0.0, maximum = 10000.0)]
+        reference_height_m: f64,
     },
     /// Linear interpolation in (z, U), constant beyond the ends (1 to 10 000 points).
     Tabulated { points: Vec<WindPointInput> },
@@ -202,6 +206,10 @@ impl WindFlowInput {
             Self::LogLaw { speed_m_s, .. } => *speed_m_s == 0.0,
         }
     }
+}
+
+fn one_metre() -> f64 {
+    1.0
 }
 
 pub(crate) fn default_reference_height() -> f64 {

@@ -397,16 +397,29 @@ impl WindFlowInput {
             Self::PowerLaw {
                 coefficient_m_s,
                 exponent_nondim,
-            } => WindProfile::Flow(SteadyFlow::PowerLaw {
-                coefficient: require_range(
+                reference_height_m,
+            } => {
+                let a = require_range(
                     &f("coefficient_m_s"),
                     *coefficient_m_s,
                     -150.0,
                     false,
                     150.0,
-                )?,
-                exponent: require_range(&f("exponent_nondim"), *exponent_nondim, 0.0, false, 2.0)?,
-            }),
+                )?;
+                let p = require_range(&f("exponent_nondim"), *exponent_nondim, 0.0, false, 2.0)?;
+                let zr = require_range(
+                    &f("reference_height_m"),
+                    *reference_height_m,
+                    0.0,
+                    true,
+                    1e4,
+                )?;
+                // a (z/z_ref)^p = (a z_ref^-p) z^p
+                WindProfile::Flow(SteadyFlow::PowerLaw {
+                    coefficient: if zr == 1.0 { a } else { a * zr.powf(-p) },
+                    exponent: p,
+                })
+            }
             Self::Tabulated { points } => {
                 if points.is_empty() || points.len() > 10_000 {
                     return Err(InvalidInput::new(
