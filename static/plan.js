@@ -42,6 +42,16 @@
     }
     togglePreset();
   });
+  // A named aerostat: its lift, mass and aerodynamics unless typed over.
+  const AEROSTAT = ["aerostat.net_buoyancy_n", "aerostat.mass_kg", "aerostat.drag_coefficient_nondim", "aerostat.reference_area_m2", "aerostat.lift_coefficient_nondim"];
+  function toggleAerostat() {
+    const preset = form.elements["aerostat.preset"].value;
+    for (const name of AEROSTAT) form.elements[name].placeholder = preset ? "blank: from the aerostat" : "";
+  }
+  form.elements["aerostat.preset"].addEventListener("change", (ev) => {
+    if (!S.restoring && ev.target.value) for (const name of AEROSTAT) form.elements[name].value = "";
+    toggleAerostat();
+  });
   function toggleWind() {
     const kind = form.elements["wind.flow.kind"].value;
     for (const el of form.querySelectorAll("[data-wind-kind]")) el.hidden = el.dataset.windKind !== kind;
@@ -69,7 +79,7 @@
     const inputs = [];
     const liftSd = Number($("plan-bands-lift-sd").value);
     const rhoSd = Number($("plan-bands-rhoa-sd").value);
-    if (liftSd > 0) inputs.push({ field: "aerostat.net_buoyancy_n", distribution: "normal", mean: body.aerostat.net_buoyancy_n, std_dev: liftSd });
+    if (liftSd > 0 && body.aerostat.net_buoyancy_n != null) inputs.push({ field: "aerostat.net_buoyancy_n", distribution: "normal", mean: body.aerostat.net_buoyancy_n, std_dev: liftSd });
     if (rhoSd > 0 && body.cable.mass_per_length_kg_m != null) {
       inputs.push({ field: "cable.mass_per_length_kg_m", distribution: "normal", mean: body.cable.mass_per_length_kg_m, std_dev: rhoSd });
     }
@@ -204,7 +214,7 @@
     const w = r.wind;
     const sf = r.limits?.min_safety_factor_nondim;
     const rows = [
-      ["Tether needed", w ? (w.target_length_m == null ? "out of reach" : `${fmt(w.target_length_m, 1)} m`) : `${fmt(req.target_elevation_m, 1)} m`],
+      ["Tether needed", w ? (w.target_length_m == null ? `out of reach (at most ${fmt(w.reachable_altitude_m, 0)} m up)` : `${fmt(w.target_length_m, 1)} m`) : `${fmt(req.target_elevation_m, 1)} m`],
       ["Blow-down angle", w?.blowdown_angle_deg == null ? "–" : `${fmt(w.blowdown_angle_deg, 1)}°`],
       ["Peak tension", r.limits?.peak_tension_n == null ? "–" : `${fmt(r.limits.peak_tension_n, 0)} N`],
       ["Safety factor", sf == null ? "not checked" : fmt(sf, 1)],
@@ -284,11 +294,11 @@
     phases.textContent = "";
     r.phases.forEach((p, i) => row(phases, [
       [String(i + 1)],
+      [p.instruction, "what"],
       [`${fmt(p.start_time_s, 1)} – ${fmt(p.end_time_s, 1)}`, "num"],
       [`${fmt(p.start_length_m, 1)} → ${fmt(p.end_length_m, 1)}`, "num"],
       [`${fmt(Math.abs(p.start_rate_m_s), 2)} → ${fmt(Math.abs(p.end_rate_m_s), 2)}`, "num"],
       [fmt(p.mean_acceleration_m_s2, 3), "num"],
-      [p.instruction],
     ]));
     const all = $("plan-table").querySelector("tbody");
     all.textContent = "";
@@ -487,6 +497,7 @@
   // The page opens planning: the shared URL's inputs if it carries any, else the defaults.
   S.readUrl();
   togglePreset();
+  toggleAerostat();
   toggleWind();
   state.runPlan = runPlan;
   runPlan();

@@ -64,11 +64,16 @@ window.tetherplanShared = window.tetherplanShared || {};
       normal_drag_coefficient_nondim: use === "calm" ? undefined : n("cable.normal_drag_coefficient_nondim", { optional: true }),
       axial_stiffness_n: use === "calm" ? undefined : n("cable.axial_stiffness_n", { optional: true }),
     });
-    const aerostat = { net_buoyancy_n: n("aerostat.net_buoyancy_n"), mass_kg: n("aerostat.mass_kg") };
+    // A named aerostat fills what is left blank.
+    const body = named(roots, "aerostat.preset")?.value || "";
+    const a = (name) => n(name, { optional: !!body });
+    const aerostat = compact({ preset: body || undefined, net_buoyancy_n: a("aerostat.net_buoyancy_n"), mass_kg: a("aerostat.mass_kg") });
     if (use !== "calm") {
-      aerostat.drag_coefficient_nondim = n("aerostat.drag_coefficient_nondim");
-      aerostat.reference_area_m2 = n("aerostat.reference_area_m2");
-      aerostat.lift_coefficient_nondim = n("aerostat.lift_coefficient_nondim");
+      Object.assign(aerostat, compact({
+        drag_coefficient_nondim: a("aerostat.drag_coefficient_nondim"),
+        reference_area_m2: a("aerostat.reference_area_m2"),
+        lift_coefficient_nondim: a("aerostat.lift_coefficient_nondim"),
+      }));
     }
     const sys = { cable, aerostat, gravity_m_s2: n("gravity_m_s2") };
     if (use === "calm") {
