@@ -36,6 +36,53 @@ struct InputArg {
     /// Request JSON file; `-` or absent reads standard input.
     #[arg(long, short)]
     input: Option<PathBuf>,
+    /// Job database holding the named systems a request refers to with
+    /// `"system": "name"` (the one `serve` uses); without it such a request
+    /// is refused.
+    #[arg(long)]
+    db: Option<PathBuf>,
+    /// PostgreSQL job store holding the named systems (replaces `--db`).
+    #[arg(long)]
+    database_url: Option<String>,
+    /// The API token the named systems were stored under (none: stored
+    /// without tokens).
+    #[arg(long, env = "TETHERPLAN_TOKEN")]
+    token: Option<String>,
+}
+
+/// The request with its named system merged in (`--db`).
+fn resolve_system(arg: &InputArg, body: Vec<u8>) -> Result<Vec<u8>, RequestError> {
+    use tetherplan::numerics::params::InvalidInput;
+    let mut store: Option<Box<dyn tetherplan::jobs::store::JobBackend>> = None;
+    let owner = arg
+        .token
+        .as_deref()
+        .map(tetherplan::api::auth::Tokens::owner_id)
+        .unwrap_or_default();
+    let resolved = contract::system::resolve::resolve_body::<RequestError>(&body, &mut |name| {
+        if store.is_none() {
+            if arg.db.is_none() && arg.database_url.is_none() {
+                return Err(InvalidInput::new(
+                    "system",
+                    format!("names the stored system `{name}`: give the job database that holds it with --db"),
+                )
+                .into());
+            }
+            let config = tetherplan::config::StoreConfig::new(
+                arg.db.clone().unwrap_or_default(),
+                arg.database_url.clone(),
+            );
+            store = Some(config.open().map_err(|e| {
+                InvalidInput::new("system", format!("the job database cannot be opened: {e}"))
+            })?);
+        }
+        let s = store.as_ref().expect("opened above");
+        let found = s
+            .get_system(&owner, name)
+            .map_err(|e| InvalidInput::new("system", format!("cannot be read: {e}")))?;
+        Ok(found.and_then(|f| serde_json::from_str(&f.body).ok()))
+    })?;
+    Ok(resolved.unwrap_or(body))
 }
 
 #[derive(Subcommand)]
@@ -132,7 +179,7 @@ fn answer_with<Req, Resp: Serialize>(
             return ExitCode::from(2);
         }
     };
-    match parse(&body).and_then(|req| run(&req)) {
+    match resolve_system(arg, body).and_then(|body| parse(&body).and_then(|req| run(&req))) {
         Ok(resp) => {
             print_json(&resp);
             ExitCode::SUCCESS
@@ -263,7 +310,10 @@ fn main() -> ExitCode {
             contract::parse_plain::<contract::envelope::dto::EnvelopeRequest>,
             |req| {
                 req.validate()?;
-                let bar = progress_bar(req.wind_speeds_m_s.count as u64, "wind speeds");
+                let bar = progress_bar(
+                    req.wind_speeds_m_s.as_ref().map_or(1, |g| g.count()) as u64,
+                    "wind speeds",
+                );
                 let out = contract::envelope::envelope(req, Parallelism::Rayon, &bar);
                 bar.0.finish_and_clear();
                 out

@@ -62,12 +62,24 @@ async fn unknown_fields_and_bad_values_name_their_path() {
     assert_eq!(r["error"]["field"], "winch.max_jerk_m_s3", "{r}");
 
     let mut body = example();
-    body["wind"] = json!({"flow": {"kind": "uniform", "speed_m_s": 5.0}, "cable_diameter_m": 0.006,
-        "aerostat_drag_coefficient_nondim": -1.0, "aerostat_reference_area_m2": 20.0});
+    body["wind"] = json!({"flow": {"kind": "uniform", "speed_m_s": 5.0}});
+    body["aerostat"]["drag_coefficient_nondim"] = json!(-1.0);
     let (status, r) = post(&body).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
     assert_eq!(
-        r["error"]["field"], "wind.aerostat_drag_coefficient_nondim",
+        r["error"]["field"], "aerostat.drag_coefficient_nondim",
+        "{r}"
+    );
+
+    // The plan's old names are refused naming their new place (SPEC §9).
+    let mut body = example();
+    body["wind"] =
+        json!({"flow": {"kind": "uniform", "speed_m_s": 5.0}, "cable_diameter_m": 0.006});
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
+    assert_eq!(r["error"]["field"], "wind.cable_diameter_m", "{r}");
+    assert_eq!(
+        r["error"]["message"], "wind.cable_diameter_m: moved to cable.diameter_m",
         "{r}"
     );
 
@@ -110,8 +122,9 @@ async fn a_plan_job_answers_what_the_route_answers() {
     let (app, queue) = app_and_queue();
     let mut body = example();
     body["winch"]["max_jerk_m_s3"] = json!(1.0);
-    body["wind"] = json!({"flow": {"kind": "uniform", "speed_m_s": 3.0}, "cable_diameter_m": 0.006,
-        "aerostat_drag_coefficient_nondim": 0.47, "aerostat_reference_area_m2": 3.0});
+    body["wind"] = json!({"flow": {"kind": "uniform", "speed_m_s": 3.0}});
+    body["aerostat"]["drag_coefficient_nondim"] = json!(0.47);
+    body["aerostat"]["reference_area_m2"] = json!(3.0);
     body["samples"] = json!(41);
     let (status, sync) = post(&body).await;
     assert_eq!(status, StatusCode::OK, "{sync}");
@@ -185,4 +198,85 @@ fn cli_prints_the_same_plan() {
     let r: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(r["feasible"], true);
     assert!((r["duration_s"].as_f64().unwrap() - 49.975).abs() < 0.01);
+}
+
+/// The issue-20 scenario: to 1000 m altitude in a uniform 6 m/s wind
+/// (0.078 kg/m, F = 1000 N, m = 10 kg, C_D 0.3 on 20 m², 6 mm tether).
+fn windy(target_m: f64) -> Value {
+    json!({
+        "cable": {"mass_per_length_kg_m": 0.078, "diameter_m": 0.006},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0,
+                     "drag_coefficient_nondim": 0.3, "reference_area_m2": 20.0},
+        "wind": {"flow": {"kind": "uniform", "speed_m_s": 6.0}},
+        "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0},
+        "target_elevation_m": target_m,
+        "samples": 41
+    })
+}
+
+#[tokio::test]
+async fn the_wind_blows_a_1000_m_plan_to_no_go_and_900_m_flies() {
+    let (status, r) = post(&windy(1000.0)).await;
+    assert_eq!(status, StatusCode::OK, "{r}");
+    assert_eq!(r["go"], false, "{}", r["reason"]);
+    assert_eq!(r["binding_limit"], "wind_blowdown");
+    // The highest altitude in this wind with full buoyancy (issue 20: 977.9 m).
+    let top = r["wind"]["reachable_altitude_m"].as_f64().unwrap();
+    assert!((top - 977.9).abs() < 0.05, "{top}");
+    assert_eq!(r["wind"]["target_length_m"], Value::Null);
+    // No breaking strength: the answer says the tension is not checked, and
+    // still reports the tension at the end (the top of the tether, at rest).
+    assert_eq!(r["tension_checked"], false);
+    assert!(
+        r["reason"]
+            .as_str()
+            .unwrap()
+            .contains("tension NOT checked")
+    );
+    let peak = r["limits"]["peak_tension_n"].as_f64().unwrap();
+    assert!(peak > 1000.0 && peak < 1100.0, "{peak}");
+    assert_eq!(r["limits"]["min_safety_factor_nondim"], Value::Null);
+
+    let mut body = windy(900.0);
+    body["cable"]["breaking_strength_n"] = json!(30000.0);
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::OK, "{r}");
+    assert_eq!(r["go"], true, "{}", r["reason"]);
+    assert_eq!(r["tension_checked"], true);
+    let w = &r["wind"];
+    let length = w["target_length_m"].as_f64().unwrap();
+    let angle = w["blowdown_angle_deg"].as_f64().unwrap();
+    assert!(length > 900.0, "{length}");
+    // The winch–aerostat line: cos(angle) = altitude / straight distance.
+    let down = w["target_downwind_m"].as_f64().unwrap();
+    assert!(
+        (angle - down.atan2(900.0).to_degrees()).abs() < 1e-6,
+        "{angle} {down}"
+    );
+    assert!(angle > 5.0 && angle < 60.0, "{angle}");
+    let peak = r["limits"]["peak_tension_n"].as_f64().unwrap();
+    let sf = r["limits"]["min_safety_factor_nondim"].as_f64().unwrap();
+    assert!((sf - 30000.0 / peak).abs() < 1e-9 * sf, "{sf} {peak}");
+    // The schedule ends at the tether length the altitude needs.
+    let last = r["schedule"].as_array().unwrap().last().unwrap().clone();
+    assert!((last["length_m"].as_f64().unwrap() - length).abs() < 1e-6);
+    assert!(
+        (last["altitude_m"].as_f64().unwrap() - 900.0).abs() < 0.01,
+        "{last}"
+    );
+
+    // In wind the drag data are required, each refused naming its field.
+    let mut body = windy(900.0);
+    body["aerostat"]
+        .as_object_mut()
+        .unwrap()
+        .remove("drag_coefficient_nondim");
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
+    assert_eq!(r["error"]["field"], "aerostat.drag_coefficient_nondim");
+    let mut body = windy(900.0);
+    body["cable"].as_object_mut().unwrap().remove("diameter_m");
+    let (status, r) = post(&body).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
+    assert_eq!(r["error"]["field"], "cable.diameter_m");
 }

@@ -20,6 +20,7 @@ pub mod openapi;
 pub mod server;
 pub mod solve;
 pub mod spec;
+pub mod systems;
 pub mod tether;
 
 use std::path::Path;
@@ -160,6 +161,14 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
             "/api/v1/envelope/bands",
             post(bands::compute_envelope_bands),
         )
+        .route("/api/v1/systems", get(systems::list_systems))
+        .route(
+            "/api/v1/systems/{name}",
+            axum::routing::put(systems::put_system)
+                .get(systems::get_system)
+                .delete(systems::delete_system),
+        )
+        .route("/api/v1/presets", get(systems::list_presets))
         .route("/api/v1/jobs", post(jobs::create_job).get(jobs::list_jobs))
         .route(
             "/api/v1/jobs/{id}",

@@ -39,6 +39,11 @@ use crate::jobs::store::JobStatus;
         solve::compute_bands,
         crate::api::bands::compute_plan_bands,
         crate::api::bands::compute_envelope_bands,
+        crate::api::systems::put_system,
+        crate::api::systems::get_system,
+        crate::api::systems::delete_system,
+        crate::api::systems::list_systems,
+        crate::api::systems::list_presets,
         jobs::create_job,
         jobs::list_jobs,
         jobs::get_job,
@@ -58,6 +63,7 @@ use crate::jobs::store::JobStatus;
     tags(
         (name = "solve", description = "Synchronous answers (about a second at most)"),
         (name = "jobs", description = "Persisted batch jobs for large or many requests"),
+        (name = "systems", description = "Named systems per token (SPEC §9) and the presets"),
         (name = "meta", description = "Liveness and this document"),
     )
 )]

@@ -235,9 +235,16 @@ macro_rules! solve_path {
                 (status = 504, description = "No answer within the solve timeout", body = ErrorBody),
             )
         )]
-        pub async fn $name(State(app): State<AppState>, JsonBody(body): JsonBody) -> Result<Response, ApiError> {
+        pub async fn $name(
+            State(app): State<AppState>,
+            axum::Extension(caller): axum::Extension<crate::api::auth::Caller>,
+            JsonBody(body): JsonBody,
+        ) -> Result<Response, ApiError> {
+            let resolver = app.clone();
             app.solve(move |$limits: &SolveCtx| {
-                let $b: &[u8] = &body;
+                // A named system is merged in before the body is parsed.
+                let resolved = resolver.resolve_body(&caller, &body)?;
+                let $b: &[u8] = resolved.as_deref().unwrap_or(&body);
                 let $r: $req = $parse?;
                 $body
             })

@@ -5,23 +5,27 @@
 //!   `example`, what `/docs` "Try it out" sends). Each succeeds as is:
 //!   `tests/api_examples.rs` posts every example of the document and
 //!   asserts a 2xx.
-//! * **The cable is one of two forms**: `mass_per_length_kg_m`, or
-//!   `density_kg_m3` with `area_m2`, never both (the server refuses a mix):
-//!   `CableInput` becomes a `oneOf` of the two, each built from the derived
-//!   property schemas (so their bounds stay the derive's).
+//! * **The cable is one of three forms**: `mass_per_length_kg_m`, or
+//!   `density_kg_m3` with `area_m2` (never both: the server refuses a mix),
+//!   or a `preset` with its `diameter_m`: `CableInput` becomes a `oneOf` of
+//!   the three, each built from the derived property schemas (so their
+//!   bounds stay the derive's).
 //! * **The synchronous limits** per route, in the operation description
 //!   (see [`SYNC_LIMITS`]); the larger requests are valid job requests.
 
 use serde_json::{Value, json};
 
 /// The Table A1 system (steel cable, F = 1000 N, m = 10 kg, L0 = 1 m).
-fn system(elements: usize) -> Value {
+/// No example fixes `model.elements`: the stability answers (t*, h*, safe
+/// rate, chart points) are then converged, and spectra and transient runs
+/// use the default mesh.
+fn system() -> Value {
     json!({
         "cable": {"mass_per_length_kg_m": 0.078},
         "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
         "initial_length_m": 1.0,
         "gravity_m_s2": 9.81,
-        "model": {"kind": "linear_string", "elements": elements}
+        "model": {"kind": "linear_string"}
     })
 }
 
@@ -37,26 +41,26 @@ fn with(mut base: Value, extra: Value) -> Value {
 /// The request example of each POST route (path, body).
 pub fn request_examples() -> Vec<(&'static str, Value)> {
     let critical = with(
-        system(50),
+        system(),
         json!({"profile": {"kind": "constant_rate", "rate_m_s": 10.0}}),
     );
     vec![
         (
             "/api/v1/stability",
             with(
-                system(50),
+                system(),
                 json!({"state": {"length_m": 500.0, "rate_m_s": 10.0, "acceleration_m_s2": 0.0}, "modes": 4}),
             ),
         ),
         ("/api/v1/critical", critical.clone()),
         (
             "/api/v1/safe-rate",
-            with(system(50), json!({"target_elevation_m": 1200.0})),
+            with(system(), json!({"target_elevation_m": 1200.0})),
         ),
         (
             "/api/v1/charts",
             with(
-                system(50),
+                system(),
                 json!({"rates_m_s": {"min": 1.0, "max": 120.0, "count": 60},
                        "net_buoyancies_n": [1000.0, 1500.0]}),
             ),
@@ -64,7 +68,7 @@ pub fn request_examples() -> Vec<(&'static str, Value)> {
         (
             "/api/v1/simulate",
             with(
-                with(system(30), json!({"initial_length_m": 100.0})),
+                with(system(), json!({"initial_length_m": 100.0})),
                 json!({"profile": {"kind": "constant_rate", "rate_m_s": 1.0}, "duration_s": 5.0,
                        "samples": 20, "initial": {"kind": "shape", "tip_deflection_m": 0.1}}),
             ),
@@ -72,7 +76,7 @@ pub fn request_examples() -> Vec<(&'static str, Value)> {
         (
             "/api/v1/frequency-response",
             with(
-                system(20),
+                system(),
                 json!({"profile": {"kind": "constant_rate", "rate_m_s": 1.0}, "duration_s": 10.0,
                        "samples": 10, "aero": {"radius_m": 0.5}, "wind_amplitude_m_s": 10.0,
                        "frequencies_rad_s": {"min": 1.0, "max": 4.0, "count": 4}}),
@@ -271,7 +275,9 @@ fn refine_value(v: &mut Value) {
     }
 }
 
-/// `CableInput` as `oneOf` its two forms, from the derived properties.
+/// `CableInput` as `oneOf` its three forms (mass per length, density and
+/// area, preset with diameter), from the derived properties; every other
+/// property is optional in each form.
 fn cable_one_of(cable: &mut Value) {
     let Some(props) = cable.get("properties").and_then(Value::as_object).cloned() else {
         return;
@@ -286,39 +292,45 @@ fn cable_one_of(cable: &mut Value) {
         }
         p
     };
-    // optional in both forms
-    let breaking = props
-        .get("breaking_strength_n")
-        .cloned()
-        .unwrap_or_else(|| json!({}));
+    let forms = ["mass_per_length_kg_m", "density_kg_m3", "area_m2", "preset"];
+    let common: serde_json::Map<String, Value> = props
+        .iter()
+        .filter(|(k, _)| !forms.contains(&k.as_str()))
+        .map(|(k, v)| (k.clone(), v.clone()))
+        .collect();
+    let form = |title: &str, required: &[&str], own: Vec<(&str, Value)>| {
+        let mut p = common.clone();
+        for (k, v) in own {
+            p.insert(k.to_string(), v);
+        }
+        json!({
+            "title": title,
+            "type": "object",
+            "required": required,
+            "properties": p,
+            "additionalProperties": false
+        })
+    };
     let description = cable
         .get("description")
         .cloned()
         .unwrap_or_else(|| json!("The cable."));
+    let mut preset = props.get("preset").cloned().unwrap_or_else(|| json!({}));
+    if let Some(o) = preset.as_object_mut() {
+        // required here: not null
+        if let Some(Value::Array(one_of)) = o.get_mut("oneOf") {
+            one_of.retain(|v| v.get("type") != Some(&json!("null")));
+        }
+    }
     *cable = json!({
         "description": description,
         "oneOf": [
-            {
-                "title": "mass per length",
-                "type": "object",
-                "required": ["mass_per_length_kg_m"],
-                "properties": {
-                    "mass_per_length_kg_m": number("mass_per_length_kg_m"),
-                    "breaking_strength_n": breaking
-                },
-                "additionalProperties": false
-            },
-            {
-                "title": "density and area",
-                "type": "object",
-                "required": ["density_kg_m3", "area_m2"],
-                "properties": {
-                    "density_kg_m3": number("density_kg_m3"),
-                    "area_m2": number("area_m2"),
-                    "breaking_strength_n": breaking
-                },
-                "additionalProperties": false
-            }
+            form("mass per length", &["mass_per_length_kg_m"],
+                 vec![("mass_per_length_kg_m", number("mass_per_length_kg_m"))]),
+            form("density and area", &["density_kg_m3", "area_m2"],
+                 vec![("density_kg_m3", number("density_kg_m3")), ("area_m2", number("area_m2"))]),
+            form("preset with its diameter", &["preset", "diameter_m"],
+                 vec![("preset", preset), ("mass_per_length_kg_m", props.get("mass_per_length_kg_m").cloned().unwrap_or_else(|| json!({})))]),
         ]
     });
 }
@@ -341,6 +353,6 @@ mod tests {
             assert!(ex.is_object(), "{p} has no request example");
         }
         let cable = &doc["components"]["schemas"]["CableInput"];
-        assert_eq!(cable["oneOf"].as_array().unwrap().len(), 2, "{cable}");
+        assert_eq!(cable["oneOf"].as_array().unwrap().len(), 3, "{cable}");
     }
 }

@@ -50,7 +50,7 @@ solve_path!(
         let points = req.points();
         if points > MAX_SYNC_ENVELOPE_POINTS {
             return Err(ApiError::too_large(
-                "tether_lengths_m.count",
+                &req.tether_lengths_m.count_field("tether_lengths_m"),
                 format!(
                     "the envelope has {points} points; synchronous envelopes have at most {MAX_SYNC_ENVELOPE_POINTS} (submit a job with \"kind\": \"envelope\")"
                 ),
@@ -58,7 +58,7 @@ solve_path!(
         }
         if req.uses_ge() && points > envelope::MAX_SYNC_GE_ENVELOPE_POINTS {
             return Err(ApiError::too_large(
-                "tether_lengths_m.count",
+                &req.tether_lengths_m.count_field("tether_lengths_m"),
                 format!(
                     "the envelope has {points} points; synchronous envelopes with the quasi-static GE stability have at most {} (submit a job with \"kind\": \"envelope\")",
                     envelope::MAX_SYNC_GE_ENVELOPE_POINTS

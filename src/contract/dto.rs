@@ -5,37 +5,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-/// The cable. Give `mass_per_length_kg_m`, or `density_kg_m3` and `area_m2`.
-#[derive(Clone, Debug, Default, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct CableInput {
-    /// Mass per unit length ρA (kg/m).
-    #[schema(example = 0.078, minimum = 1e-5, maximum = 100.0)]
-    pub mass_per_length_kg_m: Option<f64>,
-    /// Material density ρ (kg/m³), with `area_m2` (e.g. 7800 for steel).
-    #[schema(minimum = 100.0, maximum = 30000.0)]
-    pub density_kg_m3: Option<f64>,
-    /// Cross-section area A (m²), with `density_kg_m3` (e.g. 1e-5).
-    #[schema(minimum = 1e-9, maximum = 0.1)]
-    pub area_m2: Option<f64>,
-    /// Breaking strength (N): gives `critical` a safety factor (optional).
-    #[serde(default)]
-    #[schema(exclusive_minimum = 0.0, maximum = 1e9)]
-    pub breaking_strength_n: Option<f64>,
-}
-
-/// The aerostat at the top of the cable.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct AerostatInput {
-    /// Net buoyancy F = F_b − m g (N): the upward pull on the cable.
-    #[schema(example = 1000.0, minimum = 0.001, maximum = 1e7)]
-    pub net_buoyancy_n: f64,
-    /// Aerostat mass m (kg).
-    #[serde(default)]
-    #[schema(example = 10.0, minimum = 0.0, maximum = 1e6)]
-    pub mass_kg: f64,
-}
+pub use crate::contract::system::{AerostatInput, CableInput, WinchInput, WindInput};
 
 /// Which cable model, and its discretisation.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
@@ -114,6 +84,10 @@ pub const SYSTEM_KEYS: &[&str] = &[
     "gravity_m_s2",
     "numerics",
     "model",
+    "wind",
+    "winch",
+    "required_safety_factor_nondim",
+    "lift_reserve_nondim",
 ];
 
 /// The physical system and its model: common to every request.
@@ -135,6 +109,21 @@ pub struct SystemInput {
     /// Accuracy of converged answers.
     #[serde(default)]
     pub numerics: NumericsInput,
+    /// The air: accepted with the whole system, but this analysis is in calm
+    /// air, so a non-zero wind is refused (naming `wind.flow`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wind: Option<WindInput>,
+    /// The winch limits (used by the plan; checked here).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub winch: Option<WinchInput>,
+    /// Safety factor required on the breaking strength (default 5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 5.0, minimum = 1.0, maximum = 100.0)]
+    pub required_safety_factor_nondim: Option<f64>,
+    /// Lift reserve (used by the plan; checked here).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 0.05, minimum = 0.0, maximum = 0.9)]
+    pub lift_reserve_nondim: Option<f64>,
 }
 
 fn default_initial_length() -> f64 {

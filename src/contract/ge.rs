@@ -30,22 +30,9 @@ pub const MAX_EIGEN_ELEMENTS: usize = 300;
 /// Largest number of QEP solves along a run.
 pub const MAX_SPECTRA: usize = 2000;
 
-/// The aerostat of a GE run.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct GeAerostatInput {
-    /// Net buoyancy F = F_b − m g (N), applied at the aerostat along the guide axis.
-    #[schema(example = 1000.0, minimum = 0.0, maximum = 1e7)]
-    pub net_buoyancy_n: f64,
-    /// Aerostat mass m (kg).
-    #[serde(default)]
-    #[schema(example = 10.0, minimum = 0.0, maximum = 1e6)]
-    pub mass_kg: f64,
-    /// Length of the rigid link from the cable end to the aerostat's centre (m).
-    #[serde(default)]
-    #[schema(example = 0.0, minimum = 0.0, maximum = 1000.0)]
-    pub link_length_m: f64,
-}
+/// The aerostat of a GE run: the one [`crate::contract::system::AerostatInput`]
+/// (with `link_length_m`, the rigid link from the cable end to its centre).
+pub type GeAerostatInput = crate::contract::system::AerostatInput;
 
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
@@ -371,12 +358,12 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
     let rho_a = req.cable.mass_per_length()?;
     let l0 = require_positive("initial_length_m", req.initial_length_m)?;
     let g = require_non_negative("gravity_m_s2", req.gravity_m_s2)?;
-    let buoyancy = require_non_negative("aerostat.net_buoyancy_n", req.aerostat.net_buoyancy_n)?;
+    let buoyancy = req.aerostat.net_buoyancy_ge("aerostat")?;
     let m = &req.model;
     let section = m.section(rho_a, l0)?;
     let tip = TipBody {
-        mass_kg: require_non_negative("aerostat.mass_kg", req.aerostat.mass_kg)?,
-        link_length_m: require_non_negative("aerostat.link_length_m", req.aerostat.link_length_m)?,
+        mass_kg: req.aerostat.mass("aerostat")?,
+        link_length_m: req.aerostat.link_length("aerostat")?,
     };
     let model = GeModel::new(section, m.elements, tip, g)?;
 

@@ -437,8 +437,8 @@ pub fn prepare_chart(req: &GeChartRequest) -> Result<CoreChart, InvalidInput> {
             m.bending_stiffness_n_m2,
         )?,
         inertia_ratio: require_positive("model.inertia_ratio", m.inertia_ratio)?,
-        aerostat_mass_kg: require_non_negative("aerostat.mass_kg", req.aerostat.mass_kg)?,
-        link_length_m: require_non_negative("aerostat.link_length_m", req.aerostat.link_length_m)?,
+        aerostat_mass_kg: req.aerostat.mass("aerostat")?,
+        link_length_m: req.aerostat.link_length("aerostat")?,
         initial_length_m: l0,
         gravity_m_s2: g,
         elements: m.elements,
@@ -446,10 +446,7 @@ pub fn prepare_chart(req: &GeChartRequest) -> Result<CoreChart, InvalidInput> {
     let grid = &req.rates_m_s;
     let rates = rate_grid(grid.min, grid.max, grid.count)?;
     let buoyancies = if req.net_buoyancies_n.is_empty() {
-        vec![require_positive(
-            "aerostat.net_buoyancy_n",
-            req.aerostat.net_buoyancy_n,
-        )?]
+        vec![req.aerostat.net_buoyancy("aerostat")?]
     } else {
         req.net_buoyancies_n.clone()
     };
@@ -768,14 +765,11 @@ pub fn ge_base_frequency_response(
         None => (TipBody::default(), TipLoad::default()),
         Some(a) => (
             TipBody {
-                mass_kg: require_non_negative("aerostat.mass_kg", a.mass_kg)?,
-                link_length_m: require_non_negative("aerostat.link_length_m", a.link_length_m)?,
+                mass_kg: a.mass("aerostat")?,
+                link_length_m: a.link_length("aerostat")?,
             },
             TipLoad {
-                force_n: [
-                    require_non_negative("aerostat.net_buoyancy_n", a.net_buoyancy_n)?,
-                    0.0,
-                ],
+                force_n: [a.net_buoyancy_ge("aerostat")?, 0.0],
                 moment_n_m: 0.0,
             },
         ),
@@ -934,7 +928,7 @@ pub fn parse_chart(body: &[u8]) -> Result<AnyChartRequest, RequestError> {
     let value: serde_json::Value =
         serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
     if value.pointer("/model/kind").and_then(|k| k.as_str()) == Some("geometrically_exact") {
-        let req: Box<GeChartRequest> = crate::contract::parse_plain(body)?;
+        let req: Box<GeChartRequest> = crate::contract::parse_ge(body, "the GE chart")?;
         req.check_ranges()?;
         Ok(AnyChartRequest::GeometricallyExact(req))
     } else {
@@ -971,7 +965,8 @@ pub fn parse_frequency_response(body: &[u8]) -> Result<AnyFrequencyResponseReque
             crate::contract::parse(body).map(|r| AnyFrequencyResponseRequest::Wind(Box::new(r)))
         }
         Some(_) => {
-            let req: Box<GeBaseFrequencyResponseRequest> = crate::contract::parse_plain(body)?;
+            let req: Box<GeBaseFrequencyResponseRequest> =
+                crate::contract::parse_ge(body, "the base-excitation frequency response")?;
             req.check_ranges()?;
             Ok(AnyFrequencyResponseRequest::Base(req))
         }

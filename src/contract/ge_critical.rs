@@ -212,7 +212,7 @@ fn prepare(
     let rho_a = cable.mass_per_length()?;
     let l0 = require_positive("initial_length_m", initial_length_m)?;
     let g = require_non_negative("gravity_m_s2", gravity_m_s2)?;
-    let buoyancy = require_positive("aerostat.net_buoyancy_n", aerostat.net_buoyancy_n)?;
+    let buoyancy = aerostat.net_buoyancy("aerostat")?;
     if !(1..=MAX_GE_QEP_ELEMENTS).contains(&model.elements) {
         return Err(InvalidInput::new(
             "model.elements",
@@ -224,8 +224,8 @@ fn prepare(
     }
     let section = model.section(rho_a, l0)?;
     let tip = TipBody {
-        mass_kg: require_non_negative("aerostat.mass_kg", aerostat.mass_kg)?,
-        link_length_m: require_non_negative("aerostat.link_length_m", aerostat.link_length_m)?,
+        mass_kg: aerostat.mass("aerostat")?,
+        link_length_m: aerostat.link_length("aerostat")?,
     };
     Ok(Prepared {
         model: GeModel::new(section, model.elements, tip, g)?,
@@ -787,7 +787,7 @@ fn is_ge(body: &[u8]) -> Result<bool, RequestError> {
 /// Parses a critical-time body, choosing the model by `model.kind`.
 pub fn parse_critical(body: &[u8]) -> Result<AnyCriticalRequest, RequestError> {
     if is_ge(body)? {
-        let req: Box<GeCriticalRequest> = crate::contract::parse_plain(body)?;
+        let req: Box<GeCriticalRequest> = crate::contract::parse_ge(body, "the GE critical time")?;
         req.check_ranges()?;
         Ok(AnyCriticalRequest::GeometricallyExact(req))
     } else {
@@ -798,7 +798,7 @@ pub fn parse_critical(body: &[u8]) -> Result<AnyCriticalRequest, RequestError> {
 /// Parses a stability body, choosing the model by `model.kind`.
 pub fn parse_stability(body: &[u8]) -> Result<AnyStabilityRequest, RequestError> {
     if is_ge(body)? {
-        let req: Box<GeStabilityRequest> = crate::contract::parse_plain(body)?;
+        let req: Box<GeStabilityRequest> = crate::contract::parse_ge(body, "GE stability")?;
         req.check_ranges()?;
         Ok(AnyStabilityRequest::GeometricallyExact(req))
     } else {

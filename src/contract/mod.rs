@@ -17,6 +17,7 @@ pub mod plan;
 pub mod ranges;
 pub mod run;
 pub mod simulate;
+pub mod system;
 pub mod tension;
 pub mod transient;
 
@@ -66,6 +67,18 @@ fn with_system_keys(reason: &str) -> String {
     }
 }
 
+/// Parses a geometrically exact body (one pass, field paths kept): the
+/// whole system is accepted, its parts this calm-air analysis has no use
+/// for checked and set aside ([`system::resolve::strip_calm_system`]).
+pub fn parse_ge<T: serde::de::DeserializeOwned>(
+    body: &[u8],
+    analysis: &str,
+) -> Result<T, RequestError> {
+    let mut value = json_object(body)?;
+    system::resolve::strip_calm_system(&mut value, analysis)?;
+    parse_value(&value)
+}
+
 /// Parses a body that has no flattened parts (one pass, field paths kept).
 pub fn parse_plain<T: serde::de::DeserializeOwned>(body: &[u8]) -> Result<T, RequestError> {
     parse_value(&json_object(body)?)
@@ -81,7 +94,21 @@ fn json_object(body: &[u8]) -> Result<serde_json::Value, RequestError> {
             "must be a JSON object",
         )));
     }
+    system::refuse_moved(&value)?;
     Ok(value)
+}
+
+/// A JSON value in plain words for an error message (`null`, `the number 2`, …).
+pub fn describe_json(v: &serde_json::Value) -> String {
+    use serde_json::Value;
+    match v {
+        Value::Null => "nothing (null)".into(),
+        Value::Bool(b) => format!("{b}"),
+        Value::Number(n) => format!("the number {n}"),
+        Value::String(s) => format!("the text {:?}", s.chars().take(40).collect::<String>()),
+        Value::Array(_) => "a list".into(),
+        Value::Object(_) => "an object".into(),
+    }
 }
 
 /// Deserialises `T` from a JSON value with the error's field path.

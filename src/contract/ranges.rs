@@ -337,9 +337,10 @@ fn check_ge_system(
 ) -> Checked {
     cable.check_ranges()?;
     if let Some(a) = aerostat {
-        GE_NET_BUOYANCY_N.check("aerostat.net_buoyancy_n", a.net_buoyancy_n)?;
-        AEROSTAT_MASS_KG.check("aerostat.mass_kg", a.mass_kg)?;
-        LINK_LENGTH_M.check("aerostat.link_length_m", a.link_length_m)?;
+        a.net_buoyancy_ge("aerostat")?;
+        a.mass("aerostat")?;
+        a.link_length("aerostat")?;
+        a.check_given("aerostat")?;
     }
     INITIAL_LENGTH_M.check("initial_length_m", initial_length_m)?;
     GE_GRAVITY_M_S2

@@ -57,44 +57,41 @@ impl Progress for NoProgress {
     fn report(&self, _: usize, _: usize) {}
 }
 
-impl CableInput {
-    /// ρA (kg/m) from either form.
-    pub fn mass_per_length(&self) -> Result<f64, InvalidInput> {
-        match (self.mass_per_length_kg_m, self.density_kg_m3, self.area_m2) {
-            (Some(rho_a), None, None) => require_positive("cable.mass_per_length_kg_m", rho_a),
-            (None, Some(rho), Some(a)) => Ok(require_positive("cable.density_kg_m3", rho)?
-                * require_positive("cable.area_m2", a)?),
-            (Some(_), _, _) => Err(InvalidInput::new(
-                "cable.mass_per_length_kg_m",
-                "give either mass_per_length_kg_m or density_kg_m3 with area_m2, not both",
-            )),
-            (None, Some(_), None) => Err(InvalidInput::new(
-                "cable.area_m2",
-                "is required with density_kg_m3",
-            )),
-            (None, None, Some(_)) => Err(InvalidInput::new(
-                "cable.density_kg_m3",
-                "is required with area_m2",
-            )),
-            (None, None, None) => Err(InvalidInput::new(
-                "cable.mass_per_length_kg_m",
-                "is required (or density_kg_m3 with area_m2)",
-            )),
-        }
-    }
-}
-
 impl SystemInput {
     pub fn system(&self) -> Result<AerostatSystem, InvalidInput> {
         let sys = AerostatSystem::new(
             self.cable.mass_per_length()?,
-            self.aerostat.net_buoyancy_n,
-            self.aerostat.mass_kg,
+            self.aerostat.net_buoyancy("aerostat")?,
+            self.aerostat.mass("aerostat")?,
             self.initial_length_m,
             self.gravity_m_s2,
         )?;
+        self.check_calm_system("the string model")?;
         check_scales(&sys)?;
         Ok(sys)
+    }
+
+    /// The whole system is accepted; its parts this calm-air analysis does
+    /// not use are checked against their bounds, and a non-zero wind is
+    /// refused (naming `wind.flow`).
+    pub fn check_calm_system(&self, analysis: &str) -> Result<(), InvalidInput> {
+        use crate::contract::system::validate as v;
+        self.cable.check_given("cable")?;
+        self.aerostat.check_given("aerostat")?;
+        if let Some(w) = &self.wind {
+            w.check()?;
+        }
+        WindInput::require_calm(self.wind.as_ref(), analysis)?;
+        if let Some(w) = &self.winch {
+            w.check("winch")?;
+        }
+        if let Some(f) = self.required_safety_factor_nondim {
+            v::required_safety_factor(f)?;
+        }
+        if let Some(r) = self.lift_reserve_nondim {
+            v::lift_reserve(r)?;
+        }
+        Ok(())
     }
 
     pub fn model(&self) -> Result<StringModel, InvalidInput> {

@@ -7,7 +7,7 @@ use utoipa::ToSchema;
 
 use crate::contract::ge::{GeSimulateRequest, GeSimulateResponse, simulate_ge};
 use crate::contract::transient::{SimulateRequest, SimulateResponse, simulate};
-use crate::contract::{Progress, RequestError, parse, parse_plain};
+use crate::contract::{Progress, RequestError, parse};
 
 /// A transient run of either model.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
@@ -32,7 +32,7 @@ pub fn parse_simulate(body: &[u8]) -> Result<AnySimulateRequest, RequestError> {
     let value: serde_json::Value =
         serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
     if value.pointer("/model/kind").and_then(|k| k.as_str()) == Some("geometrically_exact") {
-        let req: GeSimulateRequest = parse_plain(body)?;
+        let req: GeSimulateRequest = crate::contract::parse_ge(body, "the GE transient run")?;
         req.check_ranges()?;
         Ok(AnySimulateRequest::GeometricallyExact(req))
     } else {

@@ -45,23 +45,6 @@ impl TensionOutput {
     }
 }
 
-impl crate::contract::dto::CableInput {
-    /// `breaking_strength_n`, checked (positive, at most 1e9 N).
-    pub fn breaking_strength(&self) -> Result<Option<f64>, crate::numerics::params::InvalidInput> {
-        self.breaking_strength_n
-            .map(|b| {
-                crate::contract::equilibrium::require_range(
-                    "cable.breaking_strength_n",
-                    b,
-                    0.0,
-                    true,
-                    1e9,
-                )
-            })
-            .transpose()
-    }
-}
-
 /// Tension of the vertical cable along a transient run (`simulate`), from
 /// the profile's kinematics at each output time: `T(L) = F − m a` at the
 /// aerostat, `T(0) = F − m a − ρA (g + a) L` at the winch, linear between

@@ -68,8 +68,12 @@ impl JobKind for EnvelopeBandsRequest {
     }
     fn estimate(&self) -> Estimate {
         let cells = self.envelope.points() as u64;
-        let rows =
-            (self.envelope.wind_speeds_m_s.count + self.envelope.tether_lengths_m.count) as u64;
+        let rows = (self
+            .envelope
+            .wind_speeds_m_s
+            .as_ref()
+            .map_or(1, |g| g.count())
+            + self.envelope.tether_lengths_m.count()) as u64;
         E::new(
             "wind_speeds_m_s.count",
             est::SIMULATE_BASE

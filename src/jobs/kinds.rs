@@ -939,7 +939,7 @@ impl JobItem {
                     // A string cell costs what an envelope bands cell does.
                     None => config.steps as f64 * ENVELOPE_BAND_CELL_STEP_S,
                 };
-                let lengths = r.tether_lengths_m.count as f64;
+                let lengths = r.tether_lengths_m.count() as f64;
                 Some((
                     crate::contract::envelope::chunks::envelope_row_count(r),
                     lengths * cell,

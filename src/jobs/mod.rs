@@ -127,6 +127,20 @@ impl JobQueue {
         &self.limits
     }
 
+    /// The named system `name` of `owner` (None: no tokens), as JSON.
+    pub fn stored_system(
+        &self,
+        owner: Option<&str>,
+        name: &str,
+    ) -> Result<Option<serde_json::Value>, StoreError> {
+        match self.store.get_system(owner.unwrap_or(""), name)? {
+            None => Ok(None),
+            Some(s) => serde_json::from_str(&s.body)
+                .map(Some)
+                .map_err(|e| StoreError(format!("stored system `{name}` is not JSON: {e}"))),
+        }
+    }
+
     /// Validates and stores a submission without owner or key; returns its id.
     pub fn submit(&self, body: &[u8]) -> Result<(i64, &'static str), SubmitError> {
         let kind = JobSubmission::parse(body, &self.limits)?.kind();
@@ -139,9 +153,17 @@ impl JobQueue {
     /// full); a repeated idempotency key with the same body returns the
     /// first job.
     pub fn submit_as(&self, body: &[u8], who: &Submitter) -> Result<Submitted, SubmitError> {
+        let request_hash = sha256_hex(body);
+        // A named system is resolved at submission: the job stores (and
+        // runs) the request with the system merged in.
+        let resolved =
+            crate::contract::system::resolve::resolve_job_body::<SubmitError>(body, &mut |name| {
+                self.stored_system(who.owner.as_deref(), name)
+                    .map_err(|e| SubmitError::Queue(InsertError::Store(e)))
+            })?;
+        let body: &[u8] = resolved.as_deref().unwrap_or(body);
         let request =
             std::str::from_utf8(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
-        let request_hash = sha256_hex(body);
         // A retry is answered before the (possibly long) validation.
         if let (Some(key), Some(first)) = (
             who.idempotency_key.as_deref(),

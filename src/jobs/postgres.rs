@@ -24,7 +24,8 @@
 //! Schema versions, one row each in `schema_version`, applied at start
 //! under an advisory lock (idempotent; several processes may start at once):
 //! 1. `jobs` (as SQLite's versions 1–2, with `priority`);
-//! 2. `job_chunks` and `workers`.
+//! 2. `job_chunks` and `workers`;
+//! 3. `systems`: the named systems (SPEC §9), keyed by (owner, name).
 
 use std::sync::{Mutex, MutexGuard};
 use std::time::Duration;
@@ -35,7 +36,7 @@ use super::chunks::{ChunkLease, ChunkState, ClaimedChunk};
 use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
 use super::store::{
     ClaimPolicy, ClaimedJob, InsertError, Inserted, JobBackend, JobRecord, JobStatus, KeyedJob,
-    NewJob, StoreError,
+    NewJob, PutSystem, StoreError, StoredSystem,
 };
 
 const MIGRATIONS: &[(i32, &str)] = &[
@@ -91,10 +92,23 @@ const MIGRATIONS: &[(i32, &str)] = &[
             heartbeat_ms BIGINT NOT NULL
         );",
     ),
+    (
+        3,
+        "CREATE TABLE systems (
+            owner      TEXT NOT NULL,
+            name       TEXT NOT NULL,
+            body       TEXT NOT NULL,
+            created_at TEXT NOT NULL DEFAULT to_char(clock_timestamp() AT TIME ZONE 'UTC',
+                           'YYYY-MM-DD\"T\"HH24:MI:SS.MS\"Z\"'),
+            updated_at TEXT NOT NULL DEFAULT to_char(clock_timestamp() AT TIME ZONE 'UTC',
+                           'YYYY-MM-DD\"T\"HH24:MI:SS.MS\"Z\"'),
+            PRIMARY KEY (owner, name)
+        );",
+    ),
 ];
 
 /// The current schema version.
-pub const SCHEMA_VERSION: i32 = 2;
+pub const SCHEMA_VERSION: i32 = 3;
 
 /// Advisory lock key of migrations (and of inserts: quotas are counted
 /// and the row written under it).
@@ -765,6 +779,85 @@ impl JobBackend for PgStore {
                 )?
                 .get(0);
             Ok(n as usize)
+        })
+    }
+
+    fn put_system(
+        &self,
+        owner: &str,
+        name: &str,
+        body: &str,
+        max_per_owner: usize,
+    ) -> Result<PutSystem, StoreError> {
+        self.with(|c| {
+            let mut tx = c.transaction()?;
+            // Counted and written under the insert lock (the quota holds across processes).
+            tx.execute("SELECT pg_advisory_xact_lock($1)", &[&INSERT_LOCK])?;
+            let updated = tx.execute(
+                &format!(
+                    "UPDATE systems SET body = $3, updated_at = {NOW} WHERE owner = $1 AND name = $2"
+                ),
+                &[&owner, &name, &body],
+            )?;
+            let out = if updated == 1 {
+                PutSystem::Updated
+            } else {
+                let n: i64 = tx
+                    .query_one("SELECT count(*) FROM systems WHERE owner = $1", &[&owner])?
+                    .get(0);
+                if n as usize >= max_per_owner {
+                    return Ok(PutSystem::Full { max: max_per_owner });
+                }
+                tx.execute(
+                    "INSERT INTO systems (owner, name, body) VALUES ($1, $2, $3)",
+                    &[&owner, &name, &body],
+                )?;
+                PutSystem::Created
+            };
+            tx.commit()?;
+            Ok(out)
+        })
+    }
+
+    fn get_system(&self, owner: &str, name: &str) -> Result<Option<StoredSystem>, StoreError> {
+        self.with(|c| {
+            Ok(c.query_opt(
+                "SELECT name, body, created_at, updated_at FROM systems WHERE owner = $1 AND name = $2",
+                &[&owner, &name],
+            )?
+            .map(|r| StoredSystem {
+                name: r.get(0),
+                body: r.get(1),
+                created_at: r.get(2),
+                updated_at: r.get(3),
+            }))
+        })
+    }
+
+    fn delete_system(&self, owner: &str, name: &str) -> Result<bool, StoreError> {
+        self.with(|c| {
+            let n = c.execute(
+                "DELETE FROM systems WHERE owner = $1 AND name = $2",
+                &[&owner, &name],
+            )?;
+            Ok(n == 1)
+        })
+    }
+
+    fn list_systems(&self, owner: &str) -> Result<Vec<StoredSystem>, StoreError> {
+        self.with(|c| {
+            Ok(c.query(
+                "SELECT name, created_at, updated_at FROM systems WHERE owner = $1 ORDER BY name",
+                &[&owner],
+            )?
+            .iter()
+            .map(|r| StoredSystem {
+                name: r.get(0),
+                body: String::new(),
+                created_at: r.get(1),
+                updated_at: r.get(2),
+            })
+            .collect())
         })
     }
 }

@@ -8,7 +8,8 @@
 //! 1. the `jobs` table;
 //! 2. owner, idempotency key and body hash, lease owner/expiry/epoch;
 //! 3. job priority, `job_chunks` (leased chunks of large jobs), `workers`
-//!    (live workers), `schema_version`.
+//!    (live workers), `schema_version`;
+//! 4. `systems`: the named systems (SPEC §9), keyed by (owner, name).
 
 use std::path::Path;
 use std::sync::Mutex;
@@ -19,7 +20,7 @@ use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
 use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
 use super::store::{
     ChunkLease, ChunkState, ClaimPolicy, ClaimedChunk, ClaimedJob, InsertError, Inserted,
-    JobBackend, JobRecord, JobStatus, KeyedJob, NewJob, StoreError,
+    JobBackend, JobRecord, JobStatus, KeyedJob, NewJob, PutSystem, StoreError, StoredSystem,
 };
 
 const SCHEMA_V1: &str = "
@@ -81,8 +82,20 @@ CREATE TABLE IF NOT EXISTS schema_version (
 INSERT OR IGNORE INTO schema_version (version) VALUES (1), (2), (3);
 ";
 
+const SCHEMA_V4: &str = "
+CREATE TABLE systems (
+    owner      TEXT NOT NULL,
+    name       TEXT NOT NULL,
+    body       TEXT NOT NULL,
+    created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+    updated_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+    PRIMARY KEY (owner, name)
+);
+INSERT OR IGNORE INTO schema_version (version) VALUES (4);
+";
+
 /// The current schema version.
-pub const SCHEMA_VERSION: i64 = 3;
+pub const SCHEMA_VERSION: i64 = 4;
 
 const NOW: &str = "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')";
 
@@ -254,6 +267,9 @@ fn migrate(conn: &mut Connection) -> Result<(), StoreError> {
     }
     if version < 3 {
         tx.execute_batch(SCHEMA_V3)?;
+    }
+    if version < 4 {
+        tx.execute_batch(SCHEMA_V4)?;
     }
     tx.pragma_update(None, "user_version", SCHEMA_VERSION)?;
     tx.commit()?;
@@ -741,6 +757,84 @@ impl JobBackend for JobStore {
             |r| r.get(0),
         )?;
         Ok(n as usize)
+    }
+
+    fn put_system(
+        &self,
+        owner: &str,
+        name: &str,
+        body: &str,
+        max_per_owner: usize,
+    ) -> Result<PutSystem, StoreError> {
+        let mut conn = self.conn();
+        let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
+        let updated = tx.execute(
+            &format!(
+                "UPDATE systems SET body = ?3, updated_at = {NOW} WHERE owner = ?1 AND name = ?2"
+            ),
+            params![owner, name, body],
+        )?;
+        let out = if updated == 1 {
+            PutSystem::Updated
+        } else {
+            let n: i64 = tx.query_row(
+                "SELECT count(*) FROM systems WHERE owner = ?1",
+                params![owner],
+                |r| r.get(0),
+            )?;
+            if n as usize >= max_per_owner {
+                return Ok(PutSystem::Full { max: max_per_owner });
+            }
+            tx.execute(
+                "INSERT INTO systems (owner, name, body) VALUES (?1, ?2, ?3)",
+                params![owner, name, body],
+            )?;
+            PutSystem::Created
+        };
+        tx.commit()?;
+        Ok(out)
+    }
+
+    fn get_system(&self, owner: &str, name: &str) -> Result<Option<StoredSystem>, StoreError> {
+        Ok(self
+            .conn()
+            .query_row(
+                "SELECT name, body, created_at, updated_at FROM systems WHERE owner = ?1 AND name = ?2",
+                params![owner, name],
+                |r| {
+                    Ok(StoredSystem {
+                        name: r.get(0)?,
+                        body: r.get(1)?,
+                        created_at: r.get(2)?,
+                        updated_at: r.get(3)?,
+                    })
+                },
+            )
+            .optional()?)
+    }
+
+    fn delete_system(&self, owner: &str, name: &str) -> Result<bool, StoreError> {
+        let n = self.conn().execute(
+            "DELETE FROM systems WHERE owner = ?1 AND name = ?2",
+            params![owner, name],
+        )?;
+        Ok(n == 1)
+    }
+
+    fn list_systems(&self, owner: &str) -> Result<Vec<StoredSystem>, StoreError> {
+        let conn = self.conn();
+        let mut stmt = conn.prepare(
+            "SELECT name, created_at, updated_at FROM systems WHERE owner = ?1 ORDER BY name",
+        )?;
+        let rows = stmt.query_map(params![owner], |r| {
+            Ok(StoredSystem {
+                name: r.get(0)?,
+                body: String::new(),
+                created_at: r.get(1)?,
+                updated_at: r.get(2)?,
+            })
+        })?;
+        Ok(rows.collect::<Result<Vec<_>, _>>()?)
     }
 
     fn pending(&self) -> Result<usize, StoreError> {

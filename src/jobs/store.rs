@@ -274,4 +274,46 @@ pub trait JobBackend: Send + Sync {
     fn status(&self, id: i64) -> Result<Option<JobStatus>, StoreError> {
         self.status_owned(id, None)
     }
+
+    // Named systems (SPEC §9), keyed by (owner, name); `owner` is the
+    // token's hash, "" without tokens.
+
+    /// Stores (or replaces) a named system; at most `max_per_owner` per owner.
+    fn put_system(
+        &self,
+        owner: &str,
+        name: &str,
+        body: &str,
+        max_per_owner: usize,
+    ) -> Result<PutSystem, StoreError>;
+    /// One named system of `owner`.
+    fn get_system(&self, owner: &str, name: &str) -> Result<Option<StoredSystem>, StoreError>;
+    /// Deletes a named system; false when there was none.
+    fn delete_system(&self, owner: &str, name: &str) -> Result<bool, StoreError>;
+    /// The named systems of `owner` by name (bodies left empty).
+    fn list_systems(&self, owner: &str) -> Result<Vec<StoredSystem>, StoreError>;
+}
+
+/// Most named systems per token.
+pub const MAX_SYSTEMS_PER_OWNER: usize = 100;
+
+/// A stored named system.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StoredSystem {
+    pub name: String,
+    /// The system objects (JSON text).
+    pub body: String,
+    pub created_at: String,
+    pub updated_at: String,
+}
+
+/// What storing a named system did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PutSystem {
+    Created,
+    Updated,
+    /// The owner already has `max` systems (nothing stored).
+    Full {
+        max: usize,
+    },
 }

@@ -45,7 +45,8 @@ impl JobKind for EnvelopeRequest {
         to_json(&envelope::envelope(self, Parallelism::Rayon, progress)?)
     }
     fn estimate(&self) -> Estimate {
-        let rows = (self.wind_speeds_m_s.count + self.tether_lengths_m.count) as u64;
+        let rows = (self.wind_speeds_m_s.as_ref().map_or(1, |g| g.count())
+            + self.tether_lengths_m.count()) as u64;
         E::new(
             "wind_speeds_m_s.count",
             est::SIMULATE_BASE

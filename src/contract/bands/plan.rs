@@ -48,13 +48,13 @@ pub const MAX_PLAN_BAND_VALUES: usize = 20_000_000;
 /// `POST /api/v1/plan`) and `uncertainty`.
 #[derive(Clone, Debug, Serialize, ToSchema)]
 #[schema(example = json!({
-    "cable": {"mass_per_length_kg_m": 0.078},
     "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
     "initial_length_m": 1.0,
     "target_elevation_m": 1200.0,
     "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0},
     "lift_reserve_nondim": 0.05,
-    "tether": {"breaking_strength_n": 5200.0, "safety_factor_nondim": 5.0},
+    "cable": {"mass_per_length_kg_m": 0.078, "breaking_strength_n": 5200.0},
+    "required_safety_factor_nondim": 5.0,
     "samples": 101,
     "uncertainty": {
         "samples": 1000,
@@ -97,7 +97,7 @@ pub struct PlanBandsResponse {
     pub probability_unstable: Option<ProbabilityOutput>,
     /// P(the plan's own criterion with the lift reserve fails somewhere for the sample's inputs).
     pub probability_below_reserve: Option<ProbabilityOutput>,
-    /// P(the largest tension exceeds breaking strength / safety factor somewhere); null without `tether`.
+    /// P(the largest tension exceeds breaking strength / safety factor somewhere); null without `cable.breaking_strength_n`.
     pub probability_over_rating: Option<ProbabilityOutput>,
     /// P(unstable or over the rating somewhere).
     pub probability_unsafe: Option<ProbabilityOutput>,
@@ -138,7 +138,7 @@ impl UncertainField for PlanField {
     fn path(self) -> &'static str {
         match self {
             Self::System(f) => f.path(),
-            Self::BreakingStrength => "tether.breaking_strength_n",
+            Self::BreakingStrength => "cable.breaking_strength_n",
         }
     }
     fn in_range(self, v: f64) -> bool {
@@ -165,7 +165,7 @@ const PLAN_FIELDS: [&str; 7] = [
     "cable.density_kg_m3",
     "cable.area_m2",
     "gravity_m_s2",
-    "tether.breaking_strength_n",
+    "cable.breaking_strength_n",
 ];
 
 fn system_input(req: &PlanRequest) -> SystemInput {
@@ -176,6 +176,10 @@ fn system_input(req: &PlanRequest) -> SystemInput {
         gravity_m_s2: req.gravity_m_s2,
         model: req.model.clone(),
         numerics: Default::default(),
+        wind: None,
+        winch: None,
+        required_safety_factor_nondim: None,
+        lift_reserve_nondim: None,
     }
 }
 
@@ -218,10 +222,11 @@ pub fn prepare_plan_bands(req: &PlanBandsRequest) -> Result<PreparedPlanBands, R
         )
         .into());
     }
-    let rated = req.plan.tether.is_some();
+    let breaking_strength_n = req.plan.cable.breaking_strength()?;
+    let rated = breaking_strength_n.is_some();
     let fields = common::resolve_fields(&u.inputs, &ensemble, |path| {
         let f = match path {
-            "tether.breaking_strength_n" => PlanField::BreakingStrength,
+            "cable.breaking_strength_n" => PlanField::BreakingStrength,
             _ => match SystemField::from_path(path) {
                 Some(f) if f != SystemField::InitialLength => PlanField::System(f),
                 _ => {
@@ -237,7 +242,7 @@ pub fn prepare_plan_bands(req: &PlanBandsRequest) -> Result<PreparedPlanBands, R
                 "`{path}` is not given in this request: make the cable's given form uncertain"
             )),
             PlanField::BreakingStrength if !rated => Err(
-                "`tether.breaking_strength_n` is uncertain but the request has no `tether` rating"
+                "`cable.breaking_strength_n` is uncertain but the request gives no breaking strength"
                     .into(),
             ),
             f => Ok(f),
@@ -246,12 +251,8 @@ pub fn prepare_plan_bands(req: &PlanBandsRequest) -> Result<PreparedPlanBands, R
     Ok(PreparedPlanBands {
         base,
         nominal,
-        breaking_strength_n: req.plan.tether.as_ref().map(|t| t.breaking_strength_n),
-        safety_factor: req
-            .plan
-            .tether
-            .as_ref()
-            .map_or(1.0, |t| t.safety_factor_nondim),
+        breaking_strength_n,
+        safety_factor: req.plan.required_safety_factor_nondim,
         fields,
         ensemble,
     })
@@ -532,7 +533,7 @@ fn summarise(
     let n = valid.len();
     let feasible = plan.feasible && !instants.is_empty();
     let count = |f: fn(&SampleTrace) -> bool| valid.iter().filter(|t| f(t)).count();
-    let rated = req.plan.tether.is_some();
+    let rated = prep.breaking_strength_n.is_some();
     let mut column = vec![0.0; n];
     let mut band = |pick: &dyn Fn(&SampleTrace) -> f64| {
         for (c, t) in column.iter_mut().zip(valid) {
@@ -619,7 +620,7 @@ mod tests {
         );
         assert_eq!(
             field_of(body(json!({"uncertainty": {"inputs": [
-                {"field": "tether.breaking_strength_n", "distribution": "normal", "mean": 1e4, "std_dev": 1.0}]}}))),
+                {"field": "cable.breaking_strength_n", "distribution": "normal", "mean": 1e4, "std_dev": 1.0}]}}))),
             "uncertainty.inputs[0].field"
         );
         assert_eq!(

@@ -118,12 +118,18 @@ pub(crate) struct RawSystem {
 
 impl RawSystem {
     pub(crate) fn of(s: &SystemInput) -> Self {
+        let c = &s.cable;
+        // A preset's mass per length counts as given.
+        let from_preset =
+            (c.mass_per_length_kg_m.is_none() && c.density_kg_m3.is_none() && c.area_m2.is_none())
+                .then(|| c.mass_per_length().ok())
+                .flatten();
         Self {
-            mass_per_length: s.cable.mass_per_length_kg_m,
-            density: s.cable.density_kg_m3,
-            area: s.cable.area_m2,
-            net_buoyancy: s.aerostat.net_buoyancy_n,
-            mass: s.aerostat.mass_kg,
+            mass_per_length: c.mass_per_length_kg_m.or(from_preset),
+            density: c.density_kg_m3,
+            area: c.area_m2,
+            net_buoyancy: s.aerostat.net_buoyancy("aerostat").unwrap_or(f64::NAN),
+            mass: s.aerostat.mass("aerostat").unwrap_or(f64::NAN),
             initial_length: s.initial_length_m,
             gravity: s.gravity_m_s2,
         }

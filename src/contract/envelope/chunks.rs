@@ -17,7 +17,9 @@ use crate::numerics::chart::Parallelism;
 
 /// Wind rows of the request.
 pub fn envelope_row_count(req: &EnvelopeRequest) -> usize {
-    req.wind_speeds_m_s.count
+    req.wind_speeds_m_s
+        .as_ref()
+        .map_or(1, crate::contract::system::GridInput::count)
 }
 
 /// The envelope of the wind rows `range`.

@@ -5,69 +5,9 @@ use utoipa::ToSchema;
 
 use crate::contract::equilibrium::dto::{
     ResolvedAerostatOutput, ResolvedCableOutput, TetherAerostatInput, TetherCableInput,
-    default_air_density, default_gravity, default_reference_height, default_safety_factor,
-    default_steps,
+    default_gravity, default_safety_factor, default_steps,
 };
-
-/// How the grid's wind speed sets the profile: the speed is the wind at
-/// the reference height (or everywhere, when uniform).
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-pub enum WindShapeInput {
-    /// U(z) = U.
-    Uniform,
-    /// U(z) = U (z/z_ref)^p.
-    PowerLaw {
-        #[schema(example = 0.14, minimum = 0.0, maximum = 2.0)]
-        exponent_nondim: f64,
-        #[serde(default = "default_reference_height")]
-        #[schema(example = 10.0, exclusive_minimum = 0.0, maximum = 10000.0)]
-        reference_height_m: f64,
-    },
-    /// U(z) = U ln(z/z0)/ln(z_ref/z0).
-    LogLaw {
-        #[schema(example = 0.03, exclusive_minimum = 0.0, maximum = 10.0)]
-        roughness_length_m: f64,
-        #[serde(default = "default_reference_height")]
-        #[schema(example = 10.0, exclusive_minimum = 0.0, maximum = 10000.0)]
-        reference_height_m: f64,
-    },
-}
-
-/// The air of the envelope.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct EnvelopeWindInput {
-    pub shape: WindShapeInput,
-    /// Air density (kg/m³), default 1.225.
-    #[serde(default = "default_air_density")]
-    #[schema(example = 1.225, exclusive_minimum = 0.0, maximum = 5.0)]
-    pub air_density_kg_m3: f64,
-}
-
-/// Evenly spaced wind speeds (m/s).
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct WindGridInput {
-    #[schema(example = 0.0, minimum = 0.0, maximum = 150.0)]
-    pub min: f64,
-    #[schema(example = 30.0, minimum = 0.0, maximum = 150.0)]
-    pub max: f64,
-    #[schema(example = 40, minimum = 1, maximum = 1000)]
-    pub count: usize,
-}
-
-/// Evenly spaced tether lengths (m).
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct LengthGridInput {
-    #[schema(example = 100.0, exclusive_minimum = 0.0, maximum = 100000.0)]
-    pub min: f64,
-    #[schema(example = 3000.0, exclusive_minimum = 0.0, maximum = 100000.0)]
-    pub max: f64,
-    #[schema(example = 50, minimum = 1, maximum = 1000)]
-    pub count: usize,
-}
+use crate::contract::system::{GridInput, WinchInput, WindInput};
 
 /// `POST /api/v1/envelope`: equilibria over wind speed × tether length,
 /// each judged against slack, tension, ceiling and (with a payout rate) stability.
@@ -77,7 +17,8 @@ pub struct LengthGridInput {
     "cable": {"preset": "dyneema", "diameter_m": 0.006},
     "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
                  "reference_area_m2": 20.0},
-    "wind": {"shape": {"kind": "power_law", "exponent_nondim": 0.14, "reference_height_m": 10.0},
+    "wind": {"flow": {"kind": "log_law", "speed_m_s": 8.0, "reference_height_m": 10.0,
+                      "roughness_length_m": 0.03},
              "air_density_kg_m3": 1.225},
     "wind_speeds_m_s": {"min": 0.0, "max": 30.0, "count": 40},
     "tether_lengths_m": {"min": 100.0, "max": 3000.0, "count": 50},
@@ -88,9 +29,16 @@ pub struct LengthGridInput {
 pub struct EnvelopeRequest {
     pub cable: TetherCableInput,
     pub aerostat: TetherAerostatInput,
-    pub wind: EnvelopeWindInput,
-    pub wind_speeds_m_s: WindGridInput,
-    pub tether_lengths_m: LengthGridInput,
+    /// The air: its density and the shape of its flow (uniform, log law or
+    /// power law), scaled to each grid speed (the speed at the reference
+    /// height; for a power law the coefficient, the speed at 1 m).
+    pub wind: WindInput,
+    /// Wind speeds (m/s, 0 to 150, at most 1000): a list or `{min, max, count}`;
+    /// absent: the flow's own speed only (today's wind).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wind_speeds_m_s: Option<GridInput>,
+    /// Tether lengths (m, above 0 and at most 100 000, at most 1000): a list or `{min, max, count}`.
+    pub tether_lengths_m: GridInput,
     #[serde(default = "default_gravity")]
     #[schema(example = 9.81, exclusive_minimum = 0.0, maximum = 100.0)]
     pub gravity_m_s2: f64,
@@ -113,6 +61,15 @@ pub struct EnvelopeRequest {
     /// How stability is judged at `payout_rate_m_s`; absent: the string criterion.
     #[serde(default)]
     pub stability: Option<super::stability::EnvelopeStabilityInput>,
+    /// The rest of the system (accepted and checked; the envelope has no use for them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub winch: Option<WinchInput>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 1.0, minimum = 0.001, maximum = 10000.0)]
+    pub initial_length_m: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 0.05, minimum = 0.0, maximum = 0.9)]
+    pub lift_reserve_nondim: Option<f64>,
 }
 
 /// One grid point.

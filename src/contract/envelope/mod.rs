@@ -7,8 +7,11 @@ pub mod chunks;
 pub mod dto;
 pub mod stability;
 
+use crate::contract::equilibrium::dto::WindFlowInput;
 use crate::contract::equilibrium::dto::{ResolvedAerostatOutput, ResolvedCableOutput};
 use crate::contract::equilibrium::{require_count, require_range};
+use crate::contract::system::GridInput;
+use crate::contract::system::grid::GridBounds;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::chart::Parallelism;
 use crate::numerics::params::InvalidInput;
@@ -28,63 +31,99 @@ pub const MAX_SYNC_GE_ENVELOPE_POINTS: usize = 500;
 /// What "stable" means in the envelope.
 pub const STABILITY_CRITERION: &str = "continuum linear-string criterion of SPEC §1 applied to the blown-down tether: stable while the smallest tension exceeds the kinematic term ρA v² (calm air: h* = (F/ρA − v²)/g)";
 
-fn grid(min: f64, max: f64, count: usize) -> Vec<f64> {
-    if count == 1 {
-        return vec![min];
-    }
-    (0..count)
-        .map(|k| min + (max - min) * k as f64 / (count - 1) as f64)
-        .collect()
-}
+/// Wind speeds of the envelope grid.
+const WIND_GRID: GridBounds = GridBounds {
+    min: 0.0,
+    exclusive_min: false,
+    max: 150.0,
+    max_count: 1000,
+    unit: "m/s",
+};
 
-impl WindShapeInput {
-    pub fn shape(&self) -> Result<WindShape, InvalidInput> {
-        Ok(match *self {
-            Self::Uniform => WindShape::Uniform,
-            Self::PowerLaw {
+/// Tether lengths of the envelope grid.
+const LENGTH_GRID: GridBounds = GridBounds {
+    min: 0.0,
+    exclusive_min: true,
+    max: 1e5,
+    max_count: 1000,
+    unit: "m",
+};
+
+impl EnvelopeRequest {
+    /// The shape of the flow (scaled by each grid speed) and its own speed.
+    pub fn shape(&self) -> Result<(WindShape, f64), InvalidInput> {
+        Ok(match &self.wind.flow {
+            WindFlowInput::Uniform { speed_m_s } => (WindShape::Uniform, *speed_m_s),
+            WindFlowInput::PowerLaw {
+                coefficient_m_s,
                 exponent_nondim,
+            } => (
+                WindShape::PowerLaw {
+                    exponent: require_range(
+                        "wind.flow.exponent_nondim",
+                        *exponent_nondim,
+                        0.0,
+                        false,
+                        2.0,
+                    )?,
+                    // U = a z^p: the grid speed is the speed at 1 m.
+                    reference_height_m: 1.0,
+                },
+                *coefficient_m_s,
+            ),
+            WindFlowInput::LogLaw {
+                speed_m_s,
                 reference_height_m,
-            } => WindShape::PowerLaw {
-                exponent: require_range(
-                    "wind.shape.exponent_nondim",
-                    exponent_nondim,
-                    0.0,
-                    false,
-                    2.0,
-                )?,
-                reference_height_m: require_range(
-                    "wind.shape.reference_height_m",
-                    reference_height_m,
-                    0.0,
-                    true,
-                    1e4,
-                )?,
-            },
-            Self::LogLaw {
                 roughness_length_m,
-                reference_height_m,
             } => {
                 let z0 = require_range(
-                    "wind.shape.roughness_length_m",
-                    roughness_length_m,
+                    "wind.flow.roughness_length_m",
+                    *roughness_length_m,
                     0.0,
                     true,
                     10.0,
                 )?;
                 let zr = require_range(
-                    "wind.shape.reference_height_m",
-                    reference_height_m,
+                    "wind.flow.reference_height_m",
+                    *reference_height_m,
                     0.0,
                     true,
                     1e4,
                 )?;
-                WindProfile::log_law(0.0, zr, z0, "wind.shape")?;
-                WindShape::LogLaw {
-                    roughness_length_m: z0,
-                    reference_height_m: zr,
-                }
+                WindProfile::log_law(0.0, zr, z0, "wind.flow")?;
+                (
+                    WindShape::LogLaw {
+                        roughness_length_m: z0,
+                        reference_height_m: zr,
+                    },
+                    *speed_m_s,
+                )
+            }
+            WindFlowInput::Tabulated { .. } => {
+                return Err(InvalidInput::new(
+                    "wind.flow.kind",
+                    "the envelope scales the wind profile to each grid speed, which a table cannot be: \
+                     give a uniform, log-law or power-law flow",
+                ));
             }
         })
+    }
+
+    /// The wind speeds: the grid, or the flow's own speed.
+    pub fn wind_speeds(&self) -> Result<Vec<f64>, InvalidInput> {
+        match &self.wind_speeds_m_s {
+            Some(g) => g.values("wind_speeds_m_s", WIND_GRID),
+            None => {
+                let (_, speed) = self.shape()?;
+                Ok(vec![require_range(
+                    "wind.flow.speed_m_s",
+                    speed,
+                    0.0,
+                    false,
+                    150.0,
+                )?])
+            }
+        }
     }
 }
 
@@ -92,52 +131,38 @@ impl EnvelopeRequest {
     /// Number of grid points.
     pub fn points(&self) -> usize {
         self.wind_speeds_m_s
-            .count
-            .saturating_mul(self.tether_lengths_m.count)
+            .as_ref()
+            .map_or(1, GridInput::count)
+            .saturating_mul(self.tether_lengths_m.count())
     }
 
     /// The validated sweep and its configuration.
     pub fn problem(&self) -> Result<(EnvelopeProblem, EquilibriumConfig), InvalidInput> {
-        let w = &self.wind_speeds_m_s;
-        let wmin = require_range("wind_speeds_m_s.min", w.min, 0.0, false, 150.0)?;
-        let wmax = require_range("wind_speeds_m_s.max", w.max, 0.0, false, 150.0)?;
-        if wmax < wmin {
-            return Err(InvalidInput::new(
-                "wind_speeds_m_s.max",
-                format!("must be at least wind_speeds_m_s.min = {wmin}, got {wmax}"),
-            ));
-        }
-        require_count("wind_speeds_m_s.count", w.count, 1, 1000)?;
-        let l = &self.tether_lengths_m;
-        let lmin = require_range("tether_lengths_m.min", l.min, 0.0, true, 1e5)?;
-        let lmax = require_range("tether_lengths_m.max", l.max, 0.0, true, 1e5)?;
-        if lmax < lmin {
-            return Err(InvalidInput::new(
-                "tether_lengths_m.max",
-                format!("must be at least tether_lengths_m.min = {lmin}, got {lmax}"),
-            ));
-        }
-        require_count("tether_lengths_m.count", l.count, 1, 1000)?;
+        let (shape, _) = self.shape()?;
+        let winds = self.wind_speeds()?;
+        let lengths = self
+            .tether_lengths_m
+            .values("tether_lengths_m", LENGTH_GRID)?;
+        let lmin = lengths.iter().copied().fold(f64::INFINITY, f64::min);
         if self.points() > MAX_ENVELOPE_POINTS {
             return Err(InvalidInput::new(
-                "tether_lengths_m.count",
+                self.tether_lengths_m.count_field("tether_lengths_m"),
                 format!(
-                    "the envelope would have {} points; at most {MAX_ENVELOPE_POINTS}",
+                    "the envelope would have {} points (wind speeds × tether lengths); at most {MAX_ENVELOPE_POINTS}",
                     self.points()
                 ),
             ));
         }
+        crate::contract::system::validate::check_rest(
+            self.winch.as_ref(),
+            self.initial_length_m,
+            self.lift_reserve_nondim,
+        )?;
         let base = EquilibriumProblem {
             cable: self.cable.cable("cable")?,
             body: self.aerostat.body("aerostat")?,
             wind: WindProfile::calm(),
-            air_density_kg_m3: require_range(
-                "wind.air_density_kg_m3",
-                self.wind.air_density_kg_m3,
-                0.0,
-                true,
-                5.0,
-            )?,
+            air_density_kg_m3: self.wind.air_density()?,
             tether_length_m: lmin,
             gravity_m_s2: require_range("gravity_m_s2", self.gravity_m_s2, 0.0, true, 100.0)?,
         };
@@ -158,9 +183,9 @@ impl EnvelopeRequest {
         Ok((
             EnvelopeProblem {
                 base,
-                wind: self.wind.shape.shape()?,
-                wind_speeds_m_s: grid(wmin, wmax, w.count),
-                tether_lengths_m: grid(lmin, lmax, l.count),
+                wind: shape,
+                wind_speeds_m_s: winds,
+                tether_lengths_m: lengths,
                 limits: Limits {
                     required_safety_factor: required,
                     ceiling_m: self.ceiling_m,
@@ -195,7 +220,11 @@ impl EnvelopeRequest {
         let (problem, config) = self.problem()?;
         let longest = problem.tether_lengths_m.iter().copied().fold(0.0, f64::max);
         let spec = match &self.stability {
-            Some(s) => s.spec(self.aerostat.mass_kg, longest, self.payout_rate_m_s)?,
+            Some(s) => s.spec(
+                self.aerostat.mass("aerostat")?,
+                longest,
+                self.payout_rate_m_s,
+            )?,
             None => None,
         };
         if let (Some(spec), Some(v)) = (&spec, self.payout_rate_m_s) {

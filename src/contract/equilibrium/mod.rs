@@ -6,257 +6,12 @@
 pub mod dto;
 
 use crate::contract::RequestError;
-use crate::numerics::aero::SteadyFlow;
-use crate::numerics::params::{InvalidInput, require_finite};
+use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::envelope::{Limits, judge};
-use crate::numerics::tether::presets::{BodyPreset, CYLINDER_NORMAL_DRAG, CablePreset};
-use crate::numerics::tether::{
-    Body, Cable, Equilibrium, EquilibriumConfig, EquilibriumProblem, WindProfile,
-};
+use crate::numerics::tether::{Equilibrium, EquilibriumConfig, EquilibriumProblem};
 use dto::*;
 
-/// `value` finite and within `[min, max]`; `exclusive_min` excludes `min`.
-pub(crate) fn require_range(
-    field: &str,
-    value: f64,
-    min: f64,
-    exclusive_min: bool,
-    max: f64,
-) -> Result<f64, InvalidInput> {
-    require_finite(field, value)?;
-    let low_ok = if exclusive_min {
-        value > min
-    } else {
-        value >= min
-    };
-    if !low_ok || value > max {
-        let low = if exclusive_min { "above" } else { "at least" };
-        return Err(InvalidInput::new(
-            field,
-            format!("must be {low} {min} and at most {max}, got {value}"),
-        ));
-    }
-    Ok(value)
-}
-
-/// A count within `[min, max]`.
-pub(crate) fn require_count(
-    field: &str,
-    value: usize,
-    min: usize,
-    max: usize,
-) -> Result<usize, InvalidInput> {
-    if value < min || value > max {
-        return Err(InvalidInput::new(
-            field,
-            format!("must be between {min} and {max}, got {value}"),
-        ));
-    }
-    Ok(value)
-}
-
-fn preset_cable(p: CablePresetName) -> CablePreset {
-    match p {
-        CablePresetName::Dyneema => CablePreset::Dyneema,
-        CablePresetName::Aramid => CablePreset::Aramid,
-        CablePresetName::Vectran => CablePreset::Vectran,
-        CablePresetName::Steel => CablePreset::Steel,
-    }
-}
-
-impl TetherCableInput {
-    /// The tether with the preset filled in; `at` prefixes field names.
-    pub fn cable(&self, at: &str) -> Result<Cable, InvalidInput> {
-        let f = |name: &str| format!("{at}.{name}");
-        let d = require_range(&f("diameter_m"), self.diameter_m, 0.0, true, 1.0)?;
-        let preset = self.preset.map(|p| preset_cable(p).at_diameter(d));
-        let mass = match (self.mass_per_length_kg_m, preset) {
-            (Some(m), _) => m,
-            (None, Some(p)) => p.mass_per_length_kg_m,
-            (None, None) => {
-                return Err(InvalidInput::new(
-                    f("mass_per_length_kg_m"),
-                    "is required without a preset",
-                ));
-            }
-        };
-        let mass = require_range(&f("mass_per_length_kg_m"), mass, 0.0, true, 1000.0)?;
-        let cn = self
-            .normal_drag_coefficient_nondim
-            .or(preset.map(|p| p.normal_drag_coefficient))
-            .unwrap_or(CYLINDER_NORMAL_DRAG);
-        let cn = require_range(&f("normal_drag_coefficient_nondim"), cn, 0.0, false, 10.0)?;
-        let ea = self
-            .axial_stiffness_n
-            .or(preset.map(|p| p.axial_stiffness_n))
-            .map(|v| require_range(&f("axial_stiffness_n"), v, 0.0, true, 1e12))
-            .transpose()?;
-        let strength = self
-            .breaking_strength_n
-            .or(preset.map(|p| p.breaking_strength_n))
-            .map(|v| require_range(&f("breaking_strength_n"), v, 0.0, true, 1e9))
-            .transpose()?;
-        Ok(Cable {
-            mass_per_length_kg_m: mass,
-            diameter_m: d,
-            normal_drag_coefficient: cn,
-            axial_stiffness_n: ea,
-            breaking_strength_n: strength,
-        })
-    }
-}
-
-impl TetherAerostatInput {
-    /// The aerostat's loads with the preset filled in; `at` prefixes field names.
-    pub fn body(&self, at: &str) -> Result<Body, InvalidInput> {
-        let f = |name: &str| format!("{at}.{name}");
-        if let Some(r) = self.radius_m {
-            require_range(&f("radius_m"), r, 0.0, true, 100.0)?;
-        }
-        if let Some(v) = self.volume_m3 {
-            require_range(&f("volume_m3"), v, 0.0, true, 1e7)?;
-        }
-        require_range(&f("mass_kg"), self.mass_kg, 0.0, false, 1e7)?;
-        let preset = match self.preset {
-            None => None,
-            Some(name) => {
-                let (shape, size) = match name {
-                    BodyPresetName::Sphere => (BodyPreset::Sphere, self.radius_m),
-                    BodyPresetName::Streamlined => (BodyPreset::Streamlined, self.volume_m3),
-                };
-                let field = f(shape.size_field());
-                match size {
-                    Some(size) => Some(shape.properties(size, &field)?),
-                    None if self.drag_coefficient_nondim.is_some()
-                        && self.reference_area_m2.is_some()
-                        && self.lift_coefficient_nondim.is_some() =>
-                    {
-                        None
-                    }
-                    None => {
-                        return Err(InvalidInput::new(
-                            field,
-                            "is required by this preset (or give drag_coefficient_nondim, lift_coefficient_nondim and reference_area_m2)",
-                        ));
-                    }
-                }
-            }
-        };
-        let need = |v: Option<f64>, p: Option<f64>, name: &str| {
-            v.or(p)
-                .ok_or_else(|| InvalidInput::new(f(name), "is required without a preset"))
-        };
-        let cd = need(
-            self.drag_coefficient_nondim,
-            preset.map(|p| p.drag_coefficient),
-            "drag_coefficient_nondim",
-        )?;
-        let area = need(
-            self.reference_area_m2,
-            preset.map(|p| p.reference_area_m2),
-            "reference_area_m2",
-        )?;
-        let cl = self
-            .lift_coefficient_nondim
-            .or(preset.map(|p| p.lift_coefficient))
-            .unwrap_or(0.0);
-        Ok(Body {
-            net_buoyancy_n: require_range(
-                &f("net_buoyancy_n"),
-                self.net_buoyancy_n,
-                0.0,
-                true,
-                1e8,
-            )?,
-            drag_coefficient: require_range(&f("drag_coefficient_nondim"), cd, 0.0, false, 10.0)?,
-            lift_coefficient: require_range(&f("lift_coefficient_nondim"), cl, -10.0, false, 10.0)?,
-            reference_area_m2: require_range(&f("reference_area_m2"), area, 0.0, true, 1e5)?,
-        })
-    }
-}
-
-impl WindFlowInput {
-    /// The profile; `at` is the field path of the flow.
-    pub fn profile(&self, at: &str) -> Result<WindProfile, InvalidInput> {
-        let f = |name: &str| format!("{at}.{name}");
-        Ok(match self {
-            Self::Uniform { speed_m_s } => WindProfile::uniform(require_range(
-                &f("speed_m_s"),
-                *speed_m_s,
-                -150.0,
-                false,
-                150.0,
-            )?),
-            Self::PowerLaw {
-                coefficient_m_s,
-                exponent_nondim,
-            } => WindProfile::Flow(SteadyFlow::PowerLaw {
-                coefficient: require_range(
-                    &f("coefficient_m_s"),
-                    *coefficient_m_s,
-                    -150.0,
-                    false,
-                    150.0,
-                )?,
-                exponent: require_range(&f("exponent_nondim"), *exponent_nondim, 0.0, false, 2.0)?,
-            }),
-            Self::Tabulated { points } => {
-                let mut table = Vec::with_capacity(points.len());
-                for (i, p) in points.iter().enumerate() {
-                    let z = require_range(
-                        &format!("{at}.points[{i}].elevation_m"),
-                        p.elevation_m,
-                        0.0,
-                        false,
-                        1e5,
-                    )?;
-                    let u = require_range(
-                        &format!("{at}.points[{i}].speed_m_s"),
-                        p.speed_m_s,
-                        -150.0,
-                        false,
-                        150.0,
-                    )?;
-                    table.push((z, u));
-                }
-                WindProfile::Flow(SteadyFlow::tabulated(&table, &f("points"))?)
-            }
-            Self::LogLaw {
-                reference_speed_m_s,
-                reference_height_m,
-                roughness_length_m,
-            } => {
-                require_range(
-                    &f("reference_speed_m_s"),
-                    *reference_speed_m_s,
-                    -150.0,
-                    false,
-                    150.0,
-                )?;
-                require_range(
-                    &f("reference_height_m"),
-                    *reference_height_m,
-                    0.0,
-                    true,
-                    1e4,
-                )?;
-                require_range(
-                    &f("roughness_length_m"),
-                    *roughness_length_m,
-                    0.0,
-                    true,
-                    10.0,
-                )?;
-                WindProfile::log_law(
-                    *reference_speed_m_s,
-                    *reference_height_m,
-                    *roughness_length_m,
-                    at,
-                )?
-            }
-        })
-    }
-}
+pub(crate) use crate::contract::system::validate::{require_count, require_range};
 
 impl EquilibriumRequest {
     /// The validated problem and its configuration.
@@ -265,13 +20,7 @@ impl EquilibriumRequest {
             cable: self.cable.cable("cable")?,
             body: self.aerostat.body("aerostat")?,
             wind: self.wind.flow.profile("wind.flow")?,
-            air_density_kg_m3: require_range(
-                "wind.air_density_kg_m3",
-                self.wind.air_density_kg_m3,
-                0.0,
-                true,
-                5.0,
-            )?,
+            air_density_kg_m3: self.wind.air_density()?,
             tether_length_m: require_range(
                 "tether_length_m",
                 self.tether_length_m,
@@ -293,6 +42,11 @@ impl EquilibriumRequest {
         }
         let steps = require_count("integration_steps", self.integration_steps, 8, 100_000)?;
         require_count("shape_samples", self.shape_samples, 2, 10_001)?;
+        crate::contract::system::validate::check_rest(
+            self.winch.as_ref(),
+            self.initial_length_m,
+            self.lift_reserve_nondim,
+        )?;
         Ok((
             problem,
             EquilibriumConfig {

@@ -5,79 +5,9 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::dto::{AerostatInput, CableInput, Groups, ModelInput};
-use crate::contract::equilibrium::dto::WindFlowInput;
+use crate::contract::system::{WindInput, default_lift_reserve, default_safety_factor};
 
-/// Winch limits.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct WinchInput {
-    /// Largest winch rate |L̇| (m/s).
-    #[schema(example = 40.0, exclusive_minimum = 0.0, maximum = 1000.0)]
-    pub max_rate_m_s: f64,
-    /// Largest winch acceleration |L̈| (m/s²), speeding up and braking.
-    #[schema(example = 2.0, exclusive_minimum = 0.0, maximum = 100.0)]
-    pub max_acceleration_m_s2: f64,
-    /// Largest rate of change of the winch acceleration (m/s³); absent: not
-    /// limited. With it the schedule is an S-curve (the acceleration ramps).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(example = 1.0, exclusive_minimum = 0.0, maximum = 10000.0)]
-    pub max_jerk_m_s3: Option<f64>,
-}
-
-/// Steady wind for the plan, with the aerodynamic data it needs. With it
-/// `target_elevation_m` is the aerostat's altitude in this wind (the tether
-/// is blown down, so it needs more length), and the tension limit and the
-/// stability ceiling use the steady-wind tether equilibrium.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct PlanWindInput {
-    pub flow: WindFlowInput,
-    /// Air density (kg/m³), default 1.225 (ISA sea level).
-    #[serde(default = "default_air_density")]
-    #[schema(example = 1.225, exclusive_minimum = 0.0, maximum = 5.0)]
-    pub air_density_kg_m3: f64,
-    /// Tether diameter d (m): the reference width of its normal drag.
-    #[schema(example = 0.006, exclusive_minimum = 0.0, maximum = 1.0)]
-    pub cable_diameter_m: f64,
-    /// Normal drag coefficient C_n of the tether (default 1.2, a cylinder in cross flow).
-    #[serde(default = "default_cable_drag")]
-    #[schema(example = 1.2, minimum = 0.0, maximum = 10.0)]
-    pub cable_normal_drag_coefficient_nondim: f64,
-    /// Drag coefficient C_D of the aerostat on `aerostat_reference_area_m2`.
-    #[schema(example = 0.47, minimum = 0.0, maximum = 10.0)]
-    pub aerostat_drag_coefficient_nondim: f64,
-    /// Reference area A of the aerostat (m²).
-    #[schema(example = 3.0, exclusive_minimum = 0.0, maximum = 1e5)]
-    pub aerostat_reference_area_m2: f64,
-    /// Aerodynamic lift coefficient C_L of the aerostat (default 0).
-    #[serde(default)]
-    #[schema(example = 0.0, minimum = -10.0, maximum = 10.0)]
-    pub aerostat_lift_coefficient_nondim: f64,
-}
-
-fn default_air_density() -> f64 {
-    1.225
-}
-fn default_cable_drag() -> f64 {
-    1.2
-}
-
-/// The tether's rating.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct TetherRatingInput {
-    /// Breaking strength (N).
-    #[schema(example = 20000.0, exclusive_minimum = 0.0, maximum = 1e9)]
-    pub breaking_strength_n: f64,
-    /// Safety factor on the breaking strength (FAA 14 CFR 31.25 practice: 5 for fibrous tethers).
-    #[serde(default = "default_safety_factor")]
-    #[schema(example = 5.0, minimum = 1.0, maximum = 100.0)]
-    pub safety_factor_nondim: f64,
-}
-
-fn default_safety_factor() -> f64 {
-    5.0
-}
+pub use crate::contract::system::WinchInput;
 
 /// One point of a wind forecast (wind at the aerostat).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
@@ -166,14 +96,15 @@ fn default_check_samples() -> usize {
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({
-    "cable": {"mass_per_length_kg_m": 0.078},
-    "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+    "cable": {"mass_per_length_kg_m": 0.078, "diameter_m": 0.006, "breaking_strength_n": 20000.0},
+    "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.3,
+                 "reference_area_m2": 20.0},
     "initial_length_m": 1.0,
     "gravity_m_s2": 9.81,
     "target_elevation_m": 1200.0,
     "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0},
     "lift_reserve_nondim": 0.05,
-    "tether": {"breaking_strength_n": 20000.0, "safety_factor_nondim": 5.0},
+    "required_safety_factor_nondim": 5.0,
     "haul_down": {
         "forecast": [{"time_s": 0.0, "wind_speed_m_s": 5.0}, {"time_s": 3600.0, "wind_speed_m_s": 15.0}],
         "max_operating_wind_m_s": 12.0
@@ -194,19 +125,24 @@ pub struct PlanRequest {
     /// converged continuum criterion).
     #[serde(default)]
     pub model: ModelInput,
-    /// Cable length to end at (m); below `initial_length_m` plans a retrieval.
+    /// Altitude of the aerostat to end at (m): in calm air the cable length, in
+    /// wind the altitude in that wind (the answer's `wind.target_length_m` is the
+    /// tether it needs); below `initial_length_m` plans a retrieval.
     #[schema(example = 1200.0, exclusive_minimum = 0.0, maximum = 1e6)]
     pub target_elevation_m: f64,
     pub winch: WinchInput,
     /// Stay stable with the net buoyancy reduced by this fraction
     /// (helium loss, temperature, downdraft).
-    #[serde(default = "default_reserve")]
+    #[serde(default = "default_lift_reserve")]
     #[schema(example = 0.05, minimum = 0.0, maximum = 0.9)]
     pub lift_reserve_nondim: f64,
-    /// Tether rating: the plan keeps the largest tension within
-    /// breaking strength / safety factor.
-    #[serde(default)]
-    pub tether: Option<TetherRatingInput>,
+    /// With `cable.breaking_strength_n` (or a cable preset): the plan keeps the
+    /// largest tension within breaking strength / this factor (default 5,
+    /// fibrous tethers, FAA 14 CFR 31.25 practice). Without a breaking
+    /// strength the tension is NOT checked (`tension_checked: false`).
+    #[serde(default = "default_safety_factor")]
+    #[schema(example = 5.0, minimum = 1.0, maximum = 100.0)]
+    pub required_safety_factor_nondim: f64,
     /// Retrieval only: the largest growth of an oscillation's tip amplitude
     /// over the retrieval (the winch is slowed to meet it when it can).
     #[serde(default)]
@@ -215,9 +151,10 @@ pub struct PlanRequest {
     /// Haul-down deadline under a wind forecast.
     #[serde(default)]
     pub haul_down: Option<HaulDownInput>,
-    /// Steady wind during the plan; absent: calm air.
+    /// Steady wind during the plan; absent: calm air. In wind the plan needs
+    /// `cable.diameter_m` and the aerostat's drag data.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub wind: Option<PlanWindInput>,
+    pub wind: Option<WindInput>,
     /// Stability criterion; absent: the string criterion.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stability: Option<PlanStabilityInput>,
@@ -236,9 +173,6 @@ fn default_initial_length() -> f64 {
 }
 fn default_gravity() -> f64 {
     9.81
-}
-fn default_reserve() -> f64 {
-    0.05
 }
 fn default_disturbance() -> f64 {
     0.1
@@ -387,7 +321,7 @@ pub struct PlanLimitsOutput {
     pub reserve_buoyancy_n: f64,
     /// Static lift limit with the reserve and the margin (m).
     pub lift_limit_m: f64,
-    /// Breaking strength / safety factor (N), if rated.
+    /// Breaking strength / required safety factor (N); null without a breaking strength.
     pub allowable_tension_n: Option<f64>,
     /// Effective-tension margin kept at every instant, ε(1 − r)F (N).
     pub stability_margin_n: f64,
@@ -395,9 +329,9 @@ pub struct PlanLimitsOutput {
     pub min_stability_margin_m_s: Option<f64>,
     /// Smallest effective tension over the samples (N).
     pub min_effective_tension_margin_n: Option<f64>,
-    /// Largest tension over the samples (N).
+    /// Largest tension over the schedule (N); when infeasible, at the target (or the reachable limit) at rest.
     pub peak_tension_n: Option<f64>,
-    /// Smallest tension safety factor over the samples (breaking strength / peak tension).
+    /// Breaking strength / peak tension; null without a breaking strength.
     pub min_safety_factor_nondim: Option<f64>,
 }
 
@@ -406,6 +340,10 @@ pub struct PlanLimitsOutput {
 pub struct PlanWindOutput {
     /// Tether length that flies the aerostat at `target_elevation_m` in this wind (m); null when unreachable.
     pub target_length_m: Option<f64>,
+    /// Angle of the winch–aerostat line from the vertical at the target (deg), full buoyancy; null when unreachable.
+    pub blowdown_angle_deg: Option<f64>,
+    /// Downwind distance of the aerostat from the winch at the target (m); null when unreachable.
+    pub target_downwind_m: Option<f64>,
     /// Static lift limit in this wind with the reserve (m of tether).
     pub lift_limit_m: f64,
     /// Altitude at the lift limit with full buoyancy (m): the highest reachable.
@@ -488,10 +426,15 @@ pub struct PlanResponse {
     pub direction: String,
     /// Plan duration (s); null when infeasible.
     pub duration_s: Option<f64>,
-    /// When infeasible: `static_lift_limit`, `tension_limit` or `amplification_limit`.
+    /// When infeasible: `static_lift_limit`, `tension_limit`, `amplification_limit`, `jerk_limit`,
+    /// `wind_blowdown` (the wind blows the aerostat below the target altitude), `quasi_static_ge_limit`
+    /// or `quasi_static_ge_check`.
     pub binding_limit: Option<String>,
     /// Plain-language verdict.
     pub reason: String,
+    /// Whether the tension was checked against a rating: false without
+    /// `cable.breaking_strength_n` (the tension is then NOT checked).
+    pub tension_checked: bool,
     /// The schedule, sampled (evenly spaced plus every phase boundary).
     pub schedule: Vec<PlanSampleOutput>,
     /// The operator's table: one line per phase.

@@ -9,6 +9,8 @@ use crate::contract::dto::SystemInput;
 use crate::contract::plan::dto::*;
 use crate::contract::plan::ge::*;
 use crate::contract::run::{Progress, RequestError, groups};
+use crate::contract::system::WindInput;
+use crate::contract::system::validate as system_check;
 use crate::numerics::params::{InvalidInput, require_finite, require_positive};
 use crate::numerics::plan::air::{Air, SteadyWind};
 use crate::numerics::plan::deadline::{self, Forecast};
@@ -18,7 +20,7 @@ use crate::numerics::plan::schedule::{self, PlanOptions, PlanOutcome, Schedule};
 use crate::numerics::plan::{BindingLimit, PlanProblem, STABILITY_MARGIN, Winch, validate_jerk};
 use crate::numerics::string::StringModel;
 use crate::numerics::string::transient::{Observer, RunOutcome, TransientError};
-use crate::numerics::tether::{Body, Cable};
+use crate::numerics::tether::EquilibriumConfig;
 
 /// Progress of the contract seen as a numerics observer.
 struct ProgressObserver<'a>(&'a dyn Progress);
@@ -61,53 +63,14 @@ struct WindTarget {
     unreachable: Option<BindingLimit>,
 }
 
-/// The steady wind of the request.
-fn steady_wind(w: &PlanWindInput) -> Result<SteadyWind, InvalidInput> {
+/// The steady wind of the request, with the tether and aerostat drag data
+/// it needs (each refused naming the field when missing).
+fn steady_wind(req: &PlanRequest, w: &WindInput) -> Result<SteadyWind, InvalidInput> {
     let profile = w.flow.profile("wind.flow")?;
-    let rho = bounded("wind.air_density_kg_m3", w.air_density_kg_m3, 0.0, 5.0)?;
-    require_positive("wind.air_density_kg_m3", rho)?;
-    let d = require_positive("wind.cable_diameter_m", w.cable_diameter_m)?;
-    bounded("wind.cable_diameter_m", d, 0.0, 1.0)?;
-    let cn = bounded(
-        "wind.cable_normal_drag_coefficient_nondim",
-        w.cable_normal_drag_coefficient_nondim,
-        0.0,
-        10.0,
-    )?;
-    let cd = bounded(
-        "wind.aerostat_drag_coefficient_nondim",
-        w.aerostat_drag_coefficient_nondim,
-        0.0,
-        10.0,
-    )?;
-    let area = require_positive(
-        "wind.aerostat_reference_area_m2",
-        w.aerostat_reference_area_m2,
-    )?;
-    bounded("wind.aerostat_reference_area_m2", area, 0.0, 1e5)?;
-    let cl = bounded(
-        "wind.aerostat_lift_coefficient_nondim",
-        w.aerostat_lift_coefficient_nondim,
-        -10.0,
-        10.0,
-    )?;
-    Ok(SteadyWind::new(
-        Cable {
-            mass_per_length_kg_m: 1.0,
-            diameter_m: d,
-            normal_drag_coefficient: cn,
-            axial_stiffness_n: None,
-            breaking_strength_n: None,
-        },
-        Body {
-            net_buoyancy_n: 1.0,
-            drag_coefficient: cd,
-            lift_coefficient: cl,
-            reference_area_m2: area,
-        },
-        profile,
-        rho,
-    ))
+    let rho = w.air_density()?;
+    let cable = req.cable.cable("cable")?;
+    let body = req.aerostat.body("aerostat")?;
+    Ok(SteadyWind::new(cable, body, profile, rho))
 }
 
 fn bounded(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64, InvalidInput> {
@@ -136,17 +99,27 @@ fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidI
         gravity_m_s2: req.gravity_m_s2,
         model: req.model.clone(),
         numerics: Default::default(),
+        wind: None,
+        winch: None,
+        required_safety_factor_nondim: None,
+        lift_reserve_nondim: None,
     };
     let model = system_input.model()?;
+    req.winch.check("winch")?;
     let winch = Winch::new(req.winch.max_rate_m_s, req.winch.max_acceleration_m_s2)?;
     let max_jerk_m_s3 = req.winch.max_jerk_m_s3.map(validate_jerk).transpose()?;
     let ge = ge_options(req)?;
-    let air = match (&req.wind, ge) {
-        (Some(w), None) => Air::Wind(Box::new(steady_wind(w)?)),
+    if let Some(w) = &req.wind {
+        w.check()?;
+    }
+    // A wind of zero speed everywhere is calm air (no drag data needed).
+    let wind = req.wind.as_ref().filter(|w| !w.flow.is_calm());
+    let air = match (wind, ge) {
+        (Some(w), None) => Air::Wind(Box::new(steady_wind(req, w)?)),
         (None, None) => Air::Calm,
         (w, Some(o)) => {
             let mut sw = match w {
-                Some(w) => steady_wind(w)?,
+                Some(w) => steady_wind(req, w)?,
                 None => calm_wind(model.system.mass_per_length_kg_m),
             };
             sw.ge = Some(GeCriterion::new(o));
@@ -154,20 +127,10 @@ fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidI
             Air::Wind(Box::new(sw))
         }
     };
-    let (allowable, breaking) = match &req.tether {
-        Some(t) => {
-            let b = require_positive("tether.breaking_strength_n", t.breaking_strength_n)?;
-            bounded("tether.breaking_strength_n", b, 0.0, 1e9)?;
-            let sf = bounded(
-                "tether.safety_factor_nondim",
-                t.safety_factor_nondim,
-                1.0,
-                100.0,
-            )?;
-            (Some(b / sf), Some(b))
-        }
-        None => (None, None),
-    };
+    let sf = system_check::required_safety_factor(req.required_safety_factor_nondim)?;
+    system_check::lift_reserve(req.lift_reserve_nondim)?;
+    let breaking = req.cable.breaking_strength()?;
+    let allowable = breaking.map(|b| b / sf);
     require_finite("target_elevation_m", req.target_elevation_m)?;
     // In wind the target is an altitude: the length that flies there.
     let (target_length, wind) = if air.is_calm() || (!resolve && air.has_ge()) {
@@ -479,15 +442,31 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
     };
     let inputs = serde_json::to_value(req).expect("requests serialise");
     let opts = &v.options;
-    let wind_out = v.wind.as_ref().map(|w| PlanWindOutput {
-        target_length_m: w.unreachable.is_none().then_some(p.target_length_m),
-        lift_limit_m: w.lift_limit_m,
-        reachable_altitude_m: w.reachable_altitude_m,
-        stability_criterion: match &opts.air {
-            Air::Wind(sw) => sw.criterion_name.to_string(),
-            Air::Calm => String::new(),
-        },
+    let wind_out = v.wind.as_ref().map(|w| {
+        let at_target = match (&opts.air, w.unreachable.is_none()) {
+            (Air::Wind(sw), true) => sw
+                .problem(&p.system, p.system.net_buoyancy_n, p.target_length_m)
+                .solve(&EquilibriumConfig::default())
+                .ok(),
+            _ => None,
+        };
+        PlanWindOutput {
+            target_length_m: w.unreachable.is_none().then_some(p.target_length_m),
+            blowdown_angle_deg: at_target.as_ref().map(|e| e.blowdown_angle_deg),
+            target_downwind_m: at_target.as_ref().map(|e| e.downwind_m),
+            lift_limit_m: w.lift_limit_m,
+            reachable_altitude_m: w.reachable_altitude_m,
+            stability_criterion: match &opts.air {
+                Air::Wind(sw) => sw.criterion_name.to_string(),
+                Air::Calm => String::new(),
+            },
+        }
     });
+    // At rest at the end of the plan (or the reachable limit): the tension
+    // the answer reports even when no schedule exists.
+    let rest = opts.air.rest_loads(&p, p.target_length_m);
+    let rest_peak = rest.top_tension_n.max(rest.winch_tension_n);
+    let rest_peak = rest_peak.is_finite().then_some(rest_peak);
     let limits_base = PlanLimitsOutput {
         reserve_buoyancy_n: p.reserve_buoyancy_n(),
         lift_limit_m: v.wind.as_ref().map_or(p.lift_limit_m(), |w| w.lift_limit_m),
@@ -495,8 +474,14 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         stability_margin_n: STABILITY_MARGIN * p.reserve_buoyancy_n(),
         min_stability_margin_m_s: None,
         min_effective_tension_margin_n: None,
-        peak_tension_n: None,
-        min_safety_factor_nondim: None,
+        peak_tension_n: rest_peak,
+        min_safety_factor_nondim: v.breaking_strength_n.zip(rest_peak).map(|(b, t)| b / t),
+    };
+    let tension_checked = v.breaking_strength_n.is_some();
+    let unchecked_note = if tension_checked {
+        ""
+    } else {
+        "; tension NOT checked (no cable.breaking_strength_n)"
     };
     let infeasible = |b: BindingLimit, limits: PlanLimitsOutput| PlanResponse {
         feasible: false,
@@ -504,7 +489,8 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         direction: direction.into(),
         duration_s: None,
         binding_limit: Some(b.name().into()),
-        reason: format!("no-go: {}", b.reason(p.lift_reserve)),
+        reason: format!("no-go: {}{unchecked_note}", b.reason(p.lift_reserve)),
+        tension_checked,
         schedule: vec![],
         phases: vec![],
         constant_rate: None,
@@ -718,9 +704,18 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         sched.duration_s,
         100.0 * p.lift_reserve
     );
+    if let Some(w) = &wind_out
+        && let (Some(l), Some(a)) = (w.target_length_m, w.blowdown_angle_deg)
+    {
+        reason.push_str(&format!(
+            " (in this wind {l:.1} m of tether flies the aerostat at {:.1} m, blown down {a:.1}°)",
+            req.target_elevation_m
+        ));
+    }
     if let Some(t) = p.allowable_tension_n {
         reason.push_str(&format!(", tension within {t:.0} N"));
     }
+    reason.push_str(unchecked_note);
     if let Some(h) = &haul_down {
         reason.push_str(&format!("; haul-down: {}", h.reason));
     }
@@ -731,6 +726,7 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         duration_s: Some(sched.duration_s),
         binding_limit: None,
         reason,
+        tension_checked,
         schedule: schedule_out,
         phases: phases_output(&sched),
         constant_rate,

@@ -1,0 +1,533 @@
+//! Validation of the system objects: the bounds of the schema, the
+//! presets filled in (fields given win), and the plain-words errors that
+//! name the field to fix.
+
+use super::presets::NamedAerostat;
+use super::*;
+use crate::numerics::aero::SteadyFlow;
+use crate::numerics::params::ranges::{AEROSTAT_MASS_KG, MASS_PER_LENGTH_KG_M, NET_BUOYANCY_N};
+use crate::numerics::params::{InvalidInput, compact, require_finite};
+use crate::numerics::tether::presets::{BodyPreset, CYLINDER_NORMAL_DRAG, CablePreset};
+use crate::numerics::tether::{Body, Cable, WindProfile};
+
+/// `value` finite and within `[min, max]`; `exclusive_min` excludes `min`.
+pub(crate) fn require_range(
+    field: &str,
+    value: f64,
+    min: f64,
+    exclusive_min: bool,
+    max: f64,
+) -> Result<f64, InvalidInput> {
+    require_finite(field, value)?;
+    let low_ok = if exclusive_min {
+        value > min
+    } else {
+        value >= min
+    };
+    if !low_ok || value > max {
+        let low = if exclusive_min { "above" } else { "at least" };
+        return Err(InvalidInput::new(
+            field,
+            format!(
+                "must be {low} {} and at most {}, got {}",
+                compact(min),
+                compact(max),
+                compact(value)
+            ),
+        ));
+    }
+    Ok(value)
+}
+
+/// A count within `[min, max]`.
+pub(crate) fn require_count(
+    field: &str,
+    value: usize,
+    min: usize,
+    max: usize,
+) -> Result<usize, InvalidInput> {
+    if value < min || value > max {
+        return Err(InvalidInput::new(
+            field,
+            format!("must be between {min} and {max}, got {value}"),
+        ));
+    }
+    Ok(value)
+}
+
+fn preset_cable(p: CablePresetName) -> CablePreset {
+    match p {
+        CablePresetName::Dyneema => CablePreset::Dyneema,
+        CablePresetName::Aramid => CablePreset::Aramid,
+        CablePresetName::Vectran => CablePreset::Vectran,
+        CablePresetName::Steel => CablePreset::Steel,
+    }
+}
+
+/// The plain-words request for the tether's mass.
+const MASS_HOW: &str =
+    "give the mass per length (kg/m), or the density and the area, or a preset with its diameter";
+
+impl CableInput {
+    fn field(at: &str, name: &str) -> String {
+        format!("{at}.{name}")
+    }
+
+    /// The preset's properties at the diameter (None without a preset).
+    fn preset_properties(
+        &self,
+        at: &str,
+    ) -> Result<Option<crate::numerics::tether::presets::CableProperties>, InvalidInput> {
+        let Some(p) = self.preset else {
+            return Ok(None);
+        };
+        let Some(d) = self.diameter_m else {
+            return Err(InvalidInput::new(
+                Self::field(at, "diameter_m"),
+                "is required with a preset: give the tether's diameter in metres (e.g. 0.006)",
+            ));
+        };
+        let d = require_range(&Self::field(at, "diameter_m"), d, 0.0, true, 1.0)?;
+        Ok(Some(preset_cable(p).at_diameter(d)))
+    }
+
+    /// ρA (kg/m) from the mass per length, the density and area, or the preset.
+    pub fn mass_per_length(&self) -> Result<f64, InvalidInput> {
+        self.mass_per_length_at("cable")
+    }
+
+    /// [`Self::mass_per_length`] with the fields named under `at`.
+    pub fn mass_per_length_at(&self, at: &str) -> Result<f64, InvalidInput> {
+        let f = |n: &str| Self::field(at, n);
+        let preset = self.preset_properties(at)?;
+        let check = |field: &str, v: f64| -> Result<f64, InvalidInput> {
+            MASS_PER_LENGTH_KG_M.check(field, v)
+        };
+        match (self.mass_per_length_kg_m, self.density_kg_m3, self.area_m2) {
+            (Some(rho_a), None, None) => check(&f("mass_per_length_kg_m"), rho_a),
+            (None, Some(rho), Some(a)) => {
+                require_range(&f("density_kg_m3"), rho, 100.0, false, 30_000.0)?;
+                require_range(&f("area_m2"), a, 1e-9, false, 0.1)?;
+                let rho_a = rho * a;
+                if MASS_PER_LENGTH_KG_M.check("", rho_a).is_err() {
+                    return Err(InvalidInput::new(
+                        f("area_m2"),
+                        format!(
+                            "gives a mass per length density × area = {} kg/m; it must be between {} and {} kg/m",
+                            compact(rho_a),
+                            compact(MASS_PER_LENGTH_KG_M.min),
+                            compact(MASS_PER_LENGTH_KG_M.max)
+                        ),
+                    ));
+                }
+                Ok(rho_a)
+            }
+            (Some(_), _, _) => Err(InvalidInput::new(
+                f("mass_per_length_kg_m"),
+                "give either the mass per length or the density with the area, not both",
+            )),
+            (None, Some(_), None) => Err(InvalidInput::new(
+                f("area_m2"),
+                "is needed with the density: give the cross-section area in m²",
+            )),
+            (None, None, Some(_)) => Err(InvalidInput::new(
+                f("density_kg_m3"),
+                "is needed with the area: give the material density in kg/m³",
+            )),
+            (None, None, None) => match preset {
+                Some(p) => check(&f("mass_per_length_kg_m"), p.mass_per_length_kg_m),
+                None => Err(InvalidInput::new(f("mass_per_length_kg_m"), MASS_HOW)),
+            },
+        }
+    }
+
+    /// The breaking strength given, or the preset's; None: not checked.
+    pub fn breaking_strength(&self) -> Result<Option<f64>, InvalidInput> {
+        self.breaking_strength_at("cable")
+    }
+
+    pub fn breaking_strength_at(&self, at: &str) -> Result<Option<f64>, InvalidInput> {
+        let preset = self.preset_properties(at)?;
+        self.breaking_strength_n
+            .or(preset.map(|p| p.breaking_strength_n))
+            .map(|v| require_range(&Self::field(at, "breaking_strength_n"), v, 0.0, true, 1e9))
+            .transpose()
+    }
+
+    /// The axial stiffness given, or the preset's; None: inextensible.
+    pub fn axial_stiffness(&self, at: &str) -> Result<Option<f64>, InvalidInput> {
+        let preset = self.preset_properties(at)?;
+        self.axial_stiffness_n
+            .or(preset.map(|p| p.axial_stiffness_n))
+            .map(|v| require_range(&Self::field(at, "axial_stiffness_n"), v, 0.0, true, 1e12))
+            .transpose()
+    }
+
+    /// Checks the fields that are given but not used by a calm-air analysis
+    /// (so that a whole system is refused for the same values everywhere).
+    pub fn check_given(&self, at: &str) -> Result<(), InvalidInput> {
+        let f = |n: &str| Self::field(at, n);
+        if let Some(d) = self.diameter_m {
+            require_range(&f("diameter_m"), d, 0.0, true, 1.0)?;
+        }
+        if let Some(c) = self.normal_drag_coefficient_nondim {
+            require_range(&f("normal_drag_coefficient_nondim"), c, 0.0, false, 10.0)?;
+        }
+        if let Some(e) = self.bending_stiffness_n_m2 {
+            require_range(&f("bending_stiffness_n_m2"), e, 1e-6, false, 1e12)?;
+        }
+        self.axial_stiffness(at)?;
+        self.breaking_strength_at(at)?;
+        Ok(())
+    }
+
+    /// The tether in wind, presets filled in; `at` prefixes field names.
+    /// Its diameter is required (the width the wind's drag acts on).
+    pub fn cable(&self, at: &str) -> Result<Cable, InvalidInput> {
+        let f = |n: &str| Self::field(at, n);
+        let Some(d) = self.diameter_m else {
+            return Err(InvalidInput::new(
+                f("diameter_m"),
+                "is needed in wind: give the tether's diameter in metres (the width the wind's drag acts on)",
+            ));
+        };
+        let d = require_range(&f("diameter_m"), d, 0.0, true, 1.0)?;
+        let preset = self.preset_properties(at)?;
+        let mass = self.mass_per_length_at(at)?;
+        let cn = self
+            .normal_drag_coefficient_nondim
+            .or(preset.map(|p| p.normal_drag_coefficient))
+            .unwrap_or(CYLINDER_NORMAL_DRAG);
+        let cn = require_range(&f("normal_drag_coefficient_nondim"), cn, 0.0, false, 10.0)?;
+        self.check_given(at)?;
+        Ok(Cable {
+            mass_per_length_kg_m: mass,
+            diameter_m: d,
+            normal_drag_coefficient: cn,
+            axial_stiffness_n: self.axial_stiffness(at)?,
+            breaking_strength_n: self.breaking_strength_at(at)?,
+        })
+    }
+}
+
+impl AerostatInput {
+    fn named(&self) -> Option<NamedAerostat> {
+        self.preset.and_then(NamedAerostat::of)
+    }
+
+    /// Net buoyancy F (N): given, or the named preset's.
+    pub fn net_buoyancy(&self, at: &str) -> Result<f64, InvalidInput> {
+        let field = format!("{at}.net_buoyancy_n");
+        match self
+            .net_buoyancy_n
+            .or(self.named().map(|n| n.net_buoyancy_n))
+        {
+            Some(f) => NET_BUOYANCY_N.check(&field, f),
+            None => Err(InvalidInput::new(
+                field,
+                "give the aerostat's net buoyancy in newtons (its lift minus its weight), or a named aerostat preset",
+            )),
+        }
+    }
+
+    /// Net buoyancy for the GE models (zero allowed).
+    pub fn net_buoyancy_ge(&self, at: &str) -> Result<f64, InvalidInput> {
+        let field = format!("{at}.net_buoyancy_n");
+        match self
+            .net_buoyancy_n
+            .or(self.named().map(|n| n.net_buoyancy_n))
+        {
+            Some(f) => crate::numerics::params::ranges::GE_NET_BUOYANCY_N.check(&field, f),
+            None => Err(InvalidInput::new(
+                field,
+                "give the aerostat's net buoyancy in newtons (its lift minus its weight), or a named aerostat preset",
+            )),
+        }
+    }
+
+    /// Mass m (kg): given, the named preset's, or 0.
+    pub fn mass(&self, at: &str) -> Result<f64, InvalidInput> {
+        let m = self
+            .mass_kg
+            .or(self.named().map(|n| n.mass_kg))
+            .unwrap_or(0.0);
+        AEROSTAT_MASS_KG.check(&format!("{at}.mass_kg"), m)
+    }
+
+    /// Rigid link length (m), default 0 (GE models).
+    pub fn link_length(&self, at: &str) -> Result<f64, InvalidInput> {
+        crate::numerics::params::ranges::LINK_LENGTH_M.check(
+            &format!("{at}.link_length_m"),
+            self.link_length_m.unwrap_or(0.0),
+        )
+    }
+
+    /// Added-mass coefficient: given, the preset's, or 0.5 (a sphere).
+    pub fn added_mass_coefficient(&self, at: &str) -> Result<f64, InvalidInput> {
+        let c = self
+            .added_mass_coefficient_nondim
+            .or(self.named().and_then(|n| n.added_mass_coefficient_nondim))
+            .unwrap_or(0.5);
+        require_range(
+            &format!("{at}.added_mass_coefficient_nondim"),
+            c,
+            0.0,
+            false,
+            10.0,
+        )
+    }
+
+    /// The shape preset with its size: the preset's, or a named
+    /// aerostat's shape.
+    fn shape(
+        &self,
+        at: &str,
+    ) -> Result<Option<crate::numerics::tether::presets::BodyProperties>, InvalidInput> {
+        let f = |n: &str| format!("{at}.{n}");
+        if let Some(r) = self.radius_m {
+            require_range(&f("radius_m"), r, 0.0, true, 100.0)?;
+        }
+        if let Some(v) = self.volume_m3 {
+            require_range(&f("volume_m3"), v, 0.0, true, 1e7)?;
+        }
+        let (shape, size) = match self.preset {
+            None => return Ok(None),
+            Some(BodyPresetName::Sphere) => (BodyPreset::Sphere, self.radius_m),
+            Some(BodyPresetName::Streamlined) => (BodyPreset::Streamlined, self.volume_m3),
+            Some(_) => {
+                let n = self.named().expect("a named preset");
+                let size = match n.shape {
+                    BodyPreset::Sphere => self.radius_m.unwrap_or(n.size),
+                    BodyPreset::Streamlined => self.volume_m3.unwrap_or(n.size),
+                };
+                (n.shape, Some(size))
+            }
+        };
+        let field = f(shape.size_field());
+        match size {
+            Some(size) => Ok(Some(shape.properties(size, &field)?)),
+            None if self.drag_coefficient_nondim.is_some()
+                && self.reference_area_m2.is_some()
+                && self.lift_coefficient_nondim.is_some() =>
+            {
+                Ok(None)
+            }
+            None => Err(InvalidInput::new(
+                field,
+                format!(
+                    "is needed by this preset: give the {} (or the drag coefficient, the lift coefficient and the reference area)",
+                    match shape {
+                        BodyPreset::Sphere => "sphere's radius in metres",
+                        BodyPreset::Streamlined => "hull's volume in m³",
+                    }
+                ),
+            )),
+        }
+    }
+
+    /// Checks the fields a calm-air analysis does not use.
+    pub fn check_given(&self, at: &str) -> Result<(), InvalidInput> {
+        let f = |n: &str| format!("{at}.{n}");
+        self.shape(at)?;
+        if let Some(c) = self.drag_coefficient_nondim {
+            require_range(&f("drag_coefficient_nondim"), c, 0.0, false, 10.0)?;
+        }
+        if let Some(a) = self.reference_area_m2 {
+            require_range(&f("reference_area_m2"), a, 0.0, true, 1e5)?;
+        }
+        if let Some(c) = self.lift_coefficient_nondim {
+            require_range(&f("lift_coefficient_nondim"), c, -10.0, false, 10.0)?;
+        }
+        self.added_mass_coefficient(at)?;
+        self.mass(at)?;
+        Ok(())
+    }
+
+    /// The aerostat's loads in wind, presets filled in; `at` prefixes
+    /// field names. The drag data are required.
+    pub fn body(&self, at: &str) -> Result<Body, InvalidInput> {
+        let f = |n: &str| format!("{at}.{n}");
+        let preset = self.shape(at)?;
+        let need = |v: Option<f64>, p: Option<f64>, name: &str, what: &str| {
+            v.or(p).ok_or_else(|| {
+                InvalidInput::new(
+                    f(name),
+                    format!("is needed in wind: give {what} (or a shape preset with its size)"),
+                )
+            })
+        };
+        let cd = need(
+            self.drag_coefficient_nondim,
+            preset.map(|p| p.drag_coefficient),
+            "drag_coefficient_nondim",
+            "the aerostat's drag coefficient on its reference area",
+        )?;
+        let area = need(
+            self.reference_area_m2,
+            preset.map(|p| p.reference_area_m2),
+            "reference_area_m2",
+            "the area (m²) the drag coefficient refers to",
+        )?;
+        let cl = self
+            .lift_coefficient_nondim
+            .or(preset.map(|p| p.lift_coefficient))
+            .unwrap_or(0.0);
+        self.check_given(at)?;
+        Ok(Body {
+            net_buoyancy_n: self.net_buoyancy(at)?,
+            drag_coefficient: require_range(&f("drag_coefficient_nondim"), cd, 0.0, false, 10.0)?,
+            lift_coefficient: require_range(&f("lift_coefficient_nondim"), cl, -10.0, false, 10.0)?,
+            reference_area_m2: require_range(&f("reference_area_m2"), area, 0.0, true, 1e5)?,
+        })
+    }
+}
+
+impl WindFlowInput {
+    /// The profile; `at` is the field path of the flow.
+    pub fn profile(&self, at: &str) -> Result<WindProfile, InvalidInput> {
+        let f = |name: &str| format!("{at}.{name}");
+        Ok(match self {
+            Self::Uniform { speed_m_s } => WindProfile::uniform(require_range(
+                &f("speed_m_s"),
+                *speed_m_s,
+                -150.0,
+                false,
+                150.0,
+            )?),
+            Self::PowerLaw {
+                coefficient_m_s,
+                exponent_nondim,
+            } => WindProfile::Flow(SteadyFlow::PowerLaw {
+                coefficient: require_range(
+                    &f("coefficient_m_s"),
+                    *coefficient_m_s,
+                    -150.0,
+                    false,
+                    150.0,
+                )?,
+                exponent: require_range(&f("exponent_nondim"), *exponent_nondim, 0.0, false, 2.0)?,
+            }),
+            Self::Tabulated { points } => {
+                if points.is_empty() || points.len() > 10_000 {
+                    return Err(InvalidInput::new(
+                        f("points"),
+                        format!("give 1 to 10000 points, got {}", points.len()),
+                    ));
+                }
+                let mut table = Vec::with_capacity(points.len());
+                for (i, p) in points.iter().enumerate() {
+                    let z = require_range(
+                        &format!("{at}.points[{i}].elevation_m"),
+                        p.elevation_m,
+                        0.0,
+                        false,
+                        1e5,
+                    )?;
+                    let u = require_range(
+                        &format!("{at}.points[{i}].speed_m_s"),
+                        p.speed_m_s,
+                        -150.0,
+                        false,
+                        150.0,
+                    )?;
+                    table.push((z, u));
+                }
+                WindProfile::Flow(SteadyFlow::tabulated(&table, &f("points"))?)
+            }
+            Self::LogLaw {
+                speed_m_s,
+                reference_height_m,
+                roughness_length_m,
+            } => {
+                require_range(&f("speed_m_s"), *speed_m_s, -150.0, false, 150.0)?;
+                require_range(
+                    &f("reference_height_m"),
+                    *reference_height_m,
+                    0.0,
+                    true,
+                    1e4,
+                )?;
+                require_range(
+                    &f("roughness_length_m"),
+                    *roughness_length_m,
+                    0.0,
+                    true,
+                    10.0,
+                )?;
+                WindProfile::log_law(*speed_m_s, *reference_height_m, *roughness_length_m, at)?
+            }
+        })
+    }
+}
+
+impl WindInput {
+    /// The air density, checked.
+    pub fn air_density(&self) -> Result<f64, InvalidInput> {
+        require_range(
+            "wind.air_density_kg_m3",
+            self.air_density_kg_m3,
+            0.0,
+            true,
+            5.0,
+        )
+    }
+
+    /// Checks the flow and the density (calm-air analyses: only that they are valid).
+    pub fn check(&self) -> Result<(), InvalidInput> {
+        self.flow.profile("wind.flow")?;
+        self.air_density()?;
+        Ok(())
+    }
+}
+
+impl WinchInput {
+    /// Checks the limits against the schema's bounds.
+    pub fn check(&self, at: &str) -> Result<(), InvalidInput> {
+        require_range(
+            &format!("{at}.max_rate_m_s"),
+            self.max_rate_m_s,
+            0.0,
+            true,
+            1000.0,
+        )?;
+        require_range(
+            &format!("{at}.max_acceleration_m_s2"),
+            self.max_acceleration_m_s2,
+            0.0,
+            true,
+            100.0,
+        )?;
+        if let Some(j) = self.max_jerk_m_s3 {
+            require_range(&format!("{at}.max_jerk_m_s3"), j, 0.0, true, 10000.0)?;
+        }
+        Ok(())
+    }
+}
+
+/// The safety factor, checked.
+pub fn required_safety_factor(v: f64) -> Result<f64, InvalidInput> {
+    require_range("required_safety_factor_nondim", v, 1.0, false, 100.0)
+}
+
+/// The lift reserve, checked.
+pub fn lift_reserve(v: f64) -> Result<f64, InvalidInput> {
+    require_range("lift_reserve_nondim", v, 0.0, false, 0.9)
+}
+
+/// Checks the system parts a request accepts but does not use.
+pub fn check_rest(
+    winch: Option<&WinchInput>,
+    initial_length_m: Option<f64>,
+    lift_reserve_nondim: Option<f64>,
+) -> Result<(), InvalidInput> {
+    if let Some(w) = winch {
+        w.check("winch")?;
+    }
+    if let Some(l) = initial_length_m {
+        crate::numerics::params::ranges::INITIAL_LENGTH_M.check("initial_length_m", l)?;
+    }
+    if let Some(r) = lift_reserve_nondim {
+        lift_reserve(r)?;
+    }
+    Ok(())
+}
