@@ -29,19 +29,13 @@
   const roots = [form, document.getElementById("plan-form")];
   const num = (name, errors, opts) => S.readNumber(form, name, errors, opts);
 
-  // The wind profile of today's wind (the speed is swept over the grid).
-  function envelopeWind(wind) {
-    const { kind, reference_height_m, roughness_length_m } = wind.flow;
-    const shape = kind === "log_law" ? { kind, reference_height_m, roughness_length_m } : { kind: "uniform" };
-    return { air_density_kg_m3: wind.air_density_kg_m3, shape };
-  }
-
   function readRequest(errors) {
     const sys = S.readSystem(errors, "wind");
     return S.compact({
       cable: sys.cable,
       aerostat: sys.aerostat,
-      wind: envelopeWind(sys.wind),
+      // Today's wind: its profile scaled to each grid speed (the speed at the reference height).
+      wind: sys.wind,
       wind_speeds_m_s: {
         min: num("wind_speeds_m_s.min", errors),
         max: num("wind_speeds_m_s.max", errors),

@@ -216,11 +216,12 @@
     const rows = [
       ["Tether needed", w ? (w.target_length_m == null ? `out of reach (at most ${fmt(w.reachable_altitude_m, 0)} m up)` : `${fmt(w.target_length_m, 1)} m`) : `${fmt(req.target_elevation_m, 1)} m`],
       ["Blow-down angle", w?.blowdown_angle_deg == null ? "–" : `${fmt(w.blowdown_angle_deg, 1)}°`],
+      ["Downwind of the winch", w?.target_downwind_m == null ? null : `${fmt(w.target_downwind_m, 0)} m`],
       ["Peak tension", r.limits?.peak_tension_n == null ? "–" : `${fmt(r.limits.peak_tension_n, 0)} N`],
       ["Safety factor", sf == null ? "not checked" : fmt(sf, 1)],
       ["Time at the winch", duration(r.duration_s)],
     ];
-    dl.replaceChildren(...rows.map(([k, v]) => {
+    dl.replaceChildren(...rows.filter(([, v]) => v != null).map(([k, v]) => {
       const div = document.createElement("div");
       const dt = document.createElement("dt");
       dt.textContent = k;

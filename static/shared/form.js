@@ -49,8 +49,8 @@ window.tetherplanShared = window.tetherplanShared || {};
   // ---------- the system card ----------
 
   // The §9 system from the card (and the plan form's wind and starting length).
-  // `use`: "plan" (everything), "wind" (the envelope: no winch, the wind's
-  // profile without its speed), "calm" (string analyses in calm air: the
+  // `use`: "plan" (everything), "wind" (the envelope: no winch; today's wind,
+  // whose profile the envelope scales to each grid speed), "calm" (string analyses in calm air: the
   // tether's mass and rating, the aerostat's lift and mass).
   function readSystem(errors, use = "plan") {
     const roots = [card(), document.getElementById("plan-form")];
@@ -81,7 +81,7 @@ window.tetherplanShared = window.tetherplanShared || {};
       return sys;
     }
     sys.required_safety_factor_nondim = n("required_safety_factor_nondim");
-    sys.wind = { air_density_kg_m3: n("wind.air_density_kg_m3"), flow: readFlow(roots, errors, use === "wind") };
+    sys.wind = { air_density_kg_m3: n("wind.air_density_kg_m3"), flow: readFlow(roots, errors) };
     if (use === "wind") return sys;
     sys.winch = compact({
       max_rate_m_s: n("winch.max_rate_m_s"),
@@ -94,11 +94,10 @@ window.tetherplanShared = window.tetherplanShared || {};
   }
 
   // Today's wind: uniform, or a log law through the speed at the reference height.
-  function readFlow(roots, errors, profileOnly) {
+  function readFlow(roots, errors) {
     const n = (name, opts) => readNumber(roots, name, errors, opts);
     const kind = named(roots, "wind.flow.kind")?.value || "uniform";
-    const flow = { kind };
-    if (!profileOnly) flow.speed_m_s = n("wind.flow.speed_m_s");
+    const flow = { kind, speed_m_s: n("wind.flow.speed_m_s") };
     if (kind === "log_law") {
       flow.reference_height_m = n("wind.flow.reference_height_m");
       flow.roughness_length_m = n("wind.flow.roughness_length_m");

@@ -69,7 +69,7 @@ try {
     check(d.req.wind_speeds_m_s.count === 40 && d.req.tether_lengths_m.count === 50 && d.req.ceiling_m === 2500 && d.req.payout_rate_m_s === 5,
       "the panel's defaults: 40 winds × 50 lengths, ceiling 2500 m, payout 5 m/s");
     check(d.req.cable.preset === "dyneema" && d.req.cable.mass_per_length_kg_m === undefined && d.req.aerostat.net_buoyancy_n === 2000 && d.req.aerostat.mass_kg === 100 &&
-      d.req.wind.shape?.kind === "log_law", `the card's system in the request (${JSON.stringify({ cable: d.req.cable, aerostat: d.req.aerostat })})`);
+      d.req.wind.flow?.kind === "log_law", `the card's system in the request (${JSON.stringify({ cable: d.req.cable, aerostat: d.req.aerostat })})`);
     check(d.res.points.length === 2000, `${d.res.points.length} points`);
     // Outline: every segment separates a feasible cell from an infeasible one (or the edge), and every such boundary is drawn.
     const nl = d.res.tether_lengths_m.length;
@@ -107,8 +107,8 @@ try {
     const csvPath = path.join(artifacts, "envelope_page.csv");
     await download.saveAs(csvPath);
     const all = readFileSync(csvPath, "utf8").trim().split("\n");
-    const need = ["# input cable.preset,dyneema", "# input cable.diameter_m,0.006", "# input aerostat.net_buoyancy_n,2000", "# input wind.shape.kind,log_law",
-      "# input wind.shape.roughness_length_m,0.03", "# input wind_speeds_m_s.count,40", "# input tether_lengths_m.max,3000", "# input ceiling_m,2500", "# input payout_rate_m_s,5",
+    const need = ["# input cable.preset,dyneema", "# input cable.diameter_m,0.006", "# input aerostat.net_buoyancy_n,2000", "# input wind.flow.kind,log_law",
+      "# input wind.flow.roughness_length_m,0.03", "# input wind_speeds_m_s.count,40", "# input tether_lengths_m.max,3000", "# input ceiling_m,2500", "# input payout_rate_m_s,5",
       "# input required_safety_factor_nondim,5"];
     const missing = need.filter((l) => !all.includes(l));
     check(missing.length === 0, `CSV records every input (${missing.join("; ") || "all present"})`);
