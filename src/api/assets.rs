@@ -118,6 +118,9 @@ mod tests {
                 loaded += 1;
             }
         }
-        assert!(loaded >= 12, "index.html loads {loaded} scripts and stylesheets");
+        assert!(
+            loaded >= 12,
+            "index.html loads {loaded} scripts and stylesheets"
+        );
     }
 }
