@@ -5,20 +5,21 @@
 "use strict";
 
 (function () {
-  const { clearFieldError, fieldMessage, showFormError, unwrapJobError, api } = window.tetherplanCommon;
+  const S = window.tetherplanShared;
   // Charts with more work than this (points × elements; 5000 points at 50 elements)
   // run as a background job with progress; so does any chart the direct route
   // refuses as too large (422 `too_large`) or while the server is busy (503).
   const JOB_WORK_THRESHOLD = 250_000;
   // The server's own limit for a direct chart (config.rs, max_sync_chart_points).
   const SYNC_POINT_LIMIT = 20_000;
-  const POLL_MS = 400;
   const COLORS = ["#0072b2", "#d55e00", "#009e73", "#cc79a7", "#e69f00", "#56b4e9", "#000000", "#999933"];
+  const SOURCE = "chart";
 
   const $ = (sel) => document.querySelector(sel);
   const chartForm = $("#chart-form");
   const safeForm = $("#safe-form");
   const statusEl = $("#status");
+  if (!chartForm) return;
 
   // Shared with the browser test and the console: the last request, answer and plots.
   const state = { request: null, chart: null, via: null, jobProgress: [], plots: { time: null, elevation: null, geTime: null, geElevation: null }, job: null, ge: null };
@@ -26,22 +27,9 @@
 
   // ---------- reading the form ----------
 
-  // Parses every input of `fields` ([data-field, kind]) into numbers; collects errors
-  // ({field, message}) for anything that is not a number, so they render like API errors.
-  function readNumber(field, errors, { integer = false } = {}) {
-    const input = document.querySelector(`[data-field="${field}"]`);
-    const text = input.value.trim();
-    const value = Number(text);
-    if (text === "" || !Number.isFinite(value)) {
-      errors.push({ field, message: text === "" ? "enter a number" : `“${text}” is not a number` });
-      return null;
-    }
-    if (integer && !Number.isInteger(value)) {
-      errors.push({ field, message: `must be a whole number, got ${text}` });
-      return null;
-    }
-    return value;
-  }
+  // The chart's inputs, then the system card's (the tether, the aerostat, gravity).
+  const roots = [chartForm, safeForm, document.getElementById("plan-form")];
+  const readNumber = (field, errors, opts) => S.readNumber(roots, field, errors, opts);
 
   function readBuoyancies(errors) {
     const input = $("#buoyancies");
@@ -62,28 +50,14 @@
     return values;
   }
 
-  // The system part common to every request (SystemInput in the API).
+  // The system of the card, in calm air, and the chart's mesh.
   function readSystem(errors) {
-    const cable = {};
-    if ($("#cable-mode").value === "density") {
-      cable.density_kg_m3 = readNumber("cable.density_kg_m3", errors);
-      cable.area_m2 = readNumber("cable.area_m2", errors);
-    } else {
-      cable.mass_per_length_kg_m = readNumber("cable.mass_per_length_kg_m", errors);
-    }
-    return {
-      cable,
-      aerostat: {
-        net_buoyancy_n: readNumber("aerostat.net_buoyancy_n", errors),
-        mass_kg: readNumber("aerostat.mass_kg", errors),
-      },
-      initial_length_m: readNumber("initial_length_m", errors),
-      gravity_m_s2: readNumber("gravity_m_s2", errors),
-      // No element count: the server converges every answer and gives the safe side of its error.
-      model: $("#elements").value.trim() === ""
-        ? { kind: "linear_string" }
-        : { kind: "linear_string", elements: readNumber("model.elements", errors, { integer: true }) },
-    };
+    const sys = S.readSystem(errors, "calm");
+    // No element count: the server converges every answer and gives the safe side of its error.
+    sys.model = $("#elements").value.trim() === ""
+      ? { kind: "linear_string" }
+      : { kind: "linear_string", elements: readNumber("model.elements", errors, { integer: true }) };
+    return sys;
   }
 
   function readChartRequest(errors) {
@@ -107,69 +81,14 @@
 
   // ---------- errors next to fields ----------
 
-  // The input an API field path names: exact match, else without a list index
-  // (`net_buoyancies_n[1]`), else the nearest named parent.
-  function inputFor(field) {
-    if (!field) return null;
-    let path = field.replace(/^\./, "");
-    while (path) {
-      const exact = document.querySelector(`[data-field="${CSS.escape(path)}"]`);
-      if (exact && !exact.closest("[hidden]")) return exact;
-      const unindexed = path.replace(/\[\d+\]$/, "");
-      if (unindexed !== path) {
-        path = unindexed;
-        continue;
-      }
-      const dot = path.lastIndexOf(".");
-      if (dot < 0) break;
-      path = path.slice(0, dot);
-      // A parent such as `cable` or `rates_m_s`: its first visible input.
-      const child = [...document.querySelectorAll(`[data-field^="${CSS.escape(path)}."]`)].find((el) => !el.closest("[hidden]"));
-      if (child) return child;
-    }
-    return null;
-  }
-
-  function clearErrors(form) {
-    for (const el of form.querySelectorAll(".field-error")) el.remove();
-    for (const el of form.querySelectorAll("[aria-invalid]")) {
-      el.removeAttribute("aria-invalid");
-      el.removeAttribute("aria-describedby");
-    }
-  }
-
-  // The API's message starts with the field path, which the label already says:
-  // keep the reason, and say which entry of a list is meant.
-
-  // Shows `message` under the input that `field` names; returns false when no input matches.
-  function showFieldError(field, message) {
-    const input = inputFor(field);
-    if (!input) return false;
-    clearFieldError(input);
-    const p = document.createElement("p");
-    p.className = "field-error";
-    p.id = `${input.id}-error`;
-    p.dataset.errorFor = field;
-    p.textContent = fieldMessage(field, message);
-    input.closest(".field").append(p);
-    input.setAttribute("aria-invalid", "true");
-    input.setAttribute("aria-describedby", p.id);
-    return true;
-  }
-
-  // Renders an API error body ({error: {code, field, message}}): next to its field
-  // when one is named and shown, else in `fallback`. Returns a one-line summary.
-  function renderApiError(status, body, fallback) {
-    const err = body && body.error ? body.error : { code: "http_" + status, field: null, message: `HTTP ${status}` };
-    const placed = showFieldError(err.field, err.message);
-    if (placed) {
-      showFormError(fallback, "");
-      inputFor(err.field).focus({ preventScroll: false });
-      return `Fix the highlighted field: ${err.message}`;
-    }
-    showFormError(fallback, err.message);
-    return err.message;
-  }
+  const inputFor = (field) => S.inputFor(roots, field);
+  const clearErrors = () => S.clearErrors(SOURCE);
+  const showFieldError = (field, message) => !!S.showFieldError(roots, field, message, SOURCE);
+  const renderApiError = (status, body, fallback) => {
+    const placed = S.inputFor(roots, body?.error?.field);
+    const text = S.renderApiError(roots, status, body, fallback, SOURCE);
+    return placed ? `Fix the highlighted field: ${text}` : text;
+  };
 
   // ---------- HTTP ----------
 
@@ -187,52 +106,11 @@
 
   // ---------- jobs ----------
 
-  const jobBox = $("#job");
-  const jobProgress = $("#job-progress");
-  const jobText = $("#job-text");
-  const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-
-  // A submission names fields inside its `request` (`request.rates_m_s.count`):
-  // drop that prefix so the error lands on the form's input.
-
   // Runs a chart as a background job, showing its progress; resolves to the chart
   // answer, or to {error} when the job fails, is cancelled, or cannot be submitted.
-  async function runChartJob(req, points = chartPoints(req)) {
-    const submitted = await api("POST", "/api/v1/jobs", { kind: "chart", request: req });
-    if (!submitted.ok) return { status: submitted.status, error: unwrapJobError(submitted.body) };
-    const id = submitted.body.id;
-    state.job = id;
-    state.jobProgress = [];
-    jobBox.hidden = false;
-    jobProgress.value = 0;
-    jobText.textContent = "queued";
-    try {
-      for (;;) {
-        const r = await api("GET", `/api/v1/jobs/${encodeURIComponent(id)}`);
-        if (!r.ok) return { status: r.status, error: r.body };
-        const job = r.body;
-        const progress = Number(job.progress) || 0;
-        jobProgress.value = progress;
-        state.jobProgress.push([job.status, progress]);
-        jobText.textContent = `${job.status} · ${(progress * 100).toFixed(0)} %`;
-        setStatus("busy", `Job ${id}: ${job.status}, ${(progress * 100).toFixed(0)} % of ${points} points`);
-        if (job.status === "done") return { chart: job.result, via: `job ${id}` };
-        if (job.status === "failed" || job.status === "cancelled") {
-          const body = job.error?.error ? job.error : { error: { code: job.status, field: null, message: `the job was ${job.status}` } };
-          return { status: 200, error: unwrapJobError(body) };
-        }
-        await sleep(POLL_MS);
-      }
-    } finally {
-      state.job = null;
-      jobBox.hidden = true;
-    }
-  }
-
-  $("#job-cancel").addEventListener("click", async () => {
-    if (state.job) await api("DELETE", `/api/v1/jobs/${encodeURIComponent(state.job)}`);
-  });
-
+  const jobRun = S.jobRunner("", { log: state.jobProgress, slot: state });
+  const runChartJob = (req, points = chartPoints(req)) =>
+    jobRun("chart", req, `${points} points`, setStatus).then((o) => (o.result ? { chart: o.result, via: o.via } : o));
   // ---------- plotting ----------
 
   function closedFormTime(p, initialLength) {
@@ -240,13 +118,10 @@
     return t > 0 ? t : 0;
   }
 
-  function fmt(v, digits) {
-    if (v == null || !Number.isFinite(v)) return "–";
-    return Math.abs(v) >= 1e5 ? v.toExponential(3) : v.toFixed(digits);
-  }
+  const fmt = S.fixed;
 
   // Legend values: blank until the cursor is on the plot (not a row of "–").
-  const legendValue = (digits) => (u, v) => (v == null ? "" : fmt(v, digits));
+  const legendValue = S.legendValue;
   const curves = (n) => `${n} curve${n === 1 ? "" : "s"}`;
 
   // uPlot data and series for one quantity: x = rates, then per buoyancy the model
@@ -272,37 +147,9 @@
     return { data, series, unit, sym, log };
   }
 
-  function plotSize(el) {
-    const width = Math.max(260, Math.floor(el.clientWidth));
-    return { width, height: Math.round(Math.min(380, Math.max(240, width * 0.6))) };
-  }
-
-  // On a log axis, grid lines and ticks at the decades only (uPlot draws 1..9 × 10^k).
-  const decadesOnly = (u, splits) =>
-    splits.map((v) => (v != null && Math.abs(Math.log10(v) - Math.round(Math.log10(v))) < 1e-9 ? v : null));
-
-  function makePlot(el, spec, yLabel) {
-    el.textContent = "";
-    const axis = { stroke: "#333", grid: { stroke: "#e5e5e5" }, ticks: { stroke: "#ccc" } };
-    const yAxis = spec.log
-      ? { ...axis, grid: { ...axis.grid, filter: decadesOnly }, ticks: { ...axis.ticks, filter: decadesOnly }, filter: decadesOnly }
-      : axis;
-    return new uPlot(
-      {
-        ...plotSize(el),
-        series: spec.series,
-        scales: { x: { time: false }, y: spec.log ? { distr: 3 } : {} },
-        axes: [
-          { ...axis, label: "Deployment rate v (m/s)" },
-          { ...yAxis, label: yLabel, size: 60 },
-        ],
-        legend: { live: true, markers: { dash: (u, i) => (u.series[i].dash ? "dashed" : "solid"), fill: () => "transparent" } },
-        cursor: { drag: { x: true, y: false } },
-      },
-      spec.data,
-      el,
-    );
-  }
+  const plotSize = (el) => S.plotSize(el);
+  const makePlot = (el, spec, yLabel) =>
+    S.makePlot(el, { series: spec.series, data: spec.data, log: spec.log, xLabel: "Deployment rate v (m/s)", yLabel });
 
   function render(chart, req, via = state.via) {
     state.chart = chart;
@@ -375,7 +222,7 @@
     const err = body?.error;
     if (!err || typeof err.field !== "string") return body;
     const prefixed = `ge.${err.field}`;
-    return inputFor(prefixed) && inputFor(prefixed).dataset.field.startsWith("ge.") ? { error: { ...err, field: prefixed } } : body;
+    return inputFor(prefixed)?.name.startsWith("ge.") ? { error: { ...err, field: prefixed } } : body;
   }
 
   // One x axis for curves on different rate grids: the union of the rates,
@@ -497,8 +344,8 @@
   chartForm.addEventListener("submit", async (ev) => {
     ev.preventDefault();
     if (busy) return;
-    clearErrors(chartForm);
-    showFormError($("#form-error"), "");
+    clearErrors();
+    S.showFormError($("#form-error"), "");
     const errors = [];
     const req = readChartRequest(errors);
     if (errors.length) {
@@ -517,7 +364,7 @@
         outcome = await runChartJob(req);
       } else {
         setStatus("busy", `Computing ${n} points…`);
-        const r = await api("POST", "/api/v1/charts", req);
+        const r = await S.api("POST", "/api/v1/charts", req);
         // The direct route may refuse a chart as too large or the server as busy: use a job.
         if (!r.ok && (r.body?.error?.code === "too_large" || r.status === 503)) {
           setStatus("busy", "The server asked for a background job…");
@@ -556,23 +403,27 @@
     }
   });
 
+  // Other inputs than the chart's: dimmed until plotted again.
+  const stale = () => {
+    if (state.chart && statusEl.dataset.state === "ready") setStatus("stale", "Inputs changed: plot the chart again.");
+  };
   chartForm.addEventListener("input", (ev) => {
-    if (ev.target.matches("input")) clearFieldError(ev.target);
+    if (ev.target.matches("input")) S.clearFieldError(ev.target);
+    S.writeUrl();
+    stale();
     updateHint();
   });
-
-  $("#cable-mode").addEventListener("change", (ev) => {
-    for (const el of document.querySelectorAll("[data-cable]")) el.hidden = el.dataset.cable !== ev.target.value;
-    clearErrors(chartForm);
+  document.addEventListener("tetherplan:system-input", () => {
+    stale();
+    updateHint();
   });
 
   // ---------- safe rate ----------
 
   safeForm.addEventListener("submit", async (ev) => {
     ev.preventDefault();
-    clearErrors(safeForm);
-    clearErrors(chartForm);
-    showFormError($("#safe-error"), "");
+    clearErrors();
+    S.showFormError($("#safe-error"), "");
     const out = $("#safe-result");
     out.hidden = true;
     const errors = [];
@@ -580,15 +431,15 @@
     req.target_elevation_m = readNumber("target_elevation_m", errors);
     if (errors.length) {
       for (const e of errors) showFieldError(e.field, e.message);
-      showFormError($("#safe-error"), "Fix the highlighted fields.");
+      S.showFormError($("#safe-error"), "Fix the highlighted fields.");
       return;
     }
     $("#safe-button").disabled = true;
     try {
-      const r = await api("POST", "/api/v1/safe-rate", req);
+      const r = await S.api("POST", "/api/v1/safe-rate", req);
       if (!r.ok) {
         const msg = renderApiError(r.status, r.body, $("#safe-error"));
-        if (!$("#safe-error").textContent) showFormError($("#safe-error"), msg);
+        if (!$("#safe-error").textContent) S.showFormError($("#safe-error"), msg);
         return;
       }
       const a = r.body;
@@ -620,35 +471,11 @@
     }
   });
 
-  safeForm.addEventListener("input", (ev) => {
-    if (ev.target.matches("input")) clearFieldError(ev.target);
-  });
+
 
   // ---------- downloads ----------
 
-  function download(blob, name) {
-    const url = URL.createObjectURL(blob);
-    const a = document.createElement("a");
-    a.href = url;
-    a.download = name;
-    document.body.append(a);
-    a.click();
-    a.remove();
-    setTimeout(() => URL.revokeObjectURL(url), 1000);
-  }
-
-  // Every input of the request as `# input <path>,<value>` lines.
-  function inputLines(obj, prefix = "", out = []) {
-    for (const [k, v] of Object.entries(obj ?? {})) {
-      const key = prefix ? `${prefix}.${k}` : k;
-      if (v && typeof v === "object" && !Array.isArray(v)) inputLines(v, key, out);
-      else out.push(`# input ${key},${Array.isArray(v) ? v.join(" ") : v}`);
-    }
-    return out;
-  }
-
-  // Six significant digits: what the model resolves, not 16-digit floats.
-  const sig = (v) => (typeof v === "number" && Number.isFinite(v) ? Number(v.toPrecision(6)) : v);
+  const { download, inputLines, sig } = S;
 
   function chartCsv(chart, request) {
     const lines = ["# tetherplan deployment chart", ...inputLines(request), `# elements,${chart.elements}`,
@@ -665,24 +492,7 @@
     if (state.chart) download(new Blob([chartCsv(state.chart, state.request)], { type: "text/csv" }), "deployment-chart.csv");
   });
 
-  // Splits `text` into lines no wider than `max` pixels in the context's font.
-  function wrap(ctx, text, max) {
-    const rows = [];
-    let row = "";
-    for (const word of text.split(" ")) {
-      const next = row ? `${row} ${word}` : word;
-      if (row && ctx.measureText(next).width > max) {
-        rows.push(row);
-        row = word;
-      } else {
-        row = next;
-      }
-    }
-    if (row) rows.push(row);
-    return rows;
-  }
-
-  // Both plots on one white canvas, each with its caption and a drawn legend.
+  // Both plots on one white canvas, each with its caption and a drawn legend, the inputs below.
   function chartPng(
     blocks = [
       [state.plots.time, `Critical time t* (s) against deployment rate v (m/s)${$("#log-time").checked ? ", log scale" : ""}`],
@@ -690,60 +500,7 @@
     ],
     footer = `Inputs: ${inputLines(state.request).map((l) => l.replace("# input ", "").replace(",", " = ")).join("; ")}.`,
   ) {
-    const ratio = window.devicePixelRatio || 1;
-    const pad = 12 * ratio;
-    const line = 18 * ratio;
-    const width = Math.max(...blocks.map(([u]) => u.ctx.canvas.width)) + 2 * pad;
-    const legendRows = (u) => u.series.length - 1;
-    const canvas = document.createElement("canvas");
-    const ctx = canvas.getContext("2d");
-    ctx.font = `${11 * ratio}px sans-serif`;
-    const footerRows = footer ? wrap(ctx, footer, width - 2 * pad) : [];
-    ctx.font = `bold ${13 * ratio}px sans-serif`;
-    const captionRows = (c) => wrap(ctx, c, width - 2 * pad).length;
-    const height = blocks.reduce((h, [u, c]) => h + line * (captionRows(c) + 0.5) + u.ctx.canvas.height + legendRows(u) * line + pad, pad) +
-      footerRows.length * 15 * ratio + pad;
-    canvas.width = width;
-    canvas.height = height;
-    ctx.fillStyle = "#fff";
-    ctx.fillRect(0, 0, width, height);
-    let y = pad;
-    for (const [u, caption] of blocks) {
-      ctx.fillStyle = "#111";
-      ctx.font = `bold ${13 * ratio}px sans-serif`;
-      ctx.textBaseline = "top";
-      for (const row of wrap(ctx, caption, width - 2 * pad)) {
-        ctx.fillText(row, pad, y);
-        y += line;
-      }
-      y += line * 0.5;
-      ctx.drawImage(u.ctx.canvas, pad, y);
-      y += u.ctx.canvas.height;
-      ctx.font = `${12 * ratio}px sans-serif`;
-      ctx.textBaseline = "middle";
-      for (const s of u.series.slice(1)) {
-        ctx.strokeStyle = s.color || "#000";
-        ctx.lineWidth = 2 * ratio;
-        ctx.setLineDash(s.dash ? s.dash.map((d) => d * ratio) : []);
-        ctx.beginPath();
-        ctx.moveTo(pad, y + line / 2);
-        ctx.lineTo(pad + 28 * ratio, y + line / 2);
-        ctx.stroke();
-        ctx.setLineDash([]);
-        ctx.fillStyle = "#111";
-        ctx.fillText(s.label, pad + 36 * ratio, y + line / 2);
-        y += line;
-      }
-      y += pad;
-    }
-    ctx.fillStyle = "#333";
-    ctx.font = `${11 * ratio}px sans-serif`;
-    ctx.textBaseline = "top";
-    for (const row of footerRows) {
-      ctx.fillText(row, pad, y);
-      y += 15 * ratio;
-    }
-    return canvas;
+    return S.plotsPng(blocks, footer);
   }
 
   $("#download-png").addEventListener("click", () => {

@@ -1,33 +1,33 @@
-// Uncertainty bands panel (issue 14): a self-contained <section> that posts
-// POST /api/v1/bands and shades the 5–95 % band of h* and t* around the
-// median and the nominal chart, with CSV export of the percentiles, their
-// sampling errors and the uncertainty inputs. Needs uPlot and common.js.
+// Uncertainty bands panel (issue 14): a <section> that posts POST
+// /api/v1/bands with the system card's tether and aerostat (in calm air) and
+// the plan's target altitude, and shades the 5–95 % band of h* and t* around
+// the median and the nominal chart, with CSV export of the percentiles, their
+// sampling errors and the uncertainty inputs. Needs uPlot and shared/.
 "use strict";
 
 (function () {
-  const { api, showFormError } = window.tetherplanCommon;
+  const S = window.tetherplanShared;
+  const SOURCE = "bands";
+  // [id, label, default, name (the request path; the σ are not one)]
   const fields = [
-    ["bands-lift", "Net buoyancy F (N)", "1000"],
-    ["bands-lift-sd", "σ of F (N)", "50"],
-    ["bands-rhoa", "Mass per length ρA (kg/m)", "0.078"],
-    ["bands-rhoa-sd", "σ of ρA (kg/m)", "0.002"],
-    ["bands-mass", "Aerostat mass m (kg)", "10"],
-    ["bands-min", "Smallest rate (m/s)", "5"],
-    ["bands-max", "Largest rate (m/s)", "60"],
-    ["bands-count", "Rates", "24"],
-    ["bands-samples", "Samples", "500"],
-    ["bands-seed", "Seed", "1"],
-    ["bands-target", "Target elevation (m)", "1200"],
+    ["bands-lift-sd", "Spread σ of the net buoyancy (N)", "50", "uncertainty.net_buoyancy_sd_n"],
+    ["bands-rhoa-sd", "Spread σ of the mass per length (kg/m)", "0.002", "uncertainty.mass_per_length_sd_kg_m"],
+    ["bands-min", "Smallest rate (m/s)", "5", "rates_m_s.min"],
+    ["bands-max", "Largest rate (m/s)", "60", "rates_m_s.max"],
+    ["bands-count", "Rates (count)", "24", "rates_m_s.count"],
+    ["bands-samples", "Samples", "500", "uncertainty.samples"],
+    ["bands-seed", "Seed", "1", "uncertainty.seed"],
   ];
   const section = document.createElement("section");
   section.id = "bands";
   section.innerHTML = `
     <h2>Uncertainty bands</h2>
-    <p class="hint">Monte Carlo over a normal net buoyancy and mass per length: 5–95 % band of h* and t*
-      (converged chart points), median and nominal curves, and the probability that the target is unsafe.</p>
-    <form id="bands-form" novalidate>
-      ${fields.map(([id, label, value]) => `<div class="field"><label for="${id}">${label}</label>
-        <input id="${id}" inputmode="decimal" value="${value}"></div>`).join("")}
+    <p class="hint">Monte Carlo over a normal net buoyancy and mass per length about the system card's values, in calm air:
+      5–95 % band of h* and t* (converged chart points), median and nominal curves, and the probability that the plan's
+      target altitude is unsafe.</p>
+    <form id="bands-form" novalidate data-url-prefix="bands.">
+      ${fields.map(([id, label, value, name]) => `<div class="field"><label for="${id}">${label}</label>
+        <input id="${id}" name="${name}" inputmode="decimal" value="${value}"></div>`).join("")}
       <div class="actions">
         <button type="submit" id="bands-button">Compute bands</button>
         <button type="button" id="bands-csv" class="secondary" disabled>Download CSV</button>
@@ -46,21 +46,28 @@
   const plots = {};
   let last = null;
 
-  function request() {
+  const roots = () => [document.getElementById("bands-form"), document.getElementById("plan-form")];
+
+  function request(errors) {
+    const sys = S.readSystem(errors, "calm");
+    const inputs = [{ field: "aerostat.net_buoyancy_n", distribution: "normal", mean: sys.aerostat.net_buoyancy_n, std_dev: num("bands-lift-sd") }];
+    if (sys.cable.mass_per_length_kg_m != null) {
+      inputs.push({ field: "cable.mass_per_length_kg_m", distribution: "normal", mean: sys.cable.mass_per_length_kg_m, std_dev: num("bands-rhoa-sd") });
+    }
     return {
-      cable: { mass_per_length_kg_m: num("bands-rhoa") },
-      aerostat: { net_buoyancy_n: num("bands-lift"), mass_kg: num("bands-mass") },
+      ...sys,
       rates_m_s: { min: num("bands-min"), max: num("bands-max"), count: num("bands-count") },
-      target_elevation_m: num("bands-target"),
-      uncertainty: {
-        samples: num("bands-samples"),
-        seed: num("bands-seed"),
-        inputs: [
-          { field: "aerostat.net_buoyancy_n", distribution: "normal", mean: num("bands-lift"), std_dev: num("bands-lift-sd") },
-          { field: "cable.mass_per_length_kg_m", distribution: "normal", mean: num("bands-rhoa"), std_dev: num("bands-rhoa-sd") },
-        ],
-      },
+      target_elevation_m: S.readNumber(roots(), "target_elevation_m", errors),
+      uncertainty: { samples: num("bands-samples"), seed: num("bands-seed"), inputs },
     };
+  }
+
+  // The API names the distributions by index: uncertainty.inputs[0] is the
+  // buoyancy's spread, inputs[1] the mass per length's.
+  function fieldOf(err) {
+    const m = /^uncertainty\.inputs\[(\d)\]/.exec(err?.field ?? "");
+    if (m) return m[1] === "0" ? "uncertainty.net_buoyancy_sd_n" : "uncertainty.mass_per_length_sd_kg_m";
+    return err?.field;
   }
 
   function plot(el, key, label, resp) {
@@ -109,13 +116,24 @@
 
   $("bands-form").addEventListener("submit", async (ev) => {
     ev.preventDefault();
-    showFormError($("bands-error"), "");
+    S.clearErrors(SOURCE);
+    S.showFormError($("bands-error"), "");
+    S.writeUrl();
+    const errors = [];
+    const req = request(errors);
+    if (errors.length) {
+      S.showInputErrors(roots(), errors, SOURCE);
+      S.showFormError($("bands-error"), "Fix the highlighted fields.");
+      return;
+    }
     $("bands-button").disabled = true;
-    const res = await api("POST", "/api/v1/bands", request());
+    const res = await S.api("POST", "/api/v1/bands", req);
     $("bands-button").disabled = false;
     if (!res.ok) {
       const e = res.body?.error;
-      showFormError($("bands-error"), e ? e.message : `HTTP ${res.status}`);
+      const body = e ? { error: { ...e, field: fieldOf(e) } } : res.body;
+      const text = S.renderApiError(roots(), res.status, body, null, SOURCE);
+      S.showFormError($("bands-error"), text);
       return;
     }
     last = res.body;

@@ -10,14 +10,14 @@
 "use strict";
 
 (function () {
-  const { api, clearFieldError, fieldMessage, showFormError, unwrapJobError } = window.tetherplanCommon;
+  const S = window.tetherplanShared;
   const form = document.getElementById("envelope-form");
   if (!form) return;
   const $ = (id) => document.getElementById(id);
+  const SOURCE = "envelope";
   // The server answers at most this many points directly
   // (contract::envelope::MAX_SYNC_ENVELOPE_POINTS); more run as a job.
   const SYNC_POINTS = 5000;
-  const POLL_MS = 300;
 
   // Shared with the browser test and the console.
   const state = { request: null, result: null, via: null, jobProgress: [], job: null, regions: [], outline: [], layout: null };
@@ -25,59 +25,17 @@
 
   // ---------- reading the form ----------
 
-  const byField = (f) => form.querySelector(`[data-env-field="${f}"]`);
-  const visible = (el) => el && !el.closest("[hidden]");
-
-  // A number from the input of API path `field`; blank is `undefined` when optional.
-  function num(field, errors, { integer = false, optional = false } = {}) {
-    const el = byField(field);
-    const text = el.value.trim();
-    if (text === "" && optional) return undefined;
-    const value = Number(text);
-    if (text === "" || !Number.isFinite(value)) {
-      errors.push({ field, message: text === "" ? "enter a number" : `“${text}” is not a number` });
-      return null;
-    }
-    if (integer && !Number.isInteger(value)) {
-      errors.push({ field, message: `must be a whole number, got ${text}` });
-      return null;
-    }
-    return value;
-  }
-
-  // Leaves out keys whose value is undefined (optional fields left blank).
-  function compact(obj) {
-    return Object.fromEntries(Object.entries(obj).filter(([, v]) => v !== undefined));
-  }
+  // The envelope's own inputs first, then the system card's (errors land there).
+  const roots = [form, document.getElementById("plan-form")];
+  const num = (name, errors, opts) => S.readNumber(form, name, errors, opts);
 
   function readRequest(errors) {
-    const preset = $("env-cable-preset").value;
-    const cable = compact({
-      preset: preset === "custom" ? undefined : preset,
-      diameter_m: num("cable.diameter_m", errors),
-      mass_per_length_kg_m: num("cable.mass_per_length_kg_m", errors, { optional: preset !== "custom" }),
-      breaking_strength_n: num("cable.breaking_strength_n", errors, { optional: true }),
-      axial_stiffness_n: num("cable.axial_stiffness_n", errors, { optional: true }),
-      normal_drag_coefficient_nondim: num("cable.normal_drag_coefficient_nondim", errors, { optional: true }),
-    });
-    const aerostat = {
-      net_buoyancy_n: num("aerostat.net_buoyancy_n", errors),
-      mass_kg: num("aerostat.mass_kg", errors),
-      drag_coefficient_nondim: num("aerostat.drag_coefficient_nondim", errors),
-      reference_area_m2: num("aerostat.reference_area_m2", errors),
-      lift_coefficient_nondim: num("aerostat.lift_coefficient_nondim", errors),
-    };
-    const kind = $("env-wind-shape").value;
-    let shape = { kind: "uniform" };
-    if (kind === "power_law") {
-      shape = { kind, exponent_nondim: num("wind.shape.exponent_nondim", errors), reference_height_m: num("wind.shape.reference_height_m", errors) };
-    } else if (kind === "log_law") {
-      shape = { kind, roughness_length_m: num("wind.shape.roughness_length_m", errors), reference_height_m: num("wind.shape.reference_height_m", errors) };
-    }
-    return compact({
-      cable,
-      aerostat,
-      wind: { shape, air_density_kg_m3: num("wind.air_density_kg_m3", errors) },
+    const sys = S.readSystem(errors, "wind");
+    return S.compact({
+      cable: sys.cable,
+      aerostat: sys.aerostat,
+      // Today's wind: its profile scaled to each grid speed (the speed at the reference height).
+      wind: sys.wind,
       wind_speeds_m_s: {
         min: num("wind_speeds_m_s.min", errors),
         max: num("wind_speeds_m_s.max", errors),
@@ -88,8 +46,8 @@
         max: num("tether_lengths_m.max", errors),
         count: num("tether_lengths_m.count", errors, { integer: true }),
       },
-      gravity_m_s2: num("gravity_m_s2", errors),
-      required_safety_factor_nondim: num("required_safety_factor_nondim", errors),
+      gravity_m_s2: sys.gravity_m_s2,
+      required_safety_factor_nondim: sys.required_safety_factor_nondim,
       ceiling_m: num("ceiling_m", errors, { optional: true }),
       payout_rate_m_s: num("payout_rate_m_s", errors, { optional: true }),
     });
@@ -98,125 +56,12 @@
   const points = (req) => (req.wind_speeds_m_s.count || 0) * (req.tether_lengths_m.count || 0);
   const wantsJob = (req) => points(req) > SYNC_POINTS;
 
-  // ---------- errors next to fields ----------
-
-  // The input an API path names: exact, else the first visible one under its parent.
-  function inputFor(field) {
-    if (!field) return null;
-    let path = field.replace(/^\./, "").replace(/\[\d+\]/g, "");
-    while (path) {
-      const exact = byField(path);
-      if (visible(exact)) return exact;
-      const dot = path.lastIndexOf(".");
-      if (dot < 0) break;
-      path = path.slice(0, dot);
-      const child = [...form.querySelectorAll(`[data-env-field^="${CSS.escape(path + ".")}"]`)].find(visible);
-      if (child) return child;
-    }
-    return null;
-  }
-
-  function clearErrors() {
-    for (const el of form.querySelectorAll("[data-env-field]")) clearFieldError(el);
-    showFormError($("env-error"), "");
-  }
-
-  function showFieldError(field, message) {
-    const input = inputFor(field);
-    if (!input) return null;
-    clearFieldError(input);
-    const p = document.createElement("p");
-    p.className = "field-error";
-    p.id = `${input.id}-error`;
-    p.dataset.errorFor = field;
-    p.textContent = fieldMessage(field, message);
-    input.closest(".field").append(p);
-    input.setAttribute("aria-invalid", "true");
-    input.setAttribute("aria-describedby", p.id);
-    return input;
-  }
-
-  function renderApiError(status, body) {
-    const err = body && body.error ? body.error : { code: `http_${status}`, field: null, message: `HTTP ${status}` };
-    const input = showFieldError(err.field, err.message);
-    if (input) {
-      input.focus({ preventScroll: false });
-      return `Fix the highlighted field: ${err.message}`;
-    }
-    showFormError($("env-error"), err.message);
-    return err.message;
-  }
-
   // ---------- status and jobs ----------
 
-  const statusEl = $("env-status");
-  function setStatus(kind, text) {
-    if (kind === "ready") delete $("env-results").dataset.stale;
-    else $("env-results").dataset.stale = "";
-    statusEl.dataset.state = kind;
-    statusEl.textContent = text;
-  }
-
-  const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-
-  async function runJob(req) {
-    const submitted = await api("POST", "/api/v1/jobs", { kind: "envelope", request: req });
-    if (!submitted.ok) return { status: submitted.status, error: unwrapJobError(submitted.body) };
-    const id = submitted.body.id;
-    state.job = id;
-    state.jobProgress = [];
-    const box = $("env-job");
-    const bar = $("env-job-progress");
-    const text = $("env-job-text");
-    box.hidden = false;
-    bar.value = 0;
-    text.textContent = "queued";
-    try {
-      for (;;) {
-        const r = await api("GET", `/api/v1/jobs/${encodeURIComponent(id)}`);
-        if (!r.ok) return { status: r.status, error: r.body };
-        const job = r.body;
-        const progress = Number(job.progress) || 0;
-        bar.value = progress;
-        state.jobProgress.push([job.status, progress]);
-        text.textContent = `${job.status} · ${(progress * 100).toFixed(0)} %`;
-        setStatus("busy", `Job ${id}: ${job.status}, ${(progress * 100).toFixed(0)} % of ${points(req)} points`);
-        if (job.status === "done") return { result: job.result, via: `job ${id}` };
-        if (job.status === "failed" || job.status === "cancelled") {
-          const body = job.error?.error ? job.error : { error: { code: job.status, field: null, message: `the job was ${job.status}` } };
-          return { status: 200, error: unwrapJobError(body) };
-        }
-        await sleep(POLL_MS);
-      }
-    } finally {
-      state.job = null;
-      box.hidden = true;
-    }
-  }
-
-  $("env-job-cancel").addEventListener("click", async () => {
-    if (state.job) await api("DELETE", `/api/v1/jobs/${encodeURIComponent(state.job)}`);
-  });
-
-  // ---------- numbers ----------
-
-  function fmt(v, digits = 3) {
-    if (v == null || !Number.isFinite(v)) return "–";
-    const a = Math.abs(v);
-    if (a !== 0 && (a >= 1e6 || a < 1e-3)) return v.toExponential(digits - 1);
-    return Number(v.toPrecision(digits)).toString();
-  }
-
-  // About `n` round tick values covering [lo, hi].
-  function ticks(lo, hi, n) {
-    if (!(hi > lo)) return [lo];
-    const raw = (hi - lo) / n;
-    const mag = 10 ** Math.floor(Math.log10(raw));
-    const step = [1, 2, 5, 10].map((m) => m * mag).find((s) => s >= raw) || 10 * mag;
-    const out = [];
-    for (let v = Math.ceil(lo / step - 1e-9) * step; v <= hi + step * 1e-9; v += step) out.push(Number(v.toPrecision(12)));
-    return out;
-  }
+  const setStatus = S.statusSetter($("env-status"), $("env-results"));
+  const runJob = S.jobRunner("env-", { log: state.jobProgress, slot: state });
+  const fmt = S.sig3;
+  const { ticks, colour } = S;
 
   // ---------- the heat map ----------
 
@@ -238,18 +83,6 @@
     ceiling: "above ceiling",
     not_converged: "not converged",
   };
-
-  // Viridis, sampled at 9 stops.
-  const VIRIDIS = [
-    [68, 1, 84], [71, 44, 122], [59, 81, 139], [44, 113, 142], [33, 144, 141],
-    [39, 173, 129], [92, 200, 99], [170, 220, 50], [253, 231, 37],
-  ];
-  function colour(s) {
-    const x = Math.min(1, Math.max(0, s)) * (VIRIDIS.length - 1);
-    const i = Math.min(VIRIDIS.length - 2, Math.floor(x));
-    const f = x - i;
-    return VIRIDIS[i].map((c, k) => Math.round(c + f * (VIRIDIS[i + 1][k] - c)));
-  }
 
   // The grid as [wind index][length index] cells.
   function grid(res) {
@@ -688,12 +521,13 @@
   let busy = false;
   async function run() {
     if (busy) return;
-    clearErrors();
+    S.clearErrors(SOURCE);
+    S.showFormError($("env-error"), "");
+    S.writeUrl();
     const errors = [];
     const req = readRequest(errors);
     if (errors.length) {
-      for (const e of errors) showFieldError(e.field, e.message);
-      inputFor(errors[0].field)?.focus();
+      S.showInputErrors(roots, errors, SOURCE);
       setStatus("error", "Fix the highlighted fields.");
       return;
     }
@@ -704,20 +538,23 @@
       const n = points(req);
       if (wantsJob(req)) {
         setStatus("busy", `Submitting a job for ${n} points…`);
-        outcome = await runJob(req);
+        outcome = await runJob("envelope", req, `${n} points`, setStatus);
       } else {
         setStatus("busy", `Computing ${n} points…`);
-        const r = await api("POST", "/api/v1/envelope", req);
-        if (!r.ok && (r.body?.error?.code === "too_large" || r.status === 503 || r.status === 504)) {
+        const r = await S.api("POST", "/api/v1/envelope", req);
+        if (S.needsJob(r)) {
           setStatus("busy", "The server asked for a background job…");
-          outcome = await runJob(req);
+          outcome = await runJob("envelope", req, `${n} points`, setStatus);
         } else {
           outcome = r.ok ? { result: r.body, via: "direct" } : { status: r.status, error: r.body };
         }
       }
       if (outcome.result) render(outcome.result, req, outcome.via);
       else if (outcome.error?.error?.code === "cancelled") setStatus("idle", "Job cancelled.");
-      else setStatus("error", renderApiError(outcome.status, outcome.error));
+      else {
+        const text = S.renderApiError(roots, outcome.status, outcome.error, $("env-error"), SOURCE);
+        setStatus("error", `Fix the highlighted field: ${text}`);
+      }
     } finally {
       busy = false;
       $("env-button").disabled = false;
@@ -736,30 +573,23 @@
     $("env-hint").textContent = n == null ? "" : `${n} point${n === 1 ? "" : "s"}${wantsJob(req) ? " · runs as a background job" : ""}`;
   }
 
+  // An answer for other inputs is no answer: dimmed and marked until computed again.
+  function stale() {
+    if (state.result && $("env-status").dataset.state === "ready") setStatus("stale", "Inputs changed: compute the envelope again.");
+    $("env-csv").disabled = true;
+    $("env-png").disabled = true;
+  }
   form.addEventListener("input", (ev) => {
-    if (ev.target.matches("input")) clearFieldError(ev.target);
+    if (ev.target.matches("input")) S.clearFieldError(ev.target);
+    S.writeUrl();
+    stale();
+    updateHint();
+  });
+  document.addEventListener("tetherplan:system-input", () => {
+    stale();
     updateHint();
   });
 
-  // Shape and preset switches show the fields that apply.
-  function toggleShape() {
-    const kind = $("env-wind-shape").value;
-    for (const el of form.querySelectorAll("[data-env-shape]")) el.hidden = !el.dataset.envShape.split(" ").includes(kind);
-  }
-  $("env-wind-shape").addEventListener("change", () => {
-    toggleShape();
-    updateHint();
-  });
-  function togglePreset() {
-    const custom = $("env-cable-preset").value === "custom";
-    const rho = byField("cable.mass_per_length_kg_m");
-    rho.placeholder = custom ? "" : "from the preset";
-    $("env-rho-label").textContent = custom ? "Mass per length ρA (kg/m)" : "Mass per length ρA (kg/m, blank: preset)";
-  }
-  $("env-cable-preset").addEventListener("change", () => {
-    togglePreset();
-    clearErrors();
-  });
   $("env-quantity").addEventListener("change", () => {
     $("env-log").checked = $("env-quantity").value === "safety_factor";
     if (state.result) draw();
@@ -770,29 +600,7 @@
 
   // ---------- downloads ----------
 
-  function download(blob, name) {
-    const url = URL.createObjectURL(blob);
-    const a = document.createElement("a");
-    a.href = url;
-    a.download = name;
-    document.body.append(a);
-    a.click();
-    a.remove();
-    setTimeout(() => URL.revokeObjectURL(url), 1000);
-  }
-
-  // Every input as [path, value], flattened.
-  function flatten(obj, prefix = "", out = []) {
-    for (const [k, v] of Object.entries(obj ?? {})) {
-      const key = prefix ? `${prefix}.${k}` : k;
-      if (v && typeof v === "object" && !Array.isArray(v)) flatten(v, key, out);
-      else out.push([key, Array.isArray(v) ? v.join(" ") : v]);
-    }
-    return out;
-  }
-
-  // Six significant digits: what the model resolves, not 16-digit floats.
-  const sig = (v) => (typeof v === "number" && Number.isFinite(v) ? String(Number(v.toPrecision(6))) : v == null ? "" : String(v));
+  const { download, flatten, sig, wrap } = S;
 
   const CSV_COLUMNS = ["wind_speed_m_s", "tether_length_m", "aerostat_altitude_m", "aerostat_downwind_m", "blowdown_angle_deg", "winch_tension_n",
     "top_tension_n", "max_tension_n", "min_tension_n", "safety_factor_nondim", "slack", "stability_margin_n", "stable", "feasible", "binding_limit"];
@@ -819,21 +627,6 @@
   $("env-csv").addEventListener("click", () => {
     if (state.result) download(new Blob([csv(state.result, state.request)], { type: "text/csv" }), "tetherplan-envelope.csv");
   });
-
-  // Splits `text` into lines no wider than `max` pixels in the context's font.
-  function wrap(ctx, text, max) {
-    const rows = [];
-    let row = "";
-    for (const word of text.split(" ")) {
-      const next = row ? `${row} ${word}` : word;
-      if (row && ctx.measureText(next).width > max) {
-        rows.push(row);
-        row = word;
-      } else row = next;
-    }
-    if (row) rows.push(row);
-    return rows;
-  }
 
   // The map at a fixed size, its caption, the outline's legend and every input, on one white canvas.
   function png() {
@@ -890,7 +683,7 @@
     resizeTimer = setTimeout(() => state.result && draw(), 100);
   });
 
-  toggleShape();
-  togglePreset();
   updateHint();
+  // A shared link with envelope inputs computes it at once.
+  if (new URLSearchParams(window.location.search).toString().includes("envelope.")) run();
 })();

@@ -1,199 +1,269 @@
-// The deployment plan (SPEC §7): the first section of the page. Reads the
-// plan form, keeps its inputs in the URL (?plan.<field>=…, shareable), posts
-// /api/v1/plan, and shows the go/no-go, the schedule plotted (length, rate,
-// tension, margin against time), the operator's table, the margins, a print
-// layout and CSV/JSON export with every input recorded. Self-contained: only
-// window.tetherplanCommon and uPlot are shared with the other scripts.
+// The verdict, the system card and today's plan (SPEC §7, §9): the first
+// screen of the page. Reads the card and the plan form (inputs named by their
+// request path, kept in the URL: a shared link plans at once), posts
+// /api/v1/plan in today's wind, and shows the verdict card (#verdict,
+// data-state go | no-go | stale | pending | error; aria-live), the tether
+// length the altitude needs, the blow-down angle, the peak tension and the
+// safety factor, the haul-down deadline, the operator's table and the plots.
+// Any input event clears the verdict to "inputs changed: plan again" and
+// disables Print and the downloads until a plan is current again.
 "use strict";
 
 (function () {
-  const { api, clearFieldError, fieldMessage, showFormError } = window.tetherplanCommon;
+  const S = window.tetherplanShared;
   const form = document.getElementById("plan-form");
   if (!form) return;
   const $ = (id) => document.getElementById(id);
-  const status = $("plan-status");
+  const verdict = $("verdict");
   const errorBox = $("plan-error");
+  const SOURCE = "plan";
+  const roots = [form];
+  // The server's version (GET /healthz), printed and exported with the plan.
+  let version = "unknown";
 
-  // Presets of tether + aerostat (+ winch, target, reserve).
-  const PRESETS = {
-    thesis: { "cable.mass_per_length_kg_m": "0.078", "aerostat.net_buoyancy_n": "1000", "aerostat.mass_kg": "10",
-      initial_length_m: "1", target_elevation_m: "1200", "winch.max_rate_m_s": "40", "winch.max_acceleration_m_s2": "2",
-      lift_reserve_nondim: "0.05" },
-    heavy: { "cable.mass_per_length_kg_m": "0.25", "aerostat.net_buoyancy_n": "3000", "aerostat.mass_kg": "40",
-      initial_length_m: "5", target_elevation_m: "1000", "winch.max_rate_m_s": "8", "winch.max_acceleration_m_s2": "0.3",
-      lift_reserve_nondim: "0.1" },
-    tight: { "cable.mass_per_length_kg_m": "0.078", "aerostat.net_buoyancy_n": "1000", "aerostat.mass_kg": "10",
-      initial_length_m: "1", target_elevation_m: "1200", "winch.max_rate_m_s": "40", "winch.max_acceleration_m_s2": "2",
-      lift_reserve_nondim: "0.075" },
-  };
+  const state = { request: null, plan: null, bands: null, plots: {}, seq: 0, current: false };
+  window.tetherplanPlan = state;
 
-  // Uncertainty bands (issue 14): a fieldset added by this script. When
-  // checked, the plan goes to /api/v1/plan/bands and the tension and margin
-  // plots shade the 5–95 % band of the samples around the plan's traces.
-  const bandsBox = document.createElement("fieldset");
+  // ---------- the card's behaviour ----------
+
+  // A material preset fills what is left blank from the diameter.
+  function togglePreset() {
+    const preset = form.elements["cable.preset"].value;
+    const mass = form.elements["cable.mass_per_length_kg_m"];
+    const breaking = form.elements["cable.breaking_strength_n"];
+    mass.placeholder = preset ? "blank: from the material" : "";
+    breaking.placeholder = preset ? "blank: from the material" : "blank: not checked";
+  }
+  form.elements["cable.preset"].addEventListener("change", (ev) => {
+    // A chosen material: its mass and strength unless typed over.
+    if (!S.restoring && ev.target.value) {
+      form.elements["cable.mass_per_length_kg_m"].value = "";
+      form.elements["cable.breaking_strength_n"].value = "";
+    }
+    togglePreset();
+  });
+  // A named aerostat: its lift, mass and aerodynamics unless typed over.
+  const AEROSTAT = ["aerostat.net_buoyancy_n", "aerostat.mass_kg", "aerostat.drag_coefficient_nondim", "aerostat.reference_area_m2", "aerostat.lift_coefficient_nondim"];
+  function toggleAerostat() {
+    const preset = form.elements["aerostat.preset"].value;
+    for (const name of AEROSTAT) form.elements[name].placeholder = preset ? "blank: from the aerostat" : "";
+  }
+  form.elements["aerostat.preset"].addEventListener("change", (ev) => {
+    if (!S.restoring && ev.target.value) for (const name of AEROSTAT) form.elements[name].value = "";
+    toggleAerostat();
+  });
+  function toggleWind() {
+    const kind = form.elements["wind.flow.kind"].value;
+    for (const el of form.querySelectorAll("[data-wind-kind]")) el.hidden = el.dataset.windKind !== kind;
+  }
+  form.elements["wind.flow.kind"].addEventListener("change", toggleWind);
+
+  // Uncertainty bands of the plan (issue 14), folded away: /api/v1/plan/bands
+  // shades the 5–95 % band of the tension and the margin.
+  const bandsBox = document.createElement("details");
   bandsBox.id = "plan-bands";
-  bandsBox.innerHTML = `<legend>Uncertainty (5–95 % bands, optional)</legend>
+  bandsBox.className = "more";
+  bandsBox.innerHTML = `<summary>Uncertainty: 5–95 % bands of the tension and margin (optional)</summary>
+    <fieldset>
     <div class="field"><label for="plan-bands-on"><input type="checkbox" id="plan-bands-on"> Shade the 5–95 % band</label></div>
-    <div class="field"><label for="plan-bands-lift-sd">σ of F (N)</label><input id="plan-bands-lift-sd" inputmode="decimal" value="50"></div>
-    <div class="field"><label for="plan-bands-rhoa-sd">σ of ρA (kg/m)</label><input id="plan-bands-rhoa-sd" inputmode="decimal" value="0.002"></div>
+    <div class="field"><label for="plan-bands-lift-sd">Spread of the lift (N)</label><input id="plan-bands-lift-sd" inputmode="decimal" value="50"></div>
+    <div class="field"><label for="plan-bands-rhoa-sd">Spread of the mass per length (kg/m)</label><input id="plan-bands-rhoa-sd" inputmode="decimal" value="0.002"></div>
     <div class="field"><label for="plan-bands-samples">Samples</label><input id="plan-bands-samples" inputmode="numeric" value="500"></div>
     <div class="field"><label for="plan-bands-seed">Seed</label><input id="plan-bands-seed" inputmode="numeric" value="1"></div>
+    </fieldset>
     <p id="plan-bands-summary" class="note" hidden></p>`;
-  form.insertBefore(bandsBox, form.querySelector(".actions"));
+  form.querySelector(".plan-inputs").append(bandsBox);
   const bandsOn = () => $("plan-bands-on").checked;
 
   function uncertainty(body) {
     const inputs = [];
     const liftSd = Number($("plan-bands-lift-sd").value);
     const rhoSd = Number($("plan-bands-rhoa-sd").value);
-    if (liftSd > 0) inputs.push({ field: "aerostat.net_buoyancy_n", distribution: "normal", mean: body.aerostat.net_buoyancy_n, std_dev: liftSd });
-    if (rhoSd > 0) inputs.push({ field: "cable.mass_per_length_kg_m", distribution: "normal", mean: body.cable.mass_per_length_kg_m, std_dev: rhoSd });
+    if (liftSd > 0 && body.aerostat.net_buoyancy_n != null) inputs.push({ field: "aerostat.net_buoyancy_n", distribution: "normal", mean: body.aerostat.net_buoyancy_n, std_dev: liftSd });
+    if (rhoSd > 0 && body.cable.mass_per_length_kg_m != null) {
+      inputs.push({ field: "cable.mass_per_length_kg_m", distribution: "normal", mean: body.cable.mass_per_length_kg_m, std_dev: rhoSd });
+    }
     return { samples: Number($("plan-bands-samples").value), seed: Number($("plan-bands-seed").value), inputs };
   }
 
-  const inputs = () => Array.from(form.querySelectorAll("[data-plan-field]"));
-  const byField = (f) => form.querySelector(`[data-plan-field="${f}"]`);
+  // ---------- the request ----------
 
-  // Optional jerk limit, placed after the winch acceleration (empty: none).
-  (function addJerkField() {
-    const acc = byField("winch.max_acceleration_m_s2");
-    if (!acc || byField("winch.max_jerk_m_s3")) return;
-    const field = document.createElement("div");
-    field.className = "field";
-    const label = document.createElement("label");
-    label.htmlFor = "plan-jerk";
-    label.textContent = "Winch max jerk (m/s³, optional)";
-    const input = document.createElement("input");
-    input.id = "plan-jerk";
-    input.dataset.planField = "winch.max_jerk_m_s3";
-    input.inputMode = "decimal";
-    input.placeholder = "none";
-    input.value = "";
-    field.append(label, input);
-    acc.closest(".field").after(field);
-  })();
-
-  function num(field) {
-    const el = byField(field);
-    const text = el.value.trim();
-    return text === "" ? null : Number(text);
+  // "0:5, 60:14" (minutes from now : m/s) → [{time_s, wind_speed_m_s}, …].
+  function parseForecast(text, errors) {
+    const out = [];
+    text.split(",").map((s) => s.trim()).filter(Boolean).forEach((pair, i) => {
+      const [t, u] = pair.split(":").map((x) => Number(x.trim()));
+      if (!Number.isFinite(t) || !Number.isFinite(u) || pair.split(":").length !== 2) {
+        errors.push({ field: `haul_down.forecast[${i}]`, message: `write minutes:m/s, like 60:9 (not “${pair}”)` });
+        return;
+      }
+      out.push({ time_s: 60 * t, wind_speed_m_s: u });
+    });
+    return out;
   }
 
-  // "0:5, 3600:15" → [{time_s, wind_speed_m_s}, …]
-  function parseForecast(text) {
-    return text
-      .split(",")
-      .map((s) => s.trim())
-      .filter(Boolean)
-      .map((pair) => {
-        const [t, u] = pair.split(":").map((x) => Number(x.trim()));
-        return { time_s: t, wind_speed_m_s: u };
-      });
-  }
-
-  function request() {
-    const body = {
-      cable: { mass_per_length_kg_m: num("cable.mass_per_length_kg_m") },
-      aerostat: { net_buoyancy_n: num("aerostat.net_buoyancy_n"), mass_kg: num("aerostat.mass_kg") },
-      initial_length_m: num("initial_length_m"),
-      gravity_m_s2: num("gravity_m_s2"),
-      target_elevation_m: num("target_elevation_m"),
-      winch: { max_rate_m_s: num("winch.max_rate_m_s"), max_acceleration_m_s2: num("winch.max_acceleration_m_s2") },
-      lift_reserve_nondim: num("lift_reserve_nondim"),
-      samples: 61,
-    };
-    const jerk = num("winch.max_jerk_m_s3");
-    if (jerk !== null) body.winch.max_jerk_m_s3 = jerk;
-    const breaking = num("tether.breaking_strength_n");
-    if (breaking !== null) body.tether = { breaking_strength_n: breaking, safety_factor_nondim: num("tether.safety_factor_nondim") ?? 5 };
-    const forecast = byField("haul_down.forecast").value.trim();
-    const windLimit = num("haul_down.max_operating_wind_m_s");
-    if (forecast && windLimit !== null) {
-      body.haul_down = { forecast: parseForecast(forecast), max_operating_wind_m_s: windLimit };
+  function readRequest(errors) {
+    const body = S.readSystem(errors, "plan");
+    body.target_elevation_m = S.readNumber(roots, "target_elevation_m", errors);
+    body.samples = 61;
+    const forecast = form.elements["haul_down.forecast"].value.trim();
+    if (forecast) {
+      body.haul_down = {
+        forecast: parseForecast(forecast, errors),
+        max_operating_wind_m_s: S.readNumber(roots, "haul_down.max_operating_wind_m_s", errors),
+      };
     }
     return body;
   }
 
-  // ---- URL state ----
-  function writeUrl() {
-    const params = new URLSearchParams(window.location.search);
-    for (const el of inputs()) params.set(`plan.${el.dataset.planField}`, el.value.trim());
-    params.set("plan.preset", $("plan-preset").value);
-    history.replaceState(null, "", `${window.location.pathname}?${params.toString()}${window.location.hash}`);
-  }
+  // ---------- formatting ----------
 
-  function readUrl() {
-    const params = new URLSearchParams(window.location.search);
-    let any = false;
-    if (params.has("plan.preset")) $("plan-preset").value = params.get("plan.preset");
-    for (const el of inputs()) {
-      const key = `plan.${el.dataset.planField}`;
-      if (params.has(key)) {
-        el.value = params.get(key);
-        any = true;
-      }
+  const fmt = S.fixed;
+  const lv = S.legendValue;
+  function duration(s) {
+    if (s == null || !Number.isFinite(s)) return "–";
+    if (s < 90) return `${s.toFixed(0)} s`;
+    const m = Math.floor(s / 60);
+    return m < 90 ? `${m} min ${Math.round(s - 60 * m)} s` : `${Math.floor(m / 60)} h ${m % 60} min`;
+  }
+  const clock = (s) => new Date(Date.now() + 1000 * s).toLocaleTimeString([], { hour: "2-digit", minute: "2-digit" });
+
+  // ---------- the verdict card ----------
+
+  function setVerdict(kind, word, why) {
+    verdict.dataset.state = kind;
+    verdict.querySelector(".word").textContent = word;
+    verdict.querySelector(".why").textContent = why;
+    const current = kind === "go" || kind === "no-go";
+    state.current = current;
+    if (!current) {
+      for (const sel of [".tension-check", ".deadline", ".key-figures"]) verdict.querySelector(sel).hidden = true;
+      $("plan-output").hidden = true;
     }
-    return any;
+    $("plan-print").disabled = !current;
+    $("plan-json").disabled = !current;
+    $("plan-csv").disabled = !current || !(state.plan?.schedule?.length > 0);
   }
 
-  function applyPreset(name) {
-    const p = PRESETS[name];
-    if (!p) return;
-    for (const [field, value] of Object.entries(p)) byField(field).value = value;
+  // One plain line: why GO or NO-GO, naming what decides it. Jargon stays in the details.
+  function headline(r, req) {
+    const H = req.target_elevation_m;
+    const U = req.wind?.flow?.speed_m_s;
+    const w = r.wind;
+    if (r.go) {
+      const L = w?.target_length_m;
+      const angle = w?.blowdown_angle_deg;
+      const blown = angle != null && angle > 0.05 ? `, blown ${fmt(angle, 1)}° off vertical by the ${fmt(U, 1)} m/s wind` : "";
+      return `${r.direction === "retrieval" ? "Haul down" : "Deploy"} to ${fmt(H, 0)} m: pay out ${fmt(L ?? H, 0)} m of tether${blown}; ${duration(r.duration_s)} at the winch.`;
+    }
+    switch (r.binding_limit) {
+      case "wind_blowdown":
+        return `The ${fmt(U, 1)} m/s wind blows the aerostat down: it reaches at most ${fmt(w?.reachable_altitude_m, 0)} m, short of ${fmt(H, 0)} m.`;
+      case "static_lift_limit":
+        return `Not enough lift: ${fmt(H, 0)} m is above the highest altitude the lift holds with its reserve (${fmt(r.limits?.lift_limit_m, 0)} m).`;
+      case "tension_limit":
+        return "The tether would be overloaded: its tension exceeds the breaking strength divided by the safety factor.";
+      case "amplification_limit":
+        return "Hauling in lets a swing of the tether grow beyond the limit, even at the slowest rate.";
+      case "jerk_limit":
+        return "No winch schedule within the jerk limit keeps every margin.";
+      case "quasi_static_ge_limit":
+      case "quasi_static_ge_check":
+        return "The stiff-tether check finds the tether unstable on the way up.";
+      default:
+        break;
+    }
+    if (r.feasible && r.haul_down && !r.haul_down.go) {
+      return `The forecast wind passes ${fmt(req.haul_down.max_operating_wind_m_s, 1)} m/s before the aerostat could be brought down.`;
+    }
+    return String(r.reason || "").replace(/^no-go:\s*/, "");
   }
 
-  // ---- formatting ----
-  const fmt = (v, d = 1) => (v === null || v === undefined || !Number.isFinite(v) ? "–" : v.toFixed(d));
-  // Legend values: blank until the cursor is on the plot.
-  const lv = (d) => (u, v) => (v == null ? "" : fmt(v, d));
-
-  // ---- plots ----
-  const plots = {};
-  function plotSize(el) {
-    const width = Math.max(240, Math.floor(el.clientWidth || 300));
-    return { width, height: Math.round(Math.min(260, Math.max(180, width * 0.55))) };
+  function tensionLine(r, req) {
+    const el = verdict.querySelector(".tension-check");
+    const checked = r.tension_checked ?? r.limits?.min_safety_factor_nondim != null;
+    el.hidden = false;
+    el.dataset.checked = String(!!checked);
+    if (!checked) {
+      el.textContent = "Tension NOT checked: no breaking strength entered.";
+      return;
+    }
+    const sf = r.limits.min_safety_factor_nondim;
+    el.textContent = `Tension checked: peak ${fmt(r.limits.peak_tension_n, 0)} N, safety factor ${sf == null ? "–" : fmt(sf, 1)} (required ${fmt(req.required_safety_factor_nondim, 1)}).`;
   }
 
-  function makePlot(el, yLabel, series, data, bands) {
-    el.textContent = "";
-    const axis = { stroke: "#333", grid: { stroke: "#e5e5e5" }, ticks: { stroke: "#ccc" } };
-    return new uPlot(
-      {
-        ...plotSize(el),
-        series: [{ label: "t (s)", value: lv(1) }, ...series],
-        scales: { x: { time: false } },
-        axes: [
-          { ...axis, label: "Time t (s)" },
-          { ...axis, label: yLabel, size: 60 },
-        ],
-        legend: { live: true },
-        cursor: { drag: { x: true, y: false } },
-        ...(bands ? { bands } : {}),
-      },
+  function deadlineLine(r, req) {
+    const el = verdict.querySelector(".deadline");
+    el.hidden = false;
+    const h = r.haul_down;
+    if (!req.haul_down) {
+      el.textContent = "Haul-down deadline: none set (no forecast entered).";
+    } else if (!h) {
+      el.textContent = "Haul-down deadline: not worked out (no schedule).";
+    } else if (h.wind_exceeds_limit_at_s == null) {
+      el.textContent = `Haul-down deadline: none — the forecast stays below ${fmt(req.haul_down.max_operating_wind_m_s, 1)} m/s.`;
+    } else if (h.latest_start_s != null && h.latest_start_s >= 0) {
+      el.textContent = `Haul-down deadline: start hauling down by ${clock(h.latest_start_s)} (in ${duration(h.latest_start_s)}); the wind passes ${fmt(req.haul_down.max_operating_wind_m_s, 1)} m/s at ${clock(h.wind_exceeds_limit_at_s)}.`;
+    } else {
+      el.textContent = `Haul-down deadline: already passed — ${h.reason}`;
+    }
+  }
+
+  function keyFigures(r, req) {
+    const dl = verdict.querySelector(".key-figures");
+    const w = r.wind;
+    const sf = r.limits?.min_safety_factor_nondim;
+    const rows = [
+      ["Tether needed", w ? (w.target_length_m == null ? `out of reach (at most ${fmt(w.reachable_altitude_m, 0)} m up)` : `${fmt(w.target_length_m, 1)} m`) : `${fmt(req.target_elevation_m, 1)} m`],
+      ["Blow-down angle", w?.blowdown_angle_deg == null ? "–" : `${fmt(w.blowdown_angle_deg, 1)}°`],
+      ["Downwind of the winch", w?.target_downwind_m == null ? null : `${fmt(w.target_downwind_m, 0)} m`],
+      ["Peak tension", r.limits?.peak_tension_n == null ? "–" : `${fmt(r.limits.peak_tension_n, 0)} N`],
+      ["Safety factor", sf == null ? "not checked" : fmt(sf, 1)],
+      ["Time at the winch", duration(r.duration_s)],
+    ];
+    dl.replaceChildren(...rows.filter(([, v]) => v != null).map(([k, v]) => {
+      const div = document.createElement("div");
+      const dt = document.createElement("dt");
+      dt.textContent = k;
+      const dd = document.createElement("dd");
+      dd.textContent = v;
+      dd.dataset.figure = k;
+      div.append(dt, dd);
+      return div;
+    }));
+    dl.hidden = false;
+  }
+
+  // ---------- plots and tables ----------
+
+  function plot(el, yLabel, series, data, bands) {
+    return S.makePlot(el, {
+      series: [{ label: "t (s)", value: lv(1) }, ...series],
       data,
-      el,
-    );
+      xLabel: "Time t (s)",
+      yLabel,
+      size: S.plotSize(el, { aspect: 0.55, min: 180, max: 260, minWidth: 240 }),
+      bands,
+    });
   }
 
   function drawPlots(r) {
     const s = r.schedule;
     const t = s.map((x) => x.time_s);
     const col = (k) => s.map((x) => x[k]);
-    const absRate = s.map((x) => Math.abs(x.rate_m_s));
-    plots.length = makePlot($("plan-plot-length"), "Length L (m)",
-      [{ label: "L (m)", stroke: "#0b5cad", width: 2, value: lv(1) }], [t, col("length_m")]);
-    plots.rate = makePlot($("plan-plot-rate"), "Rate (m/s)", [
-      { label: "|L̇| (m/s)", stroke: "#0b5cad", width: 2, value: lv(2) },
+    const p = state.plots;
+    p.length = plot($("plan-plot-length"), "Length L (m)", [{ label: "tether L (m)", stroke: "#0b5cad", width: 2, value: lv(1) }], [t, col("length_m")]);
+    p.rate = plot($("plan-plot-rate"), "Rate (m/s)", [
+      { label: "winch |L̇| (m/s)", stroke: "#0b5cad", width: 2, value: lv(2) },
       { label: "stability ceiling (m/s)", stroke: "#b00020", width: 1.5, dash: [6, 4], value: lv(2) },
-    ], [t, absRate, col("rate_ceiling_m_s")]);
-    const tension = [{ label: "winch (N)", stroke: "#0b5cad", width: 2, value: lv(1) },
-      { label: "peak, at aerostat (N)", stroke: "#7a4a00", width: 1.5, value: lv(1) }];
+    ], [t, s.map((x) => Math.abs(x.rate_m_s)), col("rate_ceiling_m_s")]);
+    const tension = [{ label: "winch (N)", stroke: "#0b5cad", width: 2, value: lv(1) }, { label: "peak, at the aerostat (N)", stroke: "#7a4a00", width: 1.5, value: lv(1) }];
     const tdata = [t, col("winch_tension_n"), col("max_tension_n")];
     if (r.limits.allowable_tension_n) {
       tension.push({ label: "allowable (N)", stroke: "#b00020", width: 1.5, dash: [6, 4], value: lv(1) });
       tdata.push(s.map(() => r.limits.allowable_tension_n));
     }
-    const b = lastBands && lastBands.instants.length === s.length ? lastBands.instants : null;
+    const b = state.bands && state.bands.instants.length === s.length ? state.bands.instants : null;
     const shade = (series, data, key, color, d) => {
       if (!b) return null;
       const hi = series.length + 1;
@@ -202,239 +272,234 @@
       return [{ series: [hi, hi + 1], fill: "rgba(11,92,173,0.15)" }];
     };
     const tBands = shade(tension, tdata, "winch_tension_n", "#6b9bd1", 1);
-    plots.tension = makePlot($("plan-plot-tension"), "Tension (N)", tension, tdata, tBands);
+    p.tension = plot($("plan-plot-tension"), "Tension (N)", tension, tdata, tBands);
     const mseries = [{ label: "stability margin (m/s)", stroke: "#1a7f37", width: 2, value: lv(2) }];
     const mdata = [t, col("stability_margin_m_s")];
     const mBands = shade(mseries, mdata, "stability_margin_m_s", "#6fbf86", 2);
-    plots.margin = makePlot($("plan-plot-margin"), "Margin (m/s)", mseries, mdata, mBands);
+    p.margin = plot($("plan-plot-margin"), "Margin (m/s)", mseries, mdata, mBands);
   }
 
-  // ---- tables ----
-  function cell(tr, text, cls) {
-    const td = document.createElement("td");
-    td.textContent = text;
-    if (cls) td.className = cls;
-    tr.appendChild(td);
+  function row(body, cells) {
+    const tr = document.createElement("tr");
+    for (const [text, cls] of cells) {
+      const td = document.createElement("td");
+      td.textContent = text;
+      if (cls) td.className = cls;
+      tr.append(td);
+    }
+    body.append(tr);
   }
 
-  function fillPhases(r) {
-    const body = $("plan-phases").querySelector("tbody");
-    body.textContent = "";
-    r.phases.forEach((p, i) => {
-      const tr = document.createElement("tr");
-      cell(tr, String(i + 1));
-      cell(tr, `${fmt(p.start_time_s, 1)} – ${fmt(p.end_time_s, 1)}`, "num");
-      cell(tr, `${fmt(p.start_length_m, 1)} → ${fmt(p.end_length_m, 1)}`, "num");
-      cell(tr, `${fmt(Math.abs(p.start_rate_m_s), 2)} → ${fmt(Math.abs(p.end_rate_m_s), 2)}`, "num");
-      cell(tr, fmt(p.mean_acceleration_m_s2, 3), "num");
-      cell(tr, p.instruction);
-      body.appendChild(tr);
-    });
-  }
-
-  function fillSchedule(r) {
-    const body = $("plan-table").querySelector("tbody");
-    body.textContent = "";
+  function fillTables(r) {
+    const phases = $("plan-phases").querySelector("tbody");
+    phases.textContent = "";
+    r.phases.forEach((p, i) => row(phases, [
+      [String(i + 1)],
+      [p.instruction, "what"],
+      [`${fmt(p.start_time_s, 1)} – ${fmt(p.end_time_s, 1)}`, "num"],
+      [`${fmt(p.start_length_m, 1)} → ${fmt(p.end_length_m, 1)}`, "num"],
+      [`${fmt(Math.abs(p.start_rate_m_s), 2)} → ${fmt(Math.abs(p.end_rate_m_s), 2)}`, "num"],
+      [fmt(p.mean_acceleration_m_s2, 3), "num"],
+    ]));
+    const all = $("plan-table").querySelector("tbody");
+    all.textContent = "";
     for (const s of r.schedule) {
-      const tr = document.createElement("tr");
-      cell(tr, fmt(s.time_s, 1), "num");
-      cell(tr, fmt(s.length_m, 1), "num");
-      cell(tr, fmt(Math.abs(s.rate_m_s), 2), "num");
-      cell(tr, fmt(s.acceleration_m_s2, 3), "num");
-      cell(tr, fmt(s.winch_tension_n, 0), "num");
-      cell(tr, fmt(s.stability_margin_m_s, 2), "num");
-      body.appendChild(tr);
+      row(all, [[fmt(s.time_s, 1), "num"], [fmt(s.length_m, 1), "num"], [fmt(s.altitude_m, 1), "num"], [fmt(Math.abs(s.rate_m_s), 2), "num"],
+        [fmt(s.acceleration_m_s2, 3), "num"], [fmt(s.winch_tension_n, 0), "num"], [fmt(s.stability_margin_m_s, 2), "num"]]);
     }
   }
 
-  function dl(el, rows) {
-    el.textContent = "";
-    for (const [k, v] of rows) {
-      if (v === null) continue;
+  // A table wider than its box says so (phones): the hint above it shows.
+  function scrollHints() {
+    for (const wrap of document.querySelectorAll("#plan .table-wrap")) {
+      const hint = wrap.previousElementSibling;
+      const scrolls = wrap.scrollWidth > wrap.clientWidth + 1;
+      wrap.classList.toggle("scrolls", scrolls);
+      if (hint?.classList.contains("scroll-hint")) hint.hidden = !scrolls;
+    }
+  }
+
+  function figures(r) {
+    const c = r.constant_rate;
+    const tc = r.transient_check;
+    const rows = [
+      ["What the planner says", r.reason],
+      ["Direction", r.direction],
+      ["Binding limit", r.binding_limit],
+      ["Fastest constant rate", c ? `${fmt(c.rate_m_s, 2)} m/s, ${fmt(c.duration_s, 1)} s (the plan saves ${fmt(c.time_saved_s, 1)} s)` : null],
+      ["Minimum-time bound", r.bound ? `${fmt(r.bound.duration_s, 1)} s: ${r.bound.explanation}` : null],
+      ["Lift limit with the reserve (calm air)", r.limits ? `${fmt(r.limits.lift_limit_m, 1)} m` : null],
+      ["Reachable altitude in this wind", r.wind ? `${fmt(r.wind.reachable_altitude_m, 1)} m` : null],
+      ["Stability criterion", r.wind?.stability_criterion ?? null],
+      ["Smallest stability margin", r.limits?.min_stability_margin_m_s == null ? null : `${fmt(r.limits.min_stability_margin_m_s, 2)} m/s`],
+      ["Allowable tension", r.limits?.allowable_tension_n ? `${fmt(r.limits.allowable_tension_n, 0)} N` : null],
+      ["Transient check", tc ? `${tc.outcome}; peak tip ${fmt(tc.peak_tip_deflection_m, 3)} m from ${fmt(tc.initial_tip_deflection_m, 3)} m` : null],
+      ["Haul-down", r.haul_down?.reason ?? null],
+      ["Method", r.method],
+    ];
+    $("plan-figures").replaceChildren(...rows.filter(([, v]) => v != null).flatMap(([k, v]) => {
       const dt = document.createElement("dt");
       dt.textContent = k;
       const dd = document.createElement("dd");
       dd.textContent = v;
-      el.append(dt, dd);
-    }
+      return [dt, dd];
+    }));
   }
 
-  // Every input, flattened: [["cable.mass_per_length_kg_m", 0.078], …]
-  function flatten(obj, prefix = "", out = []) {
-    for (const [k, v] of Object.entries(obj ?? {})) {
-      const key = prefix ? `${prefix}.${k}` : k;
-      if (Array.isArray(v)) {
-        v.forEach((item, i) => (typeof item === "object" ? flatten(item, `${key}[${i}]`, out) : out.push([`${key}[${i}]`, item])));
-      } else if (v && typeof v === "object") flatten(v, key, out);
-      else out.push([key, v]);
+  // The inputs as the operator typed them, with their labels and units (print, CSV).
+  function inputRows() {
+    const out = [];
+    for (const el of form.querySelectorAll("[name]")) {
+      if (!S.visible(el) && !el.closest("details")) continue;
+      if (el.closest("[hidden]")) continue;
+      const label = S.labelOf(el) ?? el.name;
+      let value = el.tagName === "SELECT" ? el.selectedOptions[0]?.textContent ?? el.value : el.value.trim();
+      if (value === "") value = el.placeholder.startsWith("blank: ") ? el.placeholder.slice(7) : el.placeholder && !el.placeholder.startsWith("e.g.") ? el.placeholder : "none";
+      else if (el.dataset.unit) value = `${value} ${el.dataset.unit}`;
+      out.push([label, value, el.name]);
     }
     return out;
   }
 
-  function fillInputs(r) {
-    dl($("plan-inputs"), flatten(r.inputs).map(([k, v]) => [k, v === null ? "none" : String(v)]));
+  function fillInputs() {
+    const body = $("plan-inputs").querySelector("tbody");
+    body.textContent = "";
+    for (const [label, value] of inputRows()) row(body, [[label], [value, "num"]]);
   }
 
-  function showResult(r) {
-    const verdict = $("plan-verdict");
-    verdict.hidden = false;
-    verdict.dataset.go = String(r.go);
-    verdict.querySelector(".word").textContent = r.go ? "GO" : "NO-GO";
-    verdict.querySelector(".why").textContent = r.reason;
-    const c = r.constant_rate;
-    const h = r.haul_down;
-    const tc = r.transient_check;
-    dl($("plan-figures"), [
-      ["Direction", r.direction],
-      ["Duration", r.duration_s === null ? "no schedule" : `${fmt(r.duration_s, 1)} s`],
-      ["Binding limit", r.binding_limit ?? null],
-      ["Best constant rate", c ? `${fmt(c.rate_m_s, 2)} m/s, ${fmt(c.duration_s, 1)} s` : null],
-      ["Time saved", c ? `${fmt(c.time_saved_s, 1)} s (${fmt(100 * c.time_saved_fraction_nondim, 0)} %)` : null],
-      ["Minimum-time bound", r.bound ? `${fmt(r.bound.duration_s, 1)} s: ${r.bound.explanation}` : null],
-      ["Lift limit with reserve", `${fmt(r.limits.lift_limit_m, 1)} m`],
-      ["Smallest stability margin", r.limits.min_stability_margin_m_s === null ? null : `${fmt(r.limits.min_stability_margin_m_s, 2)} m/s`],
-      ["Peak tension", r.limits.peak_tension_n === null ? null : `${fmt(r.limits.peak_tension_n, 0)} N`],
-      ["Allowable tension", r.limits.allowable_tension_n ? `${fmt(r.limits.allowable_tension_n, 0)} N` : null],
-      ["Transient check", tc ? `${tc.outcome}; peak tip ${fmt(tc.peak_tip_deflection_m, 3)} m from ${fmt(tc.initial_tip_deflection_m, 3)} m, ×${fmt(tc.amplification_nondim, 3)} at the end` : null],
-      ["WKB growth", r.oscillation?.wkb_amplification_nondim ? `×${fmt(r.oscillation.wkb_amplification_nondim, 3)}` : null],
-      ["Tension rise hauling in", r.retrieval ? `${fmt(r.retrieval.tension_rise_n, 1)} N` : null],
-      ["Haul-down", h ? h.reason : null],
-    ]);
-    fillInputs(r);
-    const has = r.schedule.length > 0;
-    $("plan-output").hidden = !has;
-    if (has) {
-      fillPhases(r);
-      fillSchedule(r);
-      drawPlots(r);
-    }
-    $("plan-csv").disabled = !has;
-    $("plan-json").disabled = false;
-    $("plan-print").disabled = false;
-  }
+  // ---------- planning ----------
 
-  let last = null;
-  let lastBands = null;
+  function stale() {
+    if (verdict.dataset.state === "stale") return;
+    state.seq++;
+    setVerdict("stale", "Inputs changed:", "plan again.");
+  }
 
   async function runPlan() {
-    for (const el of inputs()) clearFieldError(el);
-    showFormError(errorBox, "");
-    status.dataset.state = "busy";
-    status.textContent = "Planning…";
-    writeUrl();
-    const body = request();
-    const withBands = bandsOn();
-    if (withBands) body.uncertainty = uncertainty(body);
-    const res = await api("POST", withBands ? "api/v1/plan/bands" : "api/v1/plan", body);
-    if (!res.ok) {
-      const err = res.body?.error;
-      status.dataset.state = "error";
-      status.textContent = err?.message ?? `HTTP ${res.status}`;
-      const el = err?.field ? byField(err.field) ?? byField(err.field.replace(/\[\d+\].*$/, "")) : null;
-      if (el) {
-        const box = el.closest(".field");
-        const p = document.createElement("p");
-        p.className = "field-error";
-        p.id = `${el.id}-error`;
-        p.textContent = fieldMessage(err.field, err.message);
-        box.appendChild(p);
-        el.setAttribute("aria-invalid", "true");
-        el.setAttribute("aria-describedby", p.id);
-      } else {
-        showFormError(errorBox, err?.message ?? "the plan failed");
-      }
+    const seq = ++state.seq;
+    S.clearErrors(SOURCE);
+    S.showFormError(errorBox, "");
+    S.writeUrl();
+    const errors = [];
+    const body = readRequest(errors);
+    if (errors.length) {
+      S.showInputErrors(roots, errors, SOURCE);
+      const first = S.inputFor(roots, errors[0].field);
+      setVerdict("error", "Cannot plan:", `${S.labelOf(first) ?? "an input"}: ${S.plainMessage(errors[0].field, errors[0].message)}.`);
       return;
     }
-    lastBands = withBands ? res.body : null;
-    last = withBands ? res.body.plan : res.body;
-    const summary = $("plan-bands-summary");
-    summary.hidden = !lastBands || !lastBands.probability_unstable;
-    if (!summary.hidden) {
-      const pc = (p) => (p ? `${fmt(100 * p.probability_nondim, 1)} % (95 %: ${fmt(100 * p.low_nondim, 1)}–${fmt(100 * p.high_nondim, 1)} %)` : "–");
-      summary.textContent = `${lastBands.valid_samples} samples: P(unstable somewhere) ${pc(lastBands.probability_unstable)}; ` +
-        `P(below the lift reserve) ${pc(lastBands.probability_below_reserve)}; P(over the rating) ${pc(lastBands.probability_over_rating)}.`;
+    setVerdict("pending", "Planning…", "");
+    const withBands = bandsOn();
+    if (withBands) body.uncertainty = uncertainty(body);
+    state.request = body;
+    const res = await S.api("POST", withBands ? "api/v1/plan/bands" : "api/v1/plan", body);
+    if (seq !== state.seq) return; // an input changed meanwhile: that answer is not today's
+    if (!res.ok) {
+      state.plan = null;
+      const text = S.renderApiError(roots, res.status, res.body, errorBox, SOURCE);
+      setVerdict("error", "Cannot plan:", `${text.replace(/\.$/, "")}.`);
+      return;
     }
-    window.tetherplan = window.tetherplan || {};
-    window.tetherplan.planBands = lastBands;
-    window.tetherplan.plan = last;
-    window.tetherplan.planPlots = plots;
-    showResult(last);
-    status.dataset.state = "ready";
-    status.textContent = last.feasible
-      ? `Plan ready: ${fmt(last.duration_s, 1)} s (computed in ${fmt(1000 * last.compute_time_s, 0)} ms).`
-      : `No schedule: ${last.binding_limit}.`;
+    state.bands = withBands ? res.body : null;
+    const r = withBands ? res.body.plan : res.body;
+    state.plan = r;
+    const summary = $("plan-bands-summary");
+    summary.hidden = !state.bands?.probability_unstable;
+    if (!summary.hidden) {
+      const b = state.bands;
+      const pc = (p) => (p ? `${fmt(100 * p.probability_nondim, 1)} % (95 %: ${fmt(100 * p.low_nondim, 1)}–${fmt(100 * p.high_nondim, 1)} %)` : "–");
+      summary.textContent = `${b.valid_samples} samples: P(unstable somewhere) ${pc(b.probability_unstable)}; ` +
+        `P(below the lift reserve) ${pc(b.probability_below_reserve)}; P(over the rating) ${pc(b.probability_over_rating)}.`;
+    }
+    setVerdict(r.go ? "go" : "no-go", r.go ? "GO" : "NO-GO", headline(r, body));
+    tensionLine(r, body);
+    deadlineLine(r, body);
+    keyFigures(r, body);
+    figures(r);
+    fillInputs();
+    const has = r.schedule.length > 0;
+    $("plan-output").hidden = false;
+    for (const el of $("plan-output").querySelectorAll(".plan-plots, #plan-details, #plan-phases, h3")) el.hidden = !has;
+    if (has) {
+      fillTables(r);
+      drawPlots(r);
+    }
+    scrollHints();
   }
 
-  // ---- export ----
-  function download(name, type, text) {
-    const a = document.createElement("a");
-    a.href = URL.createObjectURL(new Blob([text], { type }));
-    a.download = name;
-    document.body.appendChild(a);
-    a.click();
-    setTimeout(() => {
-      URL.revokeObjectURL(a.href);
-      a.remove();
-    }, 0);
-  }
-
-  const round = (v, d) => (Number.isFinite(v) ? Number(v.toFixed(d)) : v);
+  // ---------- export ----------
 
   function csv(r) {
-    const lines = ["# tetherplan deployment plan", `# verdict,${r.go ? "go" : "no-go"}`, `# reason,"${r.reason.replaceAll('"', "'")}"`];
-    for (const [k, v] of flatten(r.inputs)) lines.push(`# input ${k},${v}`);
-    lines.push(`# duration_s,${round(r.duration_s, 3)}`);
-    const b = lastBands && lastBands.instants.length === r.schedule.length ? lastBands : null;
-    if (b) {
-      lines.push(`# uncertainty samples,${b.samples}`, `# uncertainty valid_samples,${b.valid_samples}`, `# uncertainty seed,${b.seed}`);
-      for (const [k, v] of flatten({ inputs: b.inputs })) lines.push(`# uncertainty ${k},${v}`);
-      for (const k of ["probability_unstable", "probability_below_reserve", "probability_over_rating"]) {
-        if (b[k]) lines.push(`# ${k},${b[k].probability_nondim},${b[k].low_nondim},${b[k].high_nondim}`);
-      }
-    }
-    lines.push("time_s,length_m,rate_m_s,acceleration_m_s2,winch_tension_n,max_tension_n,rate_ceiling_m_s,stability_margin_m_s,effective_tension_margin_n" +
-      (b ? ",winch_tension_p05_n,winch_tension_p50_n,winch_tension_p95_n,max_tension_p05_n,max_tension_p95_n,stability_margin_p05_m_s,stability_margin_p50_m_s,stability_margin_p95_m_s" : ""));
+    const v = verdict.dataset.state;
+    const lines = ["# tetherplan deployment plan", `# planned,${new Date().toISOString()}`, `# version,${version}`, `# verdict,${v}`,
+      `# why,"${verdict.querySelector(".why").textContent.replaceAll('"', "'")}"`,
+      `# tension,"${verdict.querySelector(".tension-check").textContent.replaceAll('"', "'")}"`,
+      `# haul-down,"${verdict.querySelector(".deadline").textContent.replaceAll('"', "'")}"`];
+    lines.push(...S.inputLines(state.request));
+    lines.push(`# duration_s,${S.sig(r.duration_s)}`);
+    const b = state.bands && state.bands.instants.length === r.schedule.length ? state.bands : null;
+    lines.push("time_s,length_m,altitude_m,rate_m_s,acceleration_m_s2,winch_tension_n,max_tension_n,rate_ceiling_m_s,stability_margin_m_s" +
+      (b ? ",winch_tension_p05_n,winch_tension_p50_n,winch_tension_p95_n,stability_margin_p05_m_s,stability_margin_p95_m_s" : ""));
     r.schedule.forEach((s, i) => {
-      const row = [round(s.time_s, 3), round(s.length_m, 3), round(s.rate_m_s, 4), round(s.acceleration_m_s2, 4),
-        round(s.winch_tension_n, 2), round(s.max_tension_n, 2), round(s.rate_ceiling_m_s, 4), round(s.stability_margin_m_s, 4),
-        round(s.effective_tension_margin_n, 2)];
+      const cells = [s.time_s, s.length_m, s.altitude_m, s.rate_m_s, s.acceleration_m_s2, s.winch_tension_n, s.max_tension_n, s.rate_ceiling_m_s, s.stability_margin_m_s];
       if (b) {
         const x = b.instants[i];
-        row.push(round(x.winch_tension_n.p05, 2), round(x.winch_tension_n.p50, 2), round(x.winch_tension_n.p95, 2),
-          round(x.max_tension_n.p05, 2), round(x.max_tension_n.p95, 2),
-          round(x.stability_margin_m_s.p05, 4), round(x.stability_margin_m_s.p50, 4), round(x.stability_margin_m_s.p95, 4));
+        cells.push(x.winch_tension_n.p05, x.winch_tension_n.p50, x.winch_tension_n.p95, x.stability_margin_m_s.p05, x.stability_margin_m_s.p95);
       }
-      lines.push(row.join(","));
+      lines.push(cells.map(S.sig).join(","));
     });
     return `${lines.join("\n")}\n`;
   }
 
-  $("plan-csv").addEventListener("click", () => last && download("tetherplan-plan.csv", "text/csv", csv(last)));
-  $("plan-json").addEventListener("click", () => last && download("tetherplan-plan.json", "application/json", JSON.stringify(lastBands ?? last, null, 2)));
-  $("plan-print").addEventListener("click", () => window.print());
-  $("plan-preset").addEventListener("change", (e) => {
-    applyPreset(e.target.value);
-    runPlan();
-  });
+  $("plan-csv").addEventListener("click", () => state.current && state.plan && S.download(csv(state.plan), "tetherplan-plan.csv", "text/csv"));
+  $("plan-json").addEventListener("click", () => state.current && state.plan &&
+    S.download(JSON.stringify({ version, planned: new Date().toISOString(), request: state.request, answer: state.bands ?? state.plan }, null, 2), "tetherplan-plan.json", "application/json"));
+  $("plan-print").addEventListener("click", () => state.current && window.print());
+
   form.addEventListener("submit", (e) => {
     e.preventDefault();
     runPlan();
   });
-  for (const el of inputs()) el.addEventListener("change", () => ($("plan-preset").value = "custom"));
+  // Any change clears the verdict at once; the card's changes also tell the other panels.
+  const changed = (ev) => {
+    if (!ev.target.matches("input, select, textarea")) return;
+    S.clearFieldError(ev.target);
+    stale();
+    S.writeUrl();
+    document.dispatchEvent(new CustomEvent("tetherplan:system-input", { detail: { name: ev.target.name } }));
+  };
+  form.addEventListener("input", changed);
+  form.addEventListener("change", (ev) => !S.restoring && ev.target.tagName === "SELECT" && changed(ev));
 
   let resizeTimer = null;
   window.addEventListener("resize", () => {
     clearTimeout(resizeTimer);
-    resizeTimer = setTimeout(() => last && last.schedule.length && drawPlots(last), 150);
+    resizeTimer = setTimeout(() => {
+      if (state.current && state.plan?.schedule.length) drawPlots(state.plan);
+      scrollHints();
+    }, 150);
   });
-  // Print at the page width of A4 portrait.
+  // Print at the page width of A4 portrait, stamped with the date, time and version.
   window.addEventListener("beforeprint", () => {
-    if (!last || !last.schedule.length) return;
-    for (const p of Object.values(plots)) p.setSize({ width: 330, height: 170 });
+    $("print-date").textContent = new Date().toLocaleString();
+    $("print-version").textContent = version;
+    fillInputs();
+    if (!state.current || !state.plan?.schedule.length) return;
+    for (const p of Object.values(state.plots)) p.setSize({ width: 330, height: 170 });
   });
-  window.addEventListener("afterprint", () => last && last.schedule.length && drawPlots(last));
+  window.addEventListener("afterprint", () => state.current && state.plan?.schedule.length && drawPlots(state.plan));
 
-  // The page opens on the plan: from the URL if it carries one, else the defaults.
-  readUrl();
+  S.api("GET", "healthz").then((r) => {
+    if (r.ok && r.body?.version) version = r.body.version;
+    $("print-version").textContent = version;
+  });
+  $("print-date").textContent = new Date().toLocaleString();
+
+  // The page opens planning: the shared URL's inputs if it carries any, else the defaults.
+  S.readUrl();
+  togglePreset();
+  toggleAerostat();
+  toggleWind();
+  state.runPlan = runPlan;
   runPlan();
 })();

@@ -1,29 +1,24 @@
-// The transient-run and frequency-response panels of the page (SPEC §2):
-// reads their forms (plus the cable and aerostat of the chart form), asks
-// POST /api/v1/simulate and POST /api/v1/frequency-response (directly, or as
-// a background job with progress when long), plots the tip deflection with
-// its envelope, the energy and the first natural frequency against time
-// (uPlot), the peak amplitude against wind frequency, and a heat map of the
-// envelope over (time, frequency). API errors are shown next to the field
-// they name. Kept apart from app.js; no build step.
+// The transient-run panel of the page (SPEC §2): reads its form (with the
+// tether, aerostat and gravity of the system card), asks POST /api/v1/simulate
+// (directly, or as a background job with progress when long), and plots the
+// tip deflection with its envelope, the energy and the first natural
+// frequency against time (uPlot). API errors are shown next to the field they
+// name. The frequency-response panel (frequency.js) reuses its readers and
+// plots through window.tetherplanTransient.lib. No build step.
 "use strict";
 
 (function () {
-  const { clearFieldError, fieldMessage, showFormError, unwrapJobError, api } = window.tetherplanCommon;
-  // The server answers at most this many frequencies directly (api/solve.rs,
-  // MAX_SYNC_FREQUENCIES); more run as a job.
-  const SYNC_FREQUENCIES = 16;
+  const S = window.tetherplanShared;
+  const SOURCE = "transient";
   // Runs with more work than this (simulated seconds × elements; 600 s at 50
   // elements) go through a job. So does any run the server refuses directly
   // (422 `too_large`, 503 busy, 504 timeout).
   const JOB_WORK = 30_000;
-  const POLL_MS = 300;
   const COLORS = { tip: "#0072b2", envelope: "#d55e00", energy: "#009e73", vibration: "#cc79a7", freq: "#0072b2", wind: "#d55e00" };
 
   const $ = (sel) => document.querySelector(sel);
   const form = $("#transient-form");
-  const frForm = $("#fr-form");
-  if (!form || !frForm || typeof uPlot === "undefined") return;
+  if (!form || typeof uPlot === "undefined") return;
 
   // Shared with the browser test and the console: requests, answers, what is plotted.
   const state = {
@@ -36,86 +31,26 @@
     jobProgress: [],
     plots: { tip: null, energy: null, freq: null },
     fr: { request: null, result: null, via: null, peak: null, jobProgress: [], plot: null },
-    jobs: { run: null, fr: null },
+    jobs: { run: {}, fr: {} },
   };
+  state.lib = {};
   window.tetherplanTransient = state;
 
   // ---------- inputs ----------
 
-  const visible = (el) => el && !el.closest("[hidden]");
+  // This section's inputs first, then the chart form's (elements) and the system card's.
+  const roots = [$("#transient"), $("#chart-form"), $("#plan-form")];
+  const num = (field, errors, opts) => S.readNumber(roots, field, errors, opts);
+  const inputFor = (field) => S.inputFor(roots, field);
 
-  // The visible input of this page section for an API field path (`data-api`),
-  // else the chart form's (`data-field`: cable, aerostat, gravity, elements).
-  function inputExact(path) {
-    const mine = [...document.querySelectorAll(`#transient [data-api="${CSS.escape(path)}"]`)].find(visible);
-    if (mine) return mine;
-    return [...document.querySelectorAll(`[data-field="${CSS.escape(path)}"]`)].find(visible) || null;
-  }
-
-  // The input an API field path names: exact, else without a list index, else
-  // the first visible input under the nearest named parent.
-  function inputFor(field) {
-    if (!field) return null;
-    let path = field.replace(/^\./, "");
-    while (path) {
-      const exact = inputExact(path);
-      if (exact) return exact;
-      const unindexed = path.replace(/\[\d+\]$/, "");
-      if (unindexed !== path) {
-        path = unindexed;
-        continue;
-      }
-      const dot = path.lastIndexOf(".");
-      if (dot < 0) break;
-      path = path.slice(0, dot);
-      const prefix = CSS.escape(path + ".");
-      const child = [...document.querySelectorAll(`#transient [data-api^="${prefix}"], [data-field^="${prefix}"]`)].find(visible);
-      if (child) return child;
-    }
-    return null;
-  }
-
-  // A number from `input` (API path `field`); errors collect {field, message}.
-  function numberOf(input, field, errors, { integer = false, optional = false, fallback } = {}) {
-    if (!input) return fallback ?? null;
-    const text = input.value.trim();
-    if (text === "" && optional) return undefined;
-    const value = Number(text);
-    if (text === "" || !Number.isFinite(value)) {
-      errors.push({ field, message: text === "" ? "enter a number" : `“${text}” is not a number` });
-      return null;
-    }
-    if (integer && !Number.isInteger(value)) {
-      errors.push({ field, message: `must be a whole number, got ${text}` });
-      return null;
-    }
-    return value;
-  }
-
-  const num = (field, errors, opts) => numberOf(inputExact(field), field, errors, opts);
-
-  // Cable, aerostat, gravity and elements from the chart form (its defaults if a
-  // field is not on the page); L0 from this panel.
+  // The tether, aerostat and gravity of the card; L0 from this panel; the
+  // chart's element count (blank there: the default mesh).
   function readSystem(errors) {
-    const cable = {};
-    if ($("#cable-mode")?.value === "density") {
-      cable.density_kg_m3 = num("cable.density_kg_m3", errors, { fallback: 7800 });
-      cable.area_m2 = num("cable.area_m2", errors, { fallback: 1e-5 });
-    } else {
-      cable.mass_per_length_kg_m = num("cable.mass_per_length_kg_m", errors, { fallback: 0.078 });
-    }
-    // An empty element count (the chart's "converged") runs the default mesh.
+    const sys = S.readSystem(errors, "calm");
+    sys.initial_length_m = num("initial_length_m", errors);
     const elements = num("model.elements", errors, { integer: true, optional: true, fallback: 50 });
-    return {
-      cable,
-      aerostat: {
-        net_buoyancy_n: num("aerostat.net_buoyancy_n", errors, { fallback: 1000 }),
-        mass_kg: num("aerostat.mass_kg", errors, { fallback: 10 }),
-      },
-      initial_length_m: num("initial_length_m", errors),
-      gravity_m_s2: num("gravity_m_s2", errors, { fallback: 9.81 }),
-      model: elements === undefined ? { kind: "linear_string" } : { kind: "linear_string", elements },
-    };
+    sys.model = elements === undefined ? { kind: "linear_string" } : { kind: "linear_string", elements };
+    return sys;
   }
 
   function readProfile(errors) {
@@ -188,150 +123,34 @@
     return req;
   }
 
-  function readFrequencyRequest(errors) {
-    const req = readSystem(errors);
-    req.profile = readProfile(errors);
-    req.duration_s = num("duration_s", errors);
-    req.initial = readInitial(errors);
-    req.aero = readBody(errors);
-    req.wind_amplitude_m_s = num("wind_amplitude_m_s", errors);
-    req.frequencies_rad_s = {
-      min: num("frequencies_rad_s.min", errors),
-      max: num("frequencies_rad_s.max", errors),
-      count: num("frequencies_rad_s.count", errors, { integer: true }),
-    };
-    return req;
-  }
-
   const work = (req) => (req.duration_s || 0) * (req.model.elements || 50);
   const runWantsJob = (req) => work(req) > JOB_WORK;
-  const frWantsJob = (req) => (req.frequencies_rad_s.count || 0) > SYNC_FREQUENCIES;
 
-  // ---------- errors next to fields ----------
+  // ---------- errors next to fields, status and jobs ----------
 
-  // Errors this file placed carry data-source="transient" (also those in the chart form).
-  function clearErrors() {
-    for (const el of document.querySelectorAll('.field-error[data-source="transient"]')) {
-      const input = document.getElementById(el.id.replace(/-error$/, ""));
-      if (input) {
-        input.removeAttribute("aria-invalid");
-        input.removeAttribute("aria-describedby");
-      }
-      el.remove();
-    }
-    for (const el of document.querySelectorAll('#transient [aria-invalid]')) el.removeAttribute("aria-invalid");
-  }
-
-  function showFieldError(field, message) {
-    const input = inputFor(field);
-    if (!input) return null;
-    clearFieldError(input);
-    const p = document.createElement("p");
-    p.className = "field-error";
-    p.id = `${input.id}-error`;
-    p.dataset.errorFor = field;
-    p.dataset.source = "transient";
-    p.textContent = fieldMessage(field, message);
-    input.closest(".field").append(p);
-    input.setAttribute("aria-invalid", "true");
-    input.setAttribute("aria-describedby", p.id);
-    return input;
-  }
-
-  // A job submission names fields inside its `request`: drop the prefix.
-
+  const clearErrors = () => S.clearErrors(SOURCE);
   // Renders an API error body next to its field (or in `fallback`); returns a summary.
   function renderApiError(status, body, fallback) {
-    const err = body && body.error ? body.error : { code: `http_${status}`, field: null, message: `HTTP ${status}` };
-    const input = showFieldError(err.field, err.message);
-    if (input) {
-      showFormError(fallback, "");
-      input.focus({ preventScroll: false });
-      const where = input.closest("#transient") ? "" : " (in the chart form above)";
-      return `Fix the highlighted field${where}: ${err.message}`;
-    }
-    showFormError(fallback, err.message);
-    return err.message;
+    const input = inputFor(body?.error?.field);
+    const text = S.renderApiError(roots, status, body, fallback, SOURCE);
+    if (!input) return text;
+    const where = input.closest("#transient") ? "" : input.closest("#chart-form") ? " (in the chart form above)" : " (in the system card above)";
+    return `Fix the highlighted field${where}: ${text}`;
   }
-
   function showInputErrors(errors, statusFn) {
-    for (const e of errors) showFieldError(e.field, e.message);
-    inputFor(errors[0].field)?.focus();
+    S.showInputErrors(roots, errors, SOURCE);
     statusFn("error", "Fix the highlighted fields.");
   }
 
-  // ---------- HTTP and jobs ----------
-
-  const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-  // The direct route cannot answer this one: run it as a job instead.
-  const needsJob = (r) => !r.ok && (r.body?.error?.code === "too_large" || r.status === 503 || r.status === 504);
-
-  // A progress bar with a cancel button, bound to one panel.
-  function jobUi(prefix, slot, setStatus, log) {
-    const box = $(`#${prefix}-job`);
-    const bar = $(`#${prefix}-job-progress`);
-    const text = $(`#${prefix}-job-text`);
-    $(`#${prefix}-job-cancel`).addEventListener("click", async () => {
-      const id = state.jobs[slot];
-      if (id == null) return;
-      text.textContent = "cancelling…";
-      await api("DELETE", `/api/v1/jobs/${encodeURIComponent(id)}`);
-    });
-    // Resolves to {result, via} or {status, error}.
-    return async function runJob(kind, request, what) {
-      const submitted = await api("POST", "/api/v1/jobs", { kind, request });
-      if (!submitted.ok) return { status: submitted.status, error: unwrapJobError(submitted.body) };
-      const id = submitted.body.id;
-      state.jobs[slot] = id;
-      log.length = 0;
-      box.hidden = false;
-      bar.value = 0;
-      text.textContent = "queued";
-      try {
-        for (;;) {
-          const r = await api("GET", `/api/v1/jobs/${encodeURIComponent(id)}`);
-          if (!r.ok) return { status: r.status, error: r.body };
-          const job = r.body;
-          const progress = Number(job.progress) || 0;
-          bar.value = progress;
-          log.push([job.status, progress]);
-          if (text.textContent !== "cancelling…" || job.status !== "running") text.textContent = `${job.status} · ${(progress * 100).toFixed(0)} %`;
-          setStatus("busy", `Job ${id} (${what}): ${job.status}, ${(progress * 100).toFixed(0)} %`);
-          if (job.status === "done") return { result: job.result, via: `job ${id}` };
-          if (job.status === "failed" || job.status === "cancelled") {
-            const body = job.error?.error ? job.error : { error: { code: job.status, field: null, message: `the job was ${job.status}` } };
-            return { status: 200, error: unwrapJobError(body) };
-          }
-          await sleep(POLL_MS);
-        }
-      } finally {
-        state.jobs[slot] = null;
-        box.hidden = true;
-      }
-    };
-  }
-
-  function statusSetter(statusEl, resultsEl) {
-    return (kind, text) => {
-      if (kind === "ready") delete resultsEl.dataset.stale;
-      else resultsEl.dataset.stale = "";
-      statusEl.dataset.state = kind;
-      statusEl.textContent = text;
-    };
-  }
-
-  const setRunStatus = statusSetter($("#tr-status"), $("#tr-results"));
-  const setFrStatus = statusSetter($("#fr-status"), $("#fr-results"));
-  const runJob = jobUi("tr", "run", setRunStatus, state.jobProgress);
-  const frJob = jobUi("fr", "fr", setFrStatus, state.fr.jobProgress);
+  const setRunStatus = S.statusSetter($("#tr-status"), $("#tr-results"));
+  const runJob = S.jobRunner("tr-", { log: state.jobProgress, slot: state.jobs.run });
 
   // ---------- numbers ----------
 
   function fmt(v, digits = 3) {
     if (v == null || !Number.isFinite(v)) return "–";
     const a = Math.abs(v);
-    if (a !== 0 && (a >= 1e5 || a < 1e-3)) return v.toExponential(digits - 1);
-    return Number(v.toPrecision(digits)).toString();
+    return a !== 0 && (a >= 1e5 || a < 1e-3) ? v.toExponential(digits - 1) : S.sig3(v, digits);
   }
 
   // Centered sliding maximum of `values` over `half` samples either side.
@@ -416,10 +235,7 @@
   const pow10 = (u, v) => (v == null ? "–" : powLabel(v, 3));
   const logAxis = { ...axis, values: (u, splits) => splits.map((v) => powLabel(v)) };
 
-  function plotSize(el, aspect = 0.6) {
-    const width = Math.max(260, Math.floor(el.clientWidth));
-    return { width, height: Math.round(Math.min(340, Math.max(240, width * aspect))) };
-  }
+  const plotSize = (el, aspect = 0.6) => S.plotSize(el, { aspect, max: 340 });
 
   // A hatch pattern (device pixels) for the region past the onset of instability.
   let hatch = null;
@@ -659,240 +475,19 @@
     setRunStatus("ready", `${t.length} samples, ${res.steps} steps of ${fmt(res.time_step_s)} s, ${res.elements} elements${noTrack}${via && via !== "direct" ? ` (${via})` : ""}.`);
   }
 
-  // ---------- heat map ----------
-
-  // Viridis, sampled at 9 stops.
-  const VIRIDIS = [
-    [68, 1, 84], [71, 44, 122], [59, 81, 139], [44, 113, 142], [33, 144, 141],
-    [39, 173, 129], [92, 200, 99], [170, 220, 50], [253, 231, 37],
-  ];
-  function colour(s) {
-    const x = Math.min(1, Math.max(0, s)) * (VIRIDIS.length - 1);
-    const i = Math.min(VIRIDIS.length - 2, Math.floor(x));
-    const f = x - i;
-    return VIRIDIS[i].map((c, k) => Math.round(c + f * (VIRIDIS[i + 1][k] - c)));
-  }
-
-  // About `n` round tick values covering [lo, hi].
-  function ticks(lo, hi, n) {
-    if (!(hi > lo)) return [lo];
-    const raw = (hi - lo) / n;
-    const mag = 10 ** Math.floor(Math.log10(raw));
-    const step = [1, 2, 5, 10].map((m) => m * mag).find((s) => s >= raw) || 10 * mag;
-    const out = [];
-    for (let v = Math.ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) out.push(Number(v.toPrecision(12)));
-    return out;
-  }
-
-  const heat = { layout: null, cache: null };
-
-  // The envelope drawn: the API's (max |y| over each output interval), or by
-  // default straight lines through its peaks, at most two per forcing period.
-  function heatValues(res) {
-    const smooth = $("#fr-smooth").checked;
-    if (!smooth) return res.envelope_m;
-    if (heat.cache?.res === res) return heat.cache.values;
-    const t = res.time_s;
-    const dt = t.length > 1 ? (t[t.length - 1] - t[0]) / (t.length - 1) : 1;
-    const values = res.envelope_m.map((row, i) => {
-      const w = res.frequencies_rad_s[i];
-      const spacing = w > 0 ? Math.PI / w / 2 : 2 * dt;
-      return peakEnvelope(row.map((v) => (Number.isFinite(v) ? v : 0)), Math.max(1, Math.round(spacing / dt)));
-    });
-    heat.cache = { res, values };
-    return values;
-  }
-
-  function drawHeatmap() {
-    const canvas = $("#fr-heatmap");
-    const res = state.fr.result;
-    const wrap = canvas.parentElement;
-    const cssW = Math.max(260, Math.floor(wrap.clientWidth));
-    const cssH = Math.round(Math.min(320, Math.max(220, cssW * 0.5)));
-    const dpr = window.devicePixelRatio || 1;
-    canvas.width = Math.round(cssW * dpr);
-    canvas.height = Math.round(cssH * dpr);
-    canvas.style.height = `${cssH}px`;
-    const ctx = canvas.getContext("2d");
-    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
-    ctx.fillStyle = "#fff";
-    ctx.fillRect(0, 0, cssW, cssH);
-    if (!res) return;
-    const narrow = cssW < 480;
-    const m = { left: 52, right: narrow ? 58 : 74, top: 8, bottom: 38 };
-    const pw = cssW - m.left - m.right;
-    const ph = cssH - m.top - m.bottom;
-    const w = res.frequencies_rad_s;
-    const t = res.time_s;
-    const E = heatValues(res);
-    // Colour: linear in |y| from 0, or log₁₀|y| over the decades present
-    // (automatic when a run diverged).
-    const logColour = $("#fr-log").checked;
-    let max = 0;
-    let minPos = Infinity;
-    for (const row of E) {
-      for (const v of row) {
-        if (!Number.isFinite(v)) continue;
-        max = Math.max(max, v);
-        if (v > 0) minPos = Math.min(minPos, v);
-      }
-    }
-    if (!(max > 0)) max = 1;
-    const lo = logColour ? Math.log10(Math.max(minPos, max * 1e-300)) : 0;
-    const hi = logColour ? Math.log10(max) : max;
-    const scaleOf = (v) => (logColour ? (v > 0 ? (Math.log10(v) - lo) / (hi - lo || 1) : 0) : v / max);
-    // Cells: one pixel per (time, frequency) in an offscreen image, scaled up.
-    const img = document.createElement("canvas");
-    img.width = t.length;
-    img.height = w.length;
-    const ictx = img.getContext("2d");
-    const data = ictx.createImageData(t.length, w.length);
-    for (let i = 0; i < w.length; i++) {
-      const row = w.length - 1 - i; // ω increases upwards
-      for (let j = 0; j < t.length; j++) {
-        const v = E[i][j];
-        const [r, g, b] = Number.isFinite(v) ? colour(scaleOf(v)) : [200, 200, 200];
-        const k = 4 * (row * t.length + j);
-        data.data[k] = r;
-        data.data[k + 1] = g;
-        data.data[k + 2] = b;
-        data.data[k + 3] = 255;
-      }
-    }
-    ictx.putImageData(data, 0, 0);
-    ctx.imageSmoothingEnabled = false;
-    ctx.drawImage(img, m.left, m.top, pw, ph);
-    ctx.strokeStyle = "#333";
-    ctx.lineWidth = 1;
-    ctx.strokeRect(m.left + 0.5, m.top + 0.5, pw - 1, ph - 1);
-
-    // Axes. Cell i spans [ω_i − dω/2, ω_i + dω/2] (likewise in time).
-    const dw = w.length > 1 ? (w[w.length - 1] - w[0]) / (w.length - 1) : Math.max(1e-3, Math.abs(w[0]) * 0.1 || 1);
-    const dt = t.length > 1 ? (t[t.length - 1] - t[0]) / (t.length - 1) : 1;
-    const w0 = w[0] - dw / 2, w1 = w[w.length - 1] + dw / 2;
-    const t0 = t[0] - dt / 2, t1 = t[t.length - 1] + dt / 2;
-    const xOf = (v) => m.left + ((v - t0) / (t1 - t0)) * pw;
-    const yOf = (v) => m.top + ph - ((v - w0) / (w1 - w0)) * ph;
-    heat.layout = { m, pw, ph, w, t, E, t0, t1, w0, w1, max };
-    ctx.fillStyle = "#333";
-    ctx.font = "11px system-ui, sans-serif";
-    ctx.textAlign = "center";
-    ctx.textBaseline = "top";
-    for (const v of ticks(Math.max(0, t[0]), t[t.length - 1], narrow ? 4 : 8)) {
-      const x = xOf(v);
-      if (x < m.left - 0.5 || x > m.left + pw + 0.5) continue;
-      ctx.fillRect(x, m.top + ph, 1, 4);
-      ctx.fillText(fmt(v), x, m.top + ph + 6);
-    }
-    ctx.fillText("Time t (s)", m.left + pw / 2, m.top + ph + 21);
-    ctx.textAlign = "right";
-    ctx.textBaseline = "middle";
-    for (const v of ticks(w[0], w[w.length - 1], 5)) {
-      const y = yOf(v);
-      if (y < m.top - 0.5 || y > m.top + ph + 0.5) continue;
-      ctx.fillRect(m.left - 4, y, 4, 1);
-      ctx.fillText(fmt(v), m.left - 6, y);
-    }
-    ctx.save();
-    ctx.translate(12, m.top + ph / 2);
-    ctx.rotate(-Math.PI / 2);
-    ctx.textAlign = "center";
-    ctx.fillText("ω (rad/s)", 0, 0);
-    ctx.restore();
-
-    // Colour bar.
-    const bx = m.left + pw + 10;
-    const bw = 12;
-    for (let k = 0; k < ph; k++) {
-      const [r, g, b] = colour(1 - k / ph);
-      ctx.fillStyle = `rgb(${r},${g},${b})`;
-      ctx.fillRect(bx, m.top + k, bw, 1);
-    }
-    ctx.strokeStyle = "#333";
-    ctx.strokeRect(bx + 0.5, m.top + 0.5, bw - 1, ph - 1);
-    ctx.fillStyle = "#333";
-    ctx.textAlign = "left";
-    for (const v of ticks(lo, hi, 5)) {
-      if (logColour && !Number.isInteger(v)) continue;
-      const y = m.top + ph - ((v - lo) / (hi - lo || 1)) * ph;
-      ctx.fillRect(bx + bw, y, 3, 1);
-      const text = logColour ? (v >= -2 && v <= 3 ? fmt(10 ** v, 2) : `1e${v}`) : fmt(v, 2);
-      ctx.fillText(text, bx + bw + 5, Math.min(m.top + ph - 5, Math.max(m.top + 5, y)));
-    }
-    ctx.textAlign = "center";
-    ctx.textBaseline = "top";
-    ctx.fillText("|y| (m)", bx + bw / 2 + (narrow ? 14 : 18), m.top + ph + 21);
-  }
-
-  function heatReadout(ev) {
-    const L = heat.layout;
-    const out = $("#fr-heat-readout");
-    if (!L) return;
-    const rect = ev.target.getBoundingClientRect();
-    const x = ev.clientX - rect.left - L.m.left;
-    const y = ev.clientY - rect.top - L.m.top;
-    if (x < 0 || y < 0 || x > L.pw || y > L.ph) {
-      out.innerHTML = "&nbsp;";
-      return;
-    }
-    const j = Math.min(L.t.length - 1, Math.floor((x / L.pw) * L.t.length));
-    const i = Math.min(L.w.length - 1, Math.floor(((L.ph - y) / L.ph) * L.w.length));
-    out.textContent = `t = ${fmt(L.t[j])} s, ω = ${fmt(L.w[i])} rad/s: envelope ${fmt(L.E[i][j])} m`;
-  }
-  $("#fr-smooth").addEventListener("change", drawHeatmap);
-  $("#fr-log").addEventListener("change", drawHeatmap);
-  $("#tr-log").addEventListener("change", () => {
-    if (state.result) renderRun(state.result, state.request, state.via, true);
-  });
-  $("#fr-heatmap").addEventListener("mousemove", heatReadout);
-  $("#fr-heatmap").addEventListener("mouseleave", () => ($("#fr-heat-readout").innerHTML = "&nbsp;"));
-
-  function renderFrequency(res, req, via) {
-    state.fr.result = res;
-    state.fr.request = req;
-    state.fr.via = via;
-    const peak = res.envelope_m.map((row) => row.reduce((a, v) => (Number.isFinite(v) ? Math.max(a, v) : a), 0));
-    state.fr.peak = { frequencies_rad_s: res.frequencies_rad_s.slice(), peak_m: peak };
-    $("#fr-log").checked = res.outcomes.includes("diverged");
-    state.fr.plot?.destroy();
-    // Diverged runs peak at up to 1e100 m: then the peaks go on a log scale.
-    const log = res.outcomes.includes("diverged");
-    state.fr.plot = makePlot(
-      $("#fr-plot-peak"),
-      [
-        { label: "ω (rad/s)", value: (u, v) => fmt(v, 4) },
-        { label: "peak tip amplitude (m)", stroke: COLORS.tip, width: 2, points: { show: true, size: 7, fill: COLORS.tip }, value: log ? pow10 : (u, v) => fmt(v) },
-      ],
-      [res.frequencies_rad_s, log ? log10(peak) : peak],
-      "Wind frequency ω (rad/s)",
-      log ? "Peak amplitude (m), log scale" : "Peak amplitude (m)",
-      { log },
-    );
-    drawHeatmap();
-    $("#fr-csv").disabled = false;
-    const best = peak.indexOf(Math.max(...peak));
-    const bad = res.outcomes.filter((o) => o !== "completed").length;
-    setFrStatus(
-      "ready",
-      `${res.frequencies_rad_s.length} frequencies × ${res.time_s.length} times; largest peak ${fmt(peak[best])} m at ω = ${fmt(res.frequencies_rad_s[best])} rad/s` +
-        `${bad ? `; ${bad} run(s) did not complete (${[...new Set(res.outcomes.filter((o) => o !== "completed"))].join(", ")})` : ""}` +
-        `${via && via !== "direct" ? ` (${via})` : ""}.`,
-    );
-  }
-
   // ---------- submitting ----------
 
   // Runs `req` directly or as a job; resolves to {result, via} or {status, error}.
   async function solve(path, kind, req, useJob, setStatus, job, what) {
     if (useJob) {
       setStatus("busy", `Submitting a job (${what})…`);
-      return job(kind, req, what);
+      return job(kind, req, what, setStatus);
     }
     setStatus("busy", `Computing (${what})…`);
-    const r = await api("POST", path, req);
-    if (needsJob(r)) {
+    const r = await S.api("POST", path, req);
+    if (S.needsJob(r)) {
       setStatus("busy", "The server asked for a background job…");
-      return job(kind, req, what);
+      return job(kind, req, what, setStatus);
     }
     return r.ok ? { result: r.body, via: "direct" } : { status: r.status, error: r.body };
   }
@@ -908,7 +503,8 @@
     ev.preventDefault();
     if (runBusy) return;
     clearErrors();
-    showFormError($("#tr-form-error"), "");
+    S.showFormError($("#tr-form-error"), "");
+    S.writeUrl();
     const errors = [];
     const req = readSimulateRequest(errors);
     if (errors.length) return showInputErrors(errors, setRunStatus);
@@ -923,26 +519,6 @@
     }
   });
 
-  let frBusy = false;
-  frForm.addEventListener("submit", async (ev) => {
-    ev.preventDefault();
-    if (frBusy) return;
-    clearErrors();
-    showFormError($("#fr-form-error"), "");
-    const errors = [];
-    const req = readFrequencyRequest(errors);
-    if (errors.length) return showInputErrors(errors, setFrStatus);
-    frBusy = true;
-    $("#fr-run").disabled = true;
-    try {
-      const n = req.frequencies_rad_s.count;
-      const outcome = await solve("/api/v1/frequency-response", "frequency_response", req, frWantsJob(req), setFrStatus, frJob, `${n} frequencies`);
-      finish(outcome, (res) => renderFrequency(res, req, outcome.via), setFrStatus, $("#fr-form-error"));
-    } finally {
-      frBusy = false;
-      $("#fr-run").disabled = false;
-    }
-  });
 
   // ---------- form behaviour ----------
 
@@ -967,47 +543,30 @@
     const errors = [];
     const req = readSimulateRequest(errors);
     $("#tr-hint").textContent = errors.length ? "" : runWantsJob(req) ? "long run · runs as a background job" : "";
-    const fe = [];
-    const fr = readFrequencyRequest(fe);
-    const n = fr.frequencies_rad_s.count;
-    $("#fr-hint").textContent = fe.length ? "" : `${n} run${n === 1 ? "" : "s"}${frWantsJob(fr) ? " · runs as a background job" : ""}`;
+    state.lib.updateFrequencyHint?.();
   }
 
-  for (const f of [form, frForm]) {
-    f.addEventListener("input", (ev) => {
-      if (ev.target.matches("input")) clearFieldError(ev.target);
-      updateHints();
-    });
-  }
+  const stale = () => {
+    if (state.result && $("#tr-status").dataset.state === "ready") setRunStatus("stale", "Inputs changed: run again.");
+  };
+  form.addEventListener("input", (ev) => {
+    if (ev.target.matches("input")) S.clearFieldError(ev.target);
+    S.writeUrl();
+    stale();
+    updateHints();
+  });
   $("#chart-form")?.addEventListener("input", updateHints);
+  document.addEventListener("tetherplan:system-input", () => {
+    stale();
+    updateHints();
+  });
 
   // ---------- downloads ----------
 
-  function download(text, name) {
-    const url = URL.createObjectURL(new Blob([text], { type: "text/csv" }));
-    const a = document.createElement("a");
-    a.href = url;
-    a.download = name;
-    document.body.append(a);
-    a.click();
-    a.remove();
-    setTimeout(() => URL.revokeObjectURL(url), 1000);
-  }
+  const { inputLines, sig } = S;
+  const download = (text, name) => S.download(text, name, "text/csv");
 
   const RUN_COLUMNS = ["time_s", "length_m", "rate_m_s", "tip_deflection_m", "tip_velocity_m_s", "tip_envelope_m", "energy_j", "vibration_energy_j", "tip_force_n"];
-
-  // Every input of the request as `# input <path>,<value>` lines.
-  function inputLines(obj, prefix = "", out = []) {
-    for (const [k, v] of Object.entries(obj ?? {})) {
-      const key = prefix ? `${prefix}.${k}` : k;
-      if (v && typeof v === "object" && !Array.isArray(v)) inputLines(v, key, out);
-      else out.push(`# input ${key},${Array.isArray(v) ? v.join(" ") : sig(v)}`);
-    }
-    return out;
-  }
-
-  // Six significant digits: what the model resolves, not 16-digit floats.
-  const sig = (v) => (typeof v === "number" && Number.isFinite(v) ? String(Number(v.toPrecision(6))) : v == null ? "" : String(v));
 
   $("#tr-csv").addEventListener("click", () => {
     const r = state.result;
@@ -1018,13 +577,6 @@
     download(lines.join("\n") + "\n", "transient-run.csv");
   });
 
-  $("#fr-csv").addEventListener("click", () => {
-    const r = state.fr.result;
-    if (!r) return;
-    const lines = ["# tetherplan frequency response", ...inputLines(state.fr.request), "angular_frequency_rad_s,time_s,envelope_m"];
-    r.frequencies_rad_s.forEach((w, i) => r.time_s.forEach((t, j) => lines.push(`${sig(w)},${sig(t)},${sig(r.envelope_m[i][j])}`)));
-    download(lines.join("\n") + "\n", "frequency-response.csv");
-  });
 
   // ---------- resizing ----------
 
@@ -1035,11 +587,11 @@
       for (const [key, sel] of [["tip", "#tr-plot-tip"], ["energy", "#tr-plot-energy"], ["freq", "#tr-plot-freq"]]) {
         state.plots[key]?.setSize(plotSize($(sel)));
       }
-      state.fr.plot?.setSize(plotSize($("#fr-plot-peak")));
-      drawHeatmap();
+      state.lib.resizeFrequency?.();
     }, 100);
   });
 
-  drawHeatmap();
+  // What frequency.js reuses: the readers, the plot and the solve helpers.
+  Object.assign(state.lib, { S, roots, num, readSystem, readProfile, readInitial, readBody, makePlot, plotSize, fmt, log10, pow10, peakEnvelope, COLORS, solve, finish, clearErrors, showInputErrors, renderApiError });
   updateHints();
 })();

@@ -5,12 +5,20 @@
 //!
 //! * `chart_page.mjs` submits the default chart form, checks the plotted
 //!   curves, an error rendered next to its field and the console.
-//! * `plan_page.mjs` plans the defaults, checks the print layout and a shared URL.
+//! * `plan_page.mjs` types the issue-20 scenario into the system card and the
+//!   plan (inputs named by their request paths): 1000 m in a uniform 6 m/s
+//!   wind is NO-GO naming the wind, 900 m is GO with the tether length
+//!   shown; an edit turns `#verdict` stale at once with Print disabled, a
+//!   negative buoyancy turns it to `error` beside its field; a shared URL
+//!   plans at once with the same verdict; the card's values reach the
+//!   envelope's request; the verdict is above the fold at 1440×900, 390×844
+//!   and in print.
 //! * `transient_page.mjs` runs the default transient (thesis Fig 4.5) and
 //!   checks the resonance in the plotted envelope, runs a small frequency
 //!   response directly and a larger one as a job, checks API errors next to
 //!   their fields, the phone layout and the console.
-//! * `envelope_page.mjs` runs the operating-envelope panel's default, checks
+//! * `envelope_page.mjs` enters a system in the card and runs the
+//!   operating-envelope panel's default grid with it, checks
 //!   the feasible region's outline, the region labels, CSV/PNG export with
 //!   the inputs, a job with progress, and screenshots the page at 1280×800
 //!   and 390×844.

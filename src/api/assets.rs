@@ -80,6 +80,11 @@ mod tests {
         for f in [
             "index.html",
             "app.js",
+            "plan.js",
+            "shared/api.js",
+            "shared/form.js",
+            "shared/plot.js",
+            "shared/export.js",
             "style.css",
             "vendor/uPlot.iife.min.js",
         ] {
@@ -95,5 +100,27 @@ mod tests {
             assert_eq!(file.contents(), on_disk.as_slice(), "{f}");
         }
         assert_eq!(content_type("a/b.JS"), "text/javascript; charset=utf-8");
+    }
+
+    /// Every script and stylesheet `index.html` loads is built in (the
+    /// shared modules live in `static/shared/`).
+    #[test]
+    fn every_file_the_page_loads_is_embedded() {
+        let html = std::str::from_utf8(STATIC.get_file("index.html").unwrap().contents()).unwrap();
+        let mut loaded = 0;
+        for attr in ["src=\"", "href=\""] {
+            for part in html.split(attr).skip(1) {
+                let target = part.split('"').next().unwrap();
+                if !(target.ends_with(".js") || target.ends_with(".css")) {
+                    continue;
+                }
+                assert!(STATIC.get_file(target).is_some(), "{target} is embedded");
+                loaded += 1;
+            }
+        }
+        assert!(
+            loaded >= 12,
+            "index.html loads {loaded} scripts and stylesheets"
+        );
     }
 }

@@ -58,7 +58,7 @@ try {
   watch(page);
   const response = await page.goto(url, { waitUntil: "load" });
   check(response && response.ok(), `GET ${url} → ${response?.status()}`);
-  check((await page.title()).includes("deployment chart"), "page title names the deployment chart");
+  check((await page.title()).includes("go or no-go"), "page title names the launch decision");
 
   phase = "chart";
   if (await submitDefaultChart(page)) {
@@ -110,7 +110,7 @@ try {
   await page.click("#safe-button");
   await page.waitForSelector("#safe-result:not([hidden]), #safe-error:not([hidden])", { timeout: 30_000 });
   const maxRate = Number(await page.getAttribute("#safe-result", "data-max-rate"));
-  check(maxRate > 0 && maxRate < 113.2, `safe rate to 1200 m: ${maxRate.toFixed(2)} m/s (below the wave speed 113.2 m/s)`);
+  check(maxRate > 0 && maxRate < 113.2, `safe rate to the plan's 900 m: ${maxRate.toFixed(2)} m/s (below the wave speed 113.2 m/s)`);
 
   await page.screenshot({ path: path.join(artifacts, "chart_page.png"), fullPage: true });
 
@@ -137,10 +137,10 @@ try {
   check((await listError.getAttribute("data-error-for")) === "net_buoyancies_n[1]" && /^entry 2:/.test(await listError.textContent()), `error for net_buoyancies_n[1] next to the buoyancy list: “${await listError.textContent()}”`);
   await page.fill("#buoyancies", "500, 1000, 2000");
 
-  // The safe-rate calculator's own field.
-  await page.fill("#target", "-5");
+  // The safe rate goes to the plan's target altitude: its error lands there.
+  await page.fill("#plan-target", "-5");
   await page.click("#safe-button");
-  const targetError = page.locator(".field:has(#target) .field-error");
+  const targetError = page.locator(".field:has(#plan-target) .field-error");
   await targetError.waitFor({ timeout: 30_000 });
   check((await targetError.getAttribute("data-error-for")) === "target_elevation_m", `error next to the target elevation: “${await targetError.textContent()}”`);
   await context.close();

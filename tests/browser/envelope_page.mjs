@@ -3,9 +3,11 @@
 //
 //   node tests/browser/envelope_page.mjs http://127.0.0.1:8080/
 //
-// Loads the page at 1280×800, checks the plan is still the opening view, runs
-// the envelope panel's default (the OpenAPI example: Dyneema 6 mm, 2000 N,
-// 40 winds × 50 lengths, ceiling 2500 m, payout 5 m/s), checks the heat map
+// Loads the page at 1280×800, checks the verdict and the plan are still the
+// opening view, enters the OpenAPI example's system once in the system card
+// (Dyneema 6 mm, 2000 N, 100 kg, C_D 0.3 on 20 m², today's wind a log law)
+// and runs the envelope panel's default grid (40 winds × 50 lengths, ceiling
+// 2500 m, payout 5 m/s) with it, checks the heat map
 // against the API's altitudes, the feasible region's outline (every outline
 // edge separates a feasible cell from an infeasible one or the grid's edge),
 // the region labels (feasible and each binding limit present), the tables,
@@ -43,24 +45,31 @@ try {
   check(response && response.ok(), `GET ${url} → ${response?.status()}`);
   // The plan is the opening view: its heading is in the first screen, the envelope below it.
   const tops = await page.evaluate(() => ({
-    plan: document.querySelector("#plan-heading").getBoundingClientRect().top,
+    plan: document.querySelector("#verdict").getBoundingClientRect().top,
     envelope: document.querySelector("#envelope-heading").getBoundingClientRect().top,
     thesis: document.querySelector("#thesis-heading").getBoundingClientRect().top,
   }));
-  check(tops.plan < 200 && tops.envelope > tops.plan && tops.thesis > tops.envelope, `plan first (${tops.plan.toFixed(0)} px), then the envelope (${tops.envelope.toFixed(0)} px), then the thesis analyses`);
-  await page.waitForSelector('#plan-status[data-state="ready"]', { timeout: 30_000 }).catch(() => {});
+  check(tops.plan < 200 && tops.envelope > tops.plan && tops.thesis > tops.envelope, `the verdict first (${tops.plan.toFixed(0)} px), then the envelope (${tops.envelope.toFixed(0)} px), then the thesis analyses`);
+  await page.waitForSelector('#verdict[data-state="go"], #verdict[data-state="no-go"]', { timeout: 30_000 }).catch(() => {});
   await page.screenshot({ path: path.join(artifacts, "page_1280.png"), fullPage: false });
   await page.screenshot({ path: path.join(artifacts, "page_1280_full.png"), fullPage: true });
 
   phase = "envelope";
+  // The system, entered once in the card.
+  await page.selectOption('[name="cable.preset"]', "dyneema");
+  for (const [name, value] of [["cable.diameter_m", "0.006"], ["aerostat.net_buoyancy_n", "2000"], ["aerostat.mass_kg", "100"],
+    ["aerostat.drag_coefficient_nondim", "0.3"], ["aerostat.reference_area_m2", "20"]]) await page.fill(`[name="${name}"]`, value);
+  await page.selectOption('[name="wind.flow.kind"]', "log_law");
   if (await runEnvelope(page)) {
     const d = await page.evaluate(() => {
       const s = window.tetherplanEnvelope;
       return { req: s.request, res: s.result, regions: s.regions, outline: s.outline, via: s.via };
     });
     check(d.via === "direct", `2000 points answered directly (${d.via})`);
-    check(d.req.wind_speeds_m_s.count === 40 && d.req.tether_lengths_m.count === 50 && d.req.cable.preset === "dyneema" && d.req.ceiling_m === 2500 && d.req.payout_rate_m_s === 5,
-      "defaults: Dyneema, 40 winds × 50 lengths, ceiling 2500 m, payout 5 m/s");
+    check(d.req.wind_speeds_m_s.count === 40 && d.req.tether_lengths_m.count === 50 && d.req.ceiling_m === 2500 && d.req.payout_rate_m_s === 5,
+      "the panel's defaults: 40 winds × 50 lengths, ceiling 2500 m, payout 5 m/s");
+    check(d.req.cable.preset === "dyneema" && d.req.cable.mass_per_length_kg_m === undefined && d.req.aerostat.net_buoyancy_n === 2000 && d.req.aerostat.mass_kg === 100 &&
+      d.req.wind.flow?.kind === "log_law", `the card's system in the request (${JSON.stringify({ cable: d.req.cable, aerostat: d.req.aerostat })})`);
     check(d.res.points.length === 2000, `${d.res.points.length} points`);
     // Outline: every segment separates a feasible cell from an infeasible one (or the edge), and every such boundary is drawn.
     const nl = d.res.tether_lengths_m.length;
@@ -98,8 +107,8 @@ try {
     const csvPath = path.join(artifacts, "envelope_page.csv");
     await download.saveAs(csvPath);
     const all = readFileSync(csvPath, "utf8").trim().split("\n");
-    const need = ["# input cable.preset,dyneema", "# input cable.diameter_m,0.006", "# input aerostat.net_buoyancy_n,2000", "# input wind.shape.kind,power_law",
-      "# input wind.shape.exponent_nondim,0.14", "# input wind_speeds_m_s.count,40", "# input tether_lengths_m.max,3000", "# input ceiling_m,2500", "# input payout_rate_m_s,5",
+    const need = ["# input cable.preset,dyneema", "# input cable.diameter_m,0.006", "# input aerostat.net_buoyancy_n,2000", "# input wind.flow.kind,log_law",
+      "# input wind.flow.roughness_length_m,0.03", "# input wind_speeds_m_s.count,40", "# input tether_lengths_m.max,3000", "# input ceiling_m,2500", "# input payout_rate_m_s,5",
       "# input required_safety_factor_nondim,5"];
     const missing = need.filter((l) => !all.includes(l));
     check(missing.length === 0, `CSV records every input (${missing.join("; ") || "all present"})`);
@@ -141,12 +150,13 @@ try {
 
   // The API's error beside its field.
   phase = "invalid";
-  await page.fill("#env-diameter", "-1");
+  await page.fill("#cable-diameter", "-1");
   await page.click("#env-button");
-  const err = page.locator(".field:has(#env-diameter) .field-error");
+  const err = page.locator(".field:has(#cable-diameter) .field-error");
   await err.waitFor({ timeout: 30_000 });
-  check((await err.getAttribute("data-error-for")) === "cable.diameter_m", `error next to the diameter: “${await err.textContent()}”`);
-  await page.fill("#env-diameter", "0.006");
+  check((await err.getAttribute("data-error-for")) === "cable.diameter_m", `error next to the card's diameter: “${await err.textContent()}”`);
+  check(!/cable\.|_m\b/.test(await err.textContent()), "in plain words");
+  await page.fill("#cable-diameter", "0.006");
   check((await err.count()) === 0, "error clears when the field is edited");
   await context.close();
 
@@ -156,7 +166,7 @@ try {
   const small = await phone.newPage();
   watch(small);
   await small.goto(url, { waitUntil: "load" });
-  await small.waitForSelector('#plan-status[data-state="ready"]', { timeout: 30_000 }).catch(() => {});
+  await small.waitForSelector('#verdict[data-state="go"], #verdict[data-state="no-go"]', { timeout: 30_000 }).catch(() => {});
   await small.screenshot({ path: path.join(artifacts, "page_390.png"), fullPage: false });
   if (await runEnvelope(small)) {
     const overflow = await small.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);

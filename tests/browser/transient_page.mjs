@@ -225,13 +225,13 @@ try {
   check(/not a number/.test(await durError.textContent()), `page-side error next to the duration: “${await durError.textContent()}”`);
   await page.fill("#tr-duration", "60");
 
-  // A system field (cable, in the chart form above) refused by the transient route.
+  // A system field (the tether, in the system card above) refused by the transient route.
   await page.fill("#mass-per-length", "0");
   await page.click("#tr-run");
   const cableError = page.locator('.field:has(#mass-per-length) .field-error[data-source="transient"]');
   await cableError.waitFor({ timeout: 30_000 });
-  check((await cableError.getAttribute("data-error-for")) === "cable.mass_per_length_kg_m", `transient error on the chart form's ρA: “${await cableError.textContent()}”`);
-  check(/chart form above/.test(await page.textContent("#tr-status")), `status points at the chart form: “${await page.textContent("#tr-status")}”`);
+  check((await cableError.getAttribute("data-error-for")) === "cable.mass_per_length_kg_m", `transient error on the system card's mass per length: “${await cableError.textContent()}”`);
+  check(/system card above/.test(await page.textContent("#tr-status")), `status points at the system card: “${await page.textContent("#tr-status")}”`);
   await page.fill("#mass-per-length", "0.078");
   check((await cableError.count()) === 0, "ρA error clears when edited");
 
