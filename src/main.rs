@@ -132,7 +132,10 @@ fn answer_with<Req, Resp: Serialize>(
             return ExitCode::from(2);
         }
     };
-    match parse(&body).and_then(|req| run(&req)) {
+    match contract::json_keys::reject_duplicate_keys(&body)
+        .and_then(|()| parse(&body))
+        .and_then(|req| run(&req))
+    {
         Ok(resp) => {
             print_json(&resp);
             ExitCode::SUCCESS

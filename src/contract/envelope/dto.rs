@@ -26,7 +26,7 @@ pub enum WindShapeInput {
     },
     /// U(z) = U ln(z/z0)/ln(z_ref/z0).
     LogLaw {
-        #[schema(example = 0.03, exclusive_minimum = 0.0, maximum = 10.0)]
+        #[schema(example = 0.03, minimum = 0.000001, maximum = 10.0)]
         roughness_length_m: f64,
         #[serde(default = "default_reference_height")]
         #[schema(example = 10.0, exclusive_minimum = 0.0, maximum = 10000.0)]

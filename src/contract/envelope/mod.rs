@@ -67,8 +67,8 @@ impl WindShapeInput {
                 let z0 = require_range(
                     "wind.shape.roughness_length_m",
                     roughness_length_m,
-                    0.0,
-                    true,
+                    crate::contract::equilibrium::MIN_ROUGHNESS_M,
+                    false,
                     10.0,
                 )?;
                 let zr = require_range(

@@ -16,6 +16,10 @@ use crate::numerics::tether::{
 use dto::*;
 
 /// `value` finite and within `[min, max]`; `exclusive_min` excludes `min`.
+/// Smallest roughness length z0 (m): below it ln(z/z0) overflows in
+/// double precision long before any real surface (smooth ice ≈ 1e-5 m).
+pub const MIN_ROUGHNESS_M: f64 = 1e-6;
+
 pub(crate) fn require_range(
     field: &str,
     value: f64,
@@ -243,8 +247,8 @@ impl WindFlowInput {
                 require_range(
                     &f("roughness_length_m"),
                     *roughness_length_m,
-                    0.0,
-                    true,
+                    crate::contract::equilibrium::MIN_ROUGHNESS_M,
+                    false,
                     10.0,
                 )?;
                 WindProfile::log_law(

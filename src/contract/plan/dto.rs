@@ -195,7 +195,7 @@ pub struct PlanRequest {
     #[serde(default)]
     pub model: ModelInput,
     /// Cable length to end at (m); below `initial_length_m` plans a retrieval.
-    #[schema(example = 1200.0, exclusive_minimum = 0.0, maximum = 1e6)]
+    #[schema(example = 1200.0, minimum = 0.001, maximum = 1e6)]
     pub target_elevation_m: f64,
     pub winch: WinchInput,
     /// Stay stable with the net buoyancy reduced by this fraction
