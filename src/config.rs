@@ -55,6 +55,16 @@ pub struct ServeArgs {
     /// Seconds allowed between two pieces of a request body.
     #[arg(long, env = "TETHERPLAN_BODY_TIMEOUT_S", default_value_t = ConnectionLimits::default().body_timeout.as_secs_f64())]
     pub body_timeout_s: f64,
+    /// Seconds a whole request body may take to arrive (however it trickles).
+    #[arg(long, env = "TETHERPLAN_BODY_DEADLINE_S", default_value_t = ConnectionLimits::default().body_deadline.as_secs_f64())]
+    pub body_deadline_s: f64,
+    /// Seconds a whole answer may take to be written (a client that does not read is dropped).
+    #[arg(long, env = "TETHERPLAN_WRITE_DEADLINE_S", default_value_t = ConnectionLimits::default().write_deadline.as_secs_f64())]
+    pub write_deadline_s: f64,
+    /// Request-body bytes held at once over all connections; past it new
+    /// bodies are refused (503) until earlier requests finish.
+    #[arg(long, env = "TETHERPLAN_BODY_BUDGET_BYTES", default_value_t = ConnectionLimits::default().body_budget_bytes)]
+    pub body_budget_bytes: usize,
     #[command(flatten)]
     pub jobs: JobArgs,
 }
@@ -265,6 +275,10 @@ impl From<ServeArgs> for Config {
                 header_timeout: Duration::from_secs_f64(a.header_timeout_s.clamp(0.1, 3600.0)),
                 body_timeout: Duration::from_secs_f64(a.body_timeout_s.clamp(0.1, 3600.0)),
                 max_connections: a.max_connections.max(1),
+                body_deadline: Duration::from_secs_f64(a.body_deadline_s.clamp(0.1, 86_400.0)),
+                write_deadline: Duration::from_secs_f64(a.write_deadline_s.clamp(0.1, 86_400.0)),
+                max_body_bytes: a.max_body_bytes,
+                body_budget_bytes: a.body_budget_bytes.max(a.max_body_bytes),
                 ..ConnectionLimits::default()
             },
             allowed_hosts: a.allowed_hosts,

@@ -179,7 +179,10 @@ fn answer_with<Req, Resp: Serialize>(
             return ExitCode::from(2);
         }
     };
-    match resolve_system(arg, body).and_then(|body| parse(&body).and_then(|req| run(&req))) {
+    match contract::json_keys::reject_duplicate_keys(&body)
+        .and_then(|()| resolve_system(arg, body))
+        .and_then(|body| parse(&body).and_then(|req| run(&req)))
+    {
         Ok(resp) => {
             print_json(&resp);
             ExitCode::SUCCESS

@@ -581,13 +581,13 @@ fn cases() -> Vec<Case> {
             0.0,
             1e4,
         )),
-        exclusive(lit(
+        lit(
             "equilibrium",
             &eq_log,
             "wind.flow.roughness_length_m",
-            0.0,
+            1e-6,
             10.0,
-        )),
+        ),
         // envelope (the tether's bounds, and the grids and limits)
         lit("envelope", &env, "wind_speeds_m_s.min", 0.0, 150.0),
         lit("envelope", &env, "wind_speeds_m_s.max", 0.0, 150.0),
@@ -611,13 +611,13 @@ fn cases() -> Vec<Case> {
             0.0,
             1e4,
         )),
-        exclusive(lit(
+        lit(
             "envelope",
             &env_log,
             "wind.flow.roughness_length_m",
-            0.0,
+            1e-6,
             10.0,
-        )),
+        ),
         exclusive(lit("envelope", &env, "gravity_m_s2", 0.0, 100.0)),
         lit(
             "envelope",
@@ -648,7 +648,7 @@ fn cases() -> Vec<Case> {
         lit("plan", &pl, "lift_reserve_nondim", 0.0, 0.9),
         lit("plan", &pl, "required_safety_factor_nondim", 1.0, 100.0),
         exclusive(lit("plan", &pl, "cable.breaking_strength_n", 0.0, 1e9)),
-        exclusive(lit("plan", &pl, "target_elevation_m", 0.0, 1e6)),
+        lit("plan", &pl, "target_elevation_m", 1e-3, 1e6),
         exclusive(lit("plan", &pl, "winch.max_rate_m_s", 0.0, 1000.0)),
         exclusive(lit("plan", &pl, "winch.max_acceleration_m_s2", 0.0, 100.0)),
         exclusive(lit("plan", &pl, "winch.max_jerk_m_s3", 0.0, 1e4)),

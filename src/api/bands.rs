@@ -21,7 +21,7 @@ pub const MAX_SYNC_PLAN_BAND_VALUES: usize = 2_000_000;
 pub const MAX_SYNC_ENVELOPE_BAND_EVALUATIONS: usize = 10_000;
 
 fn to_json(value: &impl serde::Serialize) -> Result<Vec<u8>, ApiError> {
-    Ok(serde_json::to_vec(value).expect("responses serialise"))
+    Ok(crate::contract::finite::to_vec(value)?)
 }
 
 solve_path!(

@@ -11,9 +11,11 @@
 //!   `[::1]`) and the bind address; `TETHERPLAN_ALLOWED_HOSTS` adds names
 //!   (comma-separated; `*` allows any host). The port is not checked.
 //!   A request without a Host header (HTTP/1.0) passes: browsers always
-//!   send one.
+//!   send one. Two Host headers are 400; an absolute-form target
+//!   (`GET http://host/…`) must name an allowed host as well.
 
 use std::net::{IpAddr, SocketAddr};
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use axum::extract::Request;
@@ -104,26 +106,99 @@ impl HostAllowList {
         request: Request,
         next: Next,
     ) -> Response {
-        if let Some(host) = request.headers().get(header::HOST) {
+        let mut hosts = request.headers().get_all(header::HOST).iter();
+        let host = hosts.next();
+        if hosts.next().is_some() {
+            return ApiError::new(
+                StatusCode::BAD_REQUEST,
+                "bad_request",
+                Some("Host"),
+                "a request carries one Host header (RFC 9112 §3.2), this one has several",
+            )
+            .into_response();
+        }
+        let refuse = |shown: &[u8]| {
+            let shown = String::from_utf8_lossy(shown)
+                .chars()
+                .take(100)
+                .collect::<String>();
+            ApiError::new(
+                StatusCode::MISDIRECTED_REQUEST,
+                "host_not_allowed",
+                Some("Host"),
+                format!(
+                    "host {shown:?} is not served here; the operator can allow it with TETHERPLAN_ALLOWED_HOSTS"
+                ),
+            )
+            .into_response()
+        };
+        if let Some(host) = host {
             let ok = host.to_str().map(|h| list.allows(h)).unwrap_or(false);
             if !ok {
-                let shown = String::from_utf8_lossy(host.as_bytes())
-                    .chars()
-                    .take(100)
-                    .collect::<String>();
-                return ApiError::new(
-                    StatusCode::MISDIRECTED_REQUEST,
-                    "host_not_allowed",
-                    Some("Host"),
-                    format!(
-                        "host {shown:?} is not served here; the operator can allow it with TETHERPLAN_ALLOWED_HOSTS"
-                    ),
-                )
-                .into_response();
+                return refuse(host.as_bytes());
+            }
+        }
+        // An absolute-form target (`GET http://other.example/ HTTP/1.1`)
+        // names the host it addresses: it must be allowed too.
+        if let Some(authority) = request.uri().authority() {
+            let named = authority.as_str();
+            let named = named.rsplit_once('@').map_or(named, |(_, h)| h);
+            if !list.allows(named) {
+                return refuse(named.as_bytes());
             }
         }
         next.run(request).await
     }
+}
+
+/// The files of `dir` (`--static-dir`), confined to it: a path that
+/// resolves (through a symlink) outside the directory is 404, as if it
+/// were not there. `..` segments are already refused by `ServeDir`.
+pub fn confined_static_dir(dir: &Path) -> axum::Router {
+    let root = Arc::new(std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf()));
+    axum::Router::new()
+        .fallback_service(tower_http::services::ServeDir::new(dir))
+        .layer(axum::middleware::from_fn_with_state(root, confine))
+}
+
+async fn confine(
+    axum::extract::State(root): axum::extract::State<Arc<PathBuf>>,
+    request: Request,
+    next: Next,
+) -> Response {
+    let decoded = percent_decode(request.uri().path());
+    let candidate = root.join(decoded.trim_start_matches('/'));
+    let root2 = root.clone();
+    let escapes = tokio::task::spawn_blocking(move || {
+        std::fs::canonicalize(&candidate).is_ok_and(|real| !real.starts_with(&*root2))
+    })
+    .await
+    .unwrap_or(true);
+    if escapes {
+        return ApiError::not_found(format!("no file {}", request.uri().path())).into_response();
+    }
+    next.run(request).await
+}
+
+/// `%2e%2E` → `..`: the percent-decoding of a URL path (invalid escapes
+/// kept as they are; invalid UTF-8 replaced).
+fn percent_decode(path: &str) -> String {
+    let b = path.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' && i + 2 < b.len() {
+            let hex = |c: u8| (c as char).to_digit(16);
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
 }
 
 fn host_of_ip(ip: IpAddr) -> String {
@@ -133,11 +208,19 @@ fn host_of_ip(ip: IpAddr) -> String {
     }
 }
 
-/// `host:port` → `host`; `[v6]:port` → `[v6]`.
+/// `host:port` → `host`; `[v6]:port` → `[v6]`. Anything after `]` other
+/// than `:digits` is kept (`[::1]evil.com` is not `[::1]`).
 fn strip_port(h: &str) -> &str {
     if h.starts_with('[') {
         return match h.find(']') {
-            Some(end) => &h[..=end],
+            Some(end) => {
+                let rest = &h[end + 1..];
+                let port_only = rest.is_empty()
+                    || rest
+                        .strip_prefix(':')
+                        .is_some_and(|p| p.bytes().all(|b| b.is_ascii_digit()));
+                if port_only { &h[..=end] } else { h }
+            }
             None => h,
         };
     }
@@ -172,9 +255,52 @@ mod tests {
             "localhost.evil.example",
             "",
             "[::2]:80",
+            "[::1]evil.com",
+            "[::1].evil.com",
+            "[::1]:80evil.com",
         ] {
             assert!(!list.allows(bad), "{bad}");
         }
+    }
+
+    #[test]
+    fn percent_decoding_of_paths() {
+        assert_eq!(percent_decode("/a%2Fb%2e%2E/c%20d"), "/a/b../c d");
+        assert_eq!(percent_decode("/100%"), "/100%");
+        assert_eq!(percent_decode("/%zz%4"), "/%zz%4");
+    }
+
+    /// A symlink in the static directory pointing outside it is not
+    /// followed (404); files inside are served.
+    #[tokio::test]
+    async fn static_files_do_not_follow_symlinks_out() {
+        use tower::ServiceExt;
+        let base = std::env::temp_dir().join(format!("tp-static-{}", std::process::id()));
+        let dir = base.join("static");
+        let outside = base.join("secret");
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::create_dir_all(&outside).unwrap();
+        std::fs::write(dir.join("index.html"), "page").unwrap();
+        std::fs::write(outside.join("key.txt"), "secret").unwrap();
+        std::os::unix::fs::symlink(&outside, dir.join("link")).unwrap();
+        std::os::unix::fs::symlink(outside.join("key.txt"), dir.join("key.txt")).unwrap();
+        let app = confined_static_dir(&dir);
+        let get = |uri: &str| {
+            axum::http::Request::builder()
+                .uri(uri)
+                .body(axum::body::Body::empty())
+                .unwrap()
+        };
+        for (uri, status) in [
+            ("/index.html", 200),
+            ("/link/key.txt", 404),
+            ("/key.txt", 404),
+            ("/%6Cink/key.txt", 404),
+        ] {
+            let resp = app.clone().oneshot(get(uri)).await.unwrap();
+            assert_eq!(resp.status().as_u16(), status, "{uri}");
+        }
+        std::fs::remove_dir_all(&base).unwrap();
     }
 
     #[test]

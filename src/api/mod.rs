@@ -33,7 +33,6 @@ use axum::response::{IntoResponse, Response};
 use axum::routing::{any, get, post};
 use serde::Serialize;
 use tokio::sync::Semaphore;
-use tower_http::services::ServeDir;
 use tower_http::trace::TraceLayer;
 use utoipa::ToSchema;
 use utoipa_swagger_ui::SwaggerUi;
@@ -184,7 +183,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
         .with_state(state)
         .merge(SwaggerUi::new("/docs").url("/openapi.json", openapi::openapi()));
     let routes = match static_dir {
-        Some(dir) => routes.fallback_service(ServeDir::new(dir)),
+        Some(dir) => routes.fallback_service(guard::confined_static_dir(dir)),
         None => routes.fallback(assets::serve_embedded),
     };
     routes

@@ -33,12 +33,23 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 
+use std::pin::Pin;
+use std::sync::Mutex;
+use std::task::{Context, Poll};
+use std::time::Instant;
+
 use axum::Router;
+use axum::body::{Body, Bytes};
+use axum::http::{Request, Response, StatusCode, header};
+use axum::response::IntoResponse;
+use hyper::body::{Frame, Incoming, SizeHint};
 use hyper::server::conn::http1;
 use hyper_util::rt::{TokioIo, TokioTimer};
 use hyper_util::service::TowerToHyperService;
+
+use crate::api::error::ApiError;
 use tokio::net::TcpListener;
-use tokio::sync::{Notify, watch};
+use tokio::sync::{Notify, OwnedSemaphorePermit, Semaphore, watch};
 
 /// File descriptors kept free of connections (database, WAL, job threads,
 /// logs, the listener).
@@ -56,6 +67,18 @@ pub struct ConnectionLimits {
     pub max_connections: usize,
     /// How long a connection asked to close may take to finish its answer.
     pub close_grace: Duration,
+    /// Time allowed for a whole request body, from its head on (a body
+    /// trickling a byte at a time is dropped at this deadline).
+    pub body_deadline: Duration,
+    /// Time allowed for writing a whole answer (a client that does not
+    /// read it is dropped at this deadline, and the answer freed).
+    pub write_deadline: Duration,
+    /// Largest request body; a larger `Content-Length` is 413 at once,
+    /// before any `100 Continue` and without reading a byte.
+    pub max_body_bytes: usize,
+    /// Request-body bytes held at once over all connections (read and not
+    /// yet answered); a body that would exceed it is refused (503).
+    pub body_budget_bytes: usize,
 }
 
 impl Default for ConnectionLimits {
@@ -65,6 +88,10 @@ impl Default for ConnectionLimits {
             body_timeout: Duration::from_secs(10),
             max_connections: 10_000,
             close_grace: Duration::from_secs(60),
+            body_deadline: Duration::from_secs(30),
+            write_deadline: Duration::from_secs(120),
+            max_body_bytes: 1 << 20,
+            body_budget_bytes: 64 << 20,
         }
     }
 }
@@ -170,6 +197,7 @@ pub async fn run(
     cap: usize,
     shutdown: impl Future<Output = ()>,
 ) {
+    crate::api::error::install_panic_hook();
     let registry = Arc::new(Registry {
         live: AtomicUsize::new(0),
         open: std::sync::Mutex::new(VecDeque::new()),
@@ -182,6 +210,9 @@ pub async fn run(
         .header_read_timeout(limits.header_timeout)
         .keep_alive(true);
     let builder = Arc::new(builder);
+    let budget = Arc::new(Semaphore::new(
+        limits.body_budget_bytes.clamp(1, Semaphore::MAX_PERMITS),
+    ));
     let mut next_id: u64 = 0;
     let mut refused_logged = false;
     tokio::pin!(shutdown);
@@ -227,27 +258,47 @@ pub async fn run(
         }
         let guard = LiveGuard(registry.clone(), id);
         let builder = builder.clone();
-        let service = TowerToHyperService::new(app.clone());
+        let conn_state = Arc::new(ConnState::new());
+        let service = ConnService {
+            app: app.clone(),
+            state: conn_state.clone(),
+            budget: budget.clone(),
+            max_body_bytes: limits.max_body_bytes,
+        };
         let mut stopping = stopping.clone();
-        let grace = limits.close_grace;
+        let limits = limits.clone();
         tokio::spawn(async move {
             let _guard = guard;
             let conn = builder.serve_connection(TokioIo::new(stream), service);
             tokio::pin!(conn);
-            let asked_to_close = tokio::select! {
+            tokio::select! {
                 r = conn.as_mut() => {
                     if let Err(e) = r {
                         tracing::debug!("connection ended: {e}");
                     }
-                    false
+                    return;
                 }
-                _ = stop.notified() => true,
-                _ = stopping.wait_for(|s| *s) => true,
-            };
-            if asked_to_close {
-                conn.as_mut().graceful_shutdown();
-                let _ = tokio::time::timeout(grace, conn).await;
+                _ = stop.notified() => {}
+                _ = stopping.wait_for(|s| *s) => {}
+                why = conn_state.past_deadline(&limits) => {
+                    tracing::debug!("connection dropped: {why}");
+                    return;
+                }
             }
+            // Asked to close. A body still arriving is dropped, not waited
+            // for: it cannot be answered before it ends.
+            if conn_state.phase() == Phase::Body {
+                tracing::debug!("connection asked to close while its body arrives: dropped");
+                return;
+            }
+            conn.as_mut().graceful_shutdown();
+            let _ = tokio::time::timeout(limits.close_grace, async {
+                tokio::select! {
+                    _ = conn.as_mut() => {}
+                    _ = conn_state.past_deadline(&limits) => {}
+                }
+            })
+            .await;
         });
     }
     drop(listener);
@@ -255,6 +306,286 @@ pub async fn run(
     let deadline = tokio::time::Instant::now() + limits.close_grace;
     while registry.live.load(Ordering::Acquire) > 0 && tokio::time::Instant::now() < deadline {
         tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+}
+
+/// Where a connection is in its current exchange.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Phase {
+    /// Waiting for a request head (hyper's header timeout applies).
+    Idle,
+    /// A request body is arriving.
+    Body,
+    /// The answer is being computed (the solve timeout applies).
+    Handling,
+    /// The answer is being written.
+    Writing,
+}
+
+/// The phase of one connection and when it began.
+pub(crate) struct ConnState {
+    phase: Mutex<(Phase, Instant)>,
+    /// Signalled at every change of phase.
+    changed: Notify,
+}
+
+impl ConnState {
+    fn new() -> Self {
+        Self {
+            phase: Mutex::new((Phase::Idle, Instant::now())),
+            changed: Notify::new(),
+        }
+    }
+
+    fn set(&self, phase: Phase) {
+        *self.phase.lock().unwrap_or_else(|e| e.into_inner()) = (phase, Instant::now());
+        self.changed.notify_one();
+    }
+
+    /// Moves from `from` to `to` (nothing when in another phase).
+    fn leave(&self, from: Phase, to: Phase) {
+        let mut p = self.phase.lock().unwrap_or_else(|e| e.into_inner());
+        if p.0 == from {
+            *p = (to, Instant::now());
+            drop(p);
+            self.changed.notify_one();
+        }
+    }
+
+    /// Resolves when the connection is past the deadline of its phase
+    /// (no timer runs while it is idle or computing).
+    async fn past_deadline(&self, limits: &ConnectionLimits) -> &'static str {
+        loop {
+            let changed = self.changed.notified();
+            if let Some(why) = self.overdue(limits) {
+                return why;
+            }
+            let (phase, since) = *self.phase.lock().unwrap_or_else(|e| e.into_inner());
+            let deadline = match phase {
+                Phase::Body => Some(since + limits.body_deadline),
+                Phase::Writing => Some(since + limits.write_deadline),
+                Phase::Idle | Phase::Handling => None,
+            };
+            match deadline {
+                Some(at) => {
+                    tokio::select! {
+                        _ = changed => {}
+                        _ = tokio::time::sleep_until(at.into()) => {}
+                    }
+                }
+                None => changed.await,
+            }
+        }
+    }
+
+    fn phase(&self) -> Phase {
+        self.phase.lock().unwrap_or_else(|e| e.into_inner()).0
+    }
+
+    /// Why the connection must be dropped now, if it must.
+    fn overdue(&self, limits: &ConnectionLimits) -> Option<&'static str> {
+        let (phase, since) = *self.phase.lock().unwrap_or_else(|e| e.into_inner());
+        let age = since.elapsed();
+        match phase {
+            Phase::Body if age > limits.body_deadline => Some("request body past its deadline"),
+            Phase::Writing if age > limits.write_deadline => {
+                Some("answer not read within its deadline")
+            }
+            _ => None,
+        }
+    }
+}
+
+/// Why the server stopped reading a body.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BodyRefusal {
+    /// The bytes held over all connections reached the budget.
+    Busy,
+}
+
+impl std::fmt::Display for BodyRefusal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Busy => f.write_str(
+                "the server holds as many request bytes as it accepts at once; retry shortly",
+            ),
+        }
+    }
+}
+
+impl std::error::Error for BodyRefusal {}
+
+/// The service of one connection: the application, with each request's
+/// body counted against the byte budget and the connection's phase kept.
+#[derive(Clone)]
+struct ConnService {
+    app: Router,
+    state: Arc<ConnState>,
+    budget: Arc<Semaphore>,
+    max_body_bytes: usize,
+}
+
+impl hyper::service::Service<Request<Incoming>> for ConnService {
+    type Response = Response<Body>;
+    type Error = std::convert::Infallible;
+    type Future =
+        Pin<Box<dyn Future<Output = Result<Response<Body>, std::convert::Infallible>> + Send>>;
+
+    fn call(&self, req: Request<Incoming>) -> Self::Future {
+        let this = self.clone();
+        Box::pin(async move {
+            let declared = req
+                .headers()
+                .get(header::CONTENT_LENGTH)
+                .and_then(|v| v.to_str().ok())
+                .and_then(|v| v.trim().parse::<u64>().ok());
+            if declared.is_some_and(|n| n > this.max_body_bytes as u64) {
+                // Refused from the head alone: no `100 Continue`, no byte read.
+                this.state.set(Phase::Writing);
+                let resp = ApiError::new(
+                    StatusCode::PAYLOAD_TOO_LARGE,
+                    "payload_too_large",
+                    Some("body"),
+                    format!(
+                        "Content-Length {} is larger than the {} bytes the server accepts (see --max-body-bytes)",
+                        declared.unwrap_or(0),
+                        this.max_body_bytes
+                    ),
+                )
+                .into_response();
+                let mut resp = crate::api::guard::security_headers(resp).await;
+                resp.headers_mut().insert(
+                    header::CONNECTION,
+                    header::HeaderValue::from_static("close"),
+                );
+                return Ok(resp.map(|b| Body::new(WatchedBody::new(b, this.state.clone()))));
+            }
+            let held = Arc::new(Mutex::new(None::<OwnedSemaphorePermit>));
+            let ended = hyper::body::Body::is_end_stream(req.body());
+            this.state
+                .set(if ended { Phase::Handling } else { Phase::Body });
+            let req = req.map(|b| {
+                Body::new(GuardedBody {
+                    inner: b,
+                    state: this.state.clone(),
+                    budget: this.budget.clone(),
+                    held: held.clone(),
+                })
+            });
+            let app = TowerToHyperService::new(this.app.clone());
+            let resp = match hyper::service::Service::call(&app, req).await {
+                Ok(r) => r,
+                Err(never) => match never {},
+            };
+            // The request's bytes are freed with the handler: the budget
+            // gets them back now (the handler's copy is gone too).
+            drop(held.lock().unwrap_or_else(|e| e.into_inner()).take());
+            this.state.set(Phase::Writing);
+            Ok(resp.map(|b| Body::new(WatchedBody::new(b, this.state.clone()))))
+        })
+    }
+}
+
+/// A request body counted against the byte budget; its end (or drop)
+/// ends the connection's body phase.
+struct GuardedBody {
+    inner: Incoming,
+    state: Arc<ConnState>,
+    budget: Arc<Semaphore>,
+    held: Arc<Mutex<Option<OwnedSemaphorePermit>>>,
+}
+
+impl hyper::body::Body for GuardedBody {
+    type Data = Bytes;
+    type Error = Box<dyn std::error::Error + Send + Sync>;
+
+    fn poll_frame(
+        mut self: Pin<&mut Self>,
+        cx: &mut Context<'_>,
+    ) -> Poll<Option<Result<Frame<Bytes>, Self::Error>>> {
+        match Pin::new(&mut self.inner).poll_frame(cx) {
+            Poll::Pending => Poll::Pending,
+            Poll::Ready(None) => {
+                self.state.leave(Phase::Body, Phase::Handling);
+                Poll::Ready(None)
+            }
+            Poll::Ready(Some(Err(e))) => Poll::Ready(Some(Err(Box::new(e)))),
+            Poll::Ready(Some(Ok(frame))) => {
+                if let Some(data) = frame.data_ref() {
+                    let n = u32::try_from(data.len()).unwrap_or(u32::MAX);
+                    if n > 0 {
+                        let Ok(permit) = self.budget.clone().try_acquire_many_owned(n) else {
+                            return Poll::Ready(Some(Err(Box::new(BodyRefusal::Busy))));
+                        };
+                        let mut held = self.held.lock().unwrap_or_else(|e| e.into_inner());
+                        match held.as_mut() {
+                            Some(p) => p.merge(permit),
+                            None => *held = Some(permit),
+                        }
+                    }
+                }
+                if self.inner.is_end_stream() {
+                    self.state.leave(Phase::Body, Phase::Handling);
+                }
+                Poll::Ready(Some(Ok(frame)))
+            }
+        }
+    }
+
+    fn is_end_stream(&self) -> bool {
+        self.inner.is_end_stream()
+    }
+
+    fn size_hint(&self) -> SizeHint {
+        self.inner.size_hint()
+    }
+}
+
+impl Drop for GuardedBody {
+    fn drop(&mut self) {
+        self.state.leave(Phase::Body, Phase::Handling);
+    }
+}
+
+/// An answer being written; its end (or drop) makes the connection idle.
+struct WatchedBody {
+    inner: Body,
+    state: Arc<ConnState>,
+}
+
+impl WatchedBody {
+    fn new(inner: Body, state: Arc<ConnState>) -> Self {
+        Self { inner, state }
+    }
+}
+
+impl hyper::body::Body for WatchedBody {
+    type Data = Bytes;
+    type Error = axum::Error;
+
+    fn poll_frame(
+        mut self: Pin<&mut Self>,
+        cx: &mut Context<'_>,
+    ) -> Poll<Option<Result<Frame<Bytes>, Self::Error>>> {
+        let r = Pin::new(&mut self.inner).poll_frame(cx);
+        if let Poll::Ready(None) = r {
+            self.state.leave(Phase::Writing, Phase::Idle);
+        }
+        r
+    }
+
+    fn is_end_stream(&self) -> bool {
+        self.inner.is_end_stream()
+    }
+
+    fn size_hint(&self) -> SizeHint {
+        self.inner.size_hint()
+    }
+}
+
+impl Drop for WatchedBody {
+    fn drop(&mut self) {
+        self.state.leave(Phase::Writing, Phase::Idle);
     }
 }
 

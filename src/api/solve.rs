@@ -139,8 +139,9 @@ impl AppState {
     }
 }
 
+/// The answer as JSON; never one holding a non-finite number (422).
 fn to_json(value: &impl Serialize) -> Result<Vec<u8>, ApiError> {
-    Ok(serde_json::to_vec(value).expect("responses serialise"))
+    Ok(contract::finite::to_vec(value)?)
 }
 
 fn limit_qep_elements(system: &SystemInput, limits: &Limits, why: &str) -> Result<(), ApiError> {

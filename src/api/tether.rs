@@ -16,7 +16,7 @@ use crate::contract::{self, equilibrium};
 use crate::numerics::chart::Parallelism;
 
 fn to_json(value: &impl serde::Serialize) -> Result<Vec<u8>, ApiError> {
-    Ok(serde_json::to_vec(value).expect("responses serialise"))
+    Ok(contract::finite::to_vec(value)?)
 }
 
 solve_path!(

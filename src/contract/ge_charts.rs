@@ -293,13 +293,14 @@ pub struct GeChartPointOutput {
     pub critical_time_s: Option<f64>,
     /// h* = L(t*) (m).
     pub max_elevation_m: Option<f64>,
-    /// String continuum bound (F/ρA − v²)/g (m), clipped at 0.
-    pub string_closed_form_elevation_m: f64,
+    /// String continuum bound (F/ρA − v²)/g (m), clipped at 0; null
+    /// without gravity (no weight: no bound).
+    pub string_closed_form_elevation_m: Option<f64>,
     /// Quasi-static bound for an extensible string of this series' axial
     /// stiffness EA = E*·EI/L0² (m), clipped at 0: above
     /// `string_closed_form_elevation_m` below the rate √((F+mg)/2ρA),
-    /// below it above that rate.
-    pub extensible_closed_form_elevation_m: f64,
+    /// below it above that rate; null without gravity.
+    pub extensible_closed_form_elevation_m: Option<f64>,
     /// Time at which the search ended without an onset (s).
     pub ended_at_s: Option<f64>,
     pub steps: usize,
@@ -588,8 +589,12 @@ pub fn ge_chart_points(
                 onset,
                 critical_time_s: p.critical_time_s,
                 max_elevation_m: p.max_elevation_m,
-                string_closed_form_elevation_m: p.string_closed_form_m,
-                extensible_closed_form_elevation_m: p.extensible_closed_form_m,
+                string_closed_form_elevation_m: crate::contract::ge_critical::finite(
+                    p.string_closed_form_m,
+                ),
+                extensible_closed_form_elevation_m: crate::contract::ge_critical::finite(
+                    p.extensible_closed_form_m,
+                ),
                 ended_at_s,
                 steps: p.steps,
                 qep_solves: p.qep_solves,

@@ -442,9 +442,9 @@ pub fn ge_critical(
         critical_time_nondim: t.map(|t| t / scale),
         max_elevation_m: r.length_m(&problem.profile),
         ended_at_s,
-        string_closed_form_elevation_m: rate.map(|v| closed(f64::INFINITY, v)),
+        string_closed_form_elevation_m: rate.and_then(|v| finite(closed(f64::INFINITY, v))),
         extensible_closed_form_elevation_m: rate
-            .map(|v| closed(model.section.axial_stiffness_n, v)),
+            .and_then(|v| finite(closed(model.section.axial_stiffness_n, v))),
         closed_form_applies: applies,
         closed_form_note: note,
         onset_root_axial_force_n: r.onset_root_axial_force_n,
@@ -565,10 +565,12 @@ pub struct GeStabilityResponse {
     pub rate_m_s: f64,
     pub acceleration_m_s2: f64,
     pub cable_motion: StartStateInput,
-    /// The string continuum bound (F/ρA − v²)/g at this rate (m), clipped at 0.
-    pub string_closed_form_elevation_m: f64,
-    /// The extensible string's quasi-static bound at this rate (m), clipped at 0.
-    pub extensible_closed_form_elevation_m: f64,
+    /// The string continuum bound (F/ρA − v²)/g at this rate (m), clipped
+    /// at 0; null without gravity (the weight sets the bound: none at g = 0).
+    pub string_closed_form_elevation_m: Option<f64>,
+    /// The extensible string's quasi-static bound at this rate (m), clipped
+    /// at 0; null without gravity.
+    pub extensible_closed_form_elevation_m: Option<f64>,
     pub stiffness_ratio: f64,
     pub elements: usize,
     /// L0 √(I_ρ/EI) (s).
@@ -665,10 +667,14 @@ pub fn ge_stability(req: &GeStabilityRequest) -> Result<GeStabilityResponse, Req
         rate_m_s: kin.rate_m_s,
         acceleration_m_s2: kin.acceleration_m_s2,
         cable_motion: req.cable_motion,
-        string_closed_form_elevation_m: string(f64::INFINITY).critical_length_m(v).unwrap_or(0.0),
-        extensible_closed_form_elevation_m: string(model.section.axial_stiffness_n)
-            .critical_length_m(v)
-            .unwrap_or(0.0),
+        string_closed_form_elevation_m: finite(
+            string(f64::INFINITY).critical_length_m(v).unwrap_or(0.0),
+        ),
+        extensible_closed_form_elevation_m: finite(
+            string(model.section.axial_stiffness_n)
+                .critical_length_m(v)
+                .unwrap_or(0.0),
+        ),
         stiffness_ratio: req.model.stiffness_ratio,
         elements: model.elements,
         time_scale_s: scale,
@@ -831,4 +837,10 @@ pub fn stability_any(req: &AnyStabilityRequest) -> Result<AnyStabilityResponse, 
             run::stability(r).map(AnyStabilityResponse::LinearString)
         }
     }
+}
+
+/// `Some(x)` for a finite closed-form bound; `None` where it does not
+/// exist (zero gravity: the string's bound F/(ρA g) is infinite).
+pub(crate) fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
 }

@@ -130,9 +130,12 @@ pub fn quasi_static_critical(
         critical_time_nondim: t.map(|t| t / scale),
         max_elevation_m: h,
         ended_at_s: ended,
-        string_closed_form_elevation_m: (v > 0.0).then(|| closed(f64::INFINITY)),
+        string_closed_form_elevation_m: (v > 0.0)
+            .then(|| closed(f64::INFINITY))
+            .and_then(crate::contract::ge_critical::finite),
         extensible_closed_form_elevation_m: (v > 0.0)
-            .then(|| closed(model.section.axial_stiffness_n)),
+            .then(|| closed(model.section.axial_stiffness_n))
+            .and_then(crate::contract::ge_critical::finite),
         closed_form_applies: v > 0.0,
         closed_form_note: (v <= 0.0).then(|| "no closed form for a retrieval".to_string()),
         onset_root_axial_force_n: match r.onset {

@@ -296,14 +296,15 @@ pub fn critical(req: &CriticalRequest) -> Result<CriticalResponse, RequestError>
     critical_with(req, &NoProgress)
 }
 
-/// [`critical`], stopping (`RequestError::Cancelled`) when `progress` is cancelled.
-pub fn critical_with(
-    req: &CriticalRequest,
-    progress: &dyn Progress,
-) -> Result<CriticalResponse, RequestError> {
+/// Slowest winch rate of a constant-rate critical-time search: below it
+/// t* overflows (a subnormal rate gives t* = ∞).
+pub const MIN_CRITICAL_RATE_M_S: f64 = 1e-6;
+
+/// Every check of a critical-time request that needs no solve (the
+/// synchronous route and a job submission alike).
+pub fn check_critical(req: &CriticalRequest) -> Result<(), RequestError> {
     let model = req.system.model()?;
-    let sys = model.system;
-    let profile = req.params.profile.profile(sys.initial_length_m)?;
+    req.params.profile.profile(model.system.initial_length_m)?;
     if let ProfileInput::ConstantRate { rate_m_s, .. } = req.params.profile {
         if rate_m_s == 0.0 {
             return Err(InvalidInput::new(
@@ -312,7 +313,28 @@ pub fn critical_with(
             )
             .into());
         }
+        if rate_m_s.abs() < MIN_CRITICAL_RATE_M_S {
+            return Err(InvalidInput::new(
+                "profile.rate_m_s",
+                format!(
+                    "must be at least {MIN_CRITICAL_RATE_M_S:e} m/s in magnitude (slower deployments never reach t* in finite numbers), got {rate_m_s:e}"
+                ),
+            )
+            .into());
+        }
     }
+    Ok(())
+}
+
+/// [`critical`], stopping (`RequestError::Cancelled`) when `progress` is cancelled.
+pub fn critical_with(
+    req: &CriticalRequest,
+    progress: &dyn Progress,
+) -> Result<CriticalResponse, RequestError> {
+    check_critical(req)?;
+    let model = req.system.model()?;
+    let sys = model.system;
+    let profile = req.params.profile.profile(sys.initial_length_m)?;
     let discretisation = req.system.discretisation()?;
     let answer = match discretisation {
         chart::Discretisation::Converged { relative_tolerance } => {

@@ -11,8 +11,9 @@ use crate::jobs::estimate::{self as est, Estimate, Estimate as E};
 use crate::jobs::kinds::JobKind;
 use crate::numerics::chart::Parallelism;
 
+/// The answer as JSON; never one holding a non-finite number.
 fn to_json(value: &impl serde::Serialize) -> Result<String, RequestError> {
-    Ok(serde_json::to_string(value).expect("responses serialise"))
+    crate::contract::finite::to_string(value)
 }
 
 /// One percentile band: 14 numbers and their keys.

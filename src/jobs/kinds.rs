@@ -46,8 +46,10 @@ pub trait JobKind: Serialize + Sized {
 pub use super::estimate::Estimate;
 use super::estimate::{self as est, Estimate as E};
 
+/// The answer as JSON; never one holding a non-finite number (the job
+/// fails `invalid_input`).
 fn to_json(value: &impl Serialize) -> Result<String, RequestError> {
-    Ok(serde_json::to_string(value).expect("responses serialise"))
+    crate::contract::finite::to_string(value)
 }
 
 impl JobKind for StabilityRequest {
@@ -92,9 +94,8 @@ impl JobKind for CriticalRequest {
         contract::parse(body)
     }
     fn validate(&self) -> Result<(), RequestError> {
-        let model = self.system.model()?;
-        self.params.profile.profile(model.system.initial_length_m)?;
-        Ok(())
+        // the synchronous route's own checks
+        run::check_critical(self)
     }
     fn run(&self, _: &dyn Progress) -> Result<String, RequestError> {
         to_json(&run::critical(self)?)

@@ -23,7 +23,7 @@ impl JobKind for PlanRequest {
         plan::validate_plan(self)
     }
     fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
-        Ok(serde_json::to_string(&plan::plan(self, progress)?).expect("responses serialise"))
+        crate::contract::finite::to_string(&plan::plan(self, progress)?)
     }
     /// The samples asked for, plus every phase start; a schedule has at
     /// most one phase per segment of the pass's grid (and twice that with

@@ -16,6 +16,7 @@ pub const STOP_GRACE: Duration = Duration::from_secs(20);
 
 /// Runs a worker process until SIGTERM/SIGINT.
 pub fn run(config: WorkerConfig) -> Result<(), Box<dyn std::error::Error>> {
+    crate::api::error::install_panic_hook();
     let store = config
         .store
         .open()

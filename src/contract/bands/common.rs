@@ -14,7 +14,7 @@ use crate::contract::bands::dto::{
 use crate::contract::bands::run::{MAX_OUT_OF_RANGE, MAX_SEED, distribution};
 use crate::contract::{Progress, RequestError};
 use crate::numerics::chart::Parallelism;
-use crate::numerics::params::InvalidInput;
+use crate::numerics::params::{InvalidInput, Range, compact};
 use crate::numerics::uncertainty::{self, Distribution, Ensemble};
 
 /// The `uncertainty` parameter of a plan or envelope bands request.
@@ -51,16 +51,167 @@ pub fn probability_output(events: usize, n: usize) -> ProbabilityOutput {
     }
 }
 
+/// The physical range of an uncertain field: a drawn value outside it is
+/// a rejected sample; a distribution whose parameters lie outside it, or
+/// with more than [`MAX_OUT_OF_RANGE`] of its mass outside it, is refused.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FieldRange {
+    pub min: f64,
+    /// `> min` rather than `≥ min`.
+    pub min_open: bool,
+    pub max: f64,
+    pub unit: &'static str,
+}
+
+impl FieldRange {
+    /// `[min, max]` of a validated range.
+    pub const fn closed(r: Range) -> Self {
+        Self {
+            min: r.min,
+            min_open: false,
+            max: r.max,
+            unit: r.unit,
+        }
+    }
+
+    /// `(min, max]`.
+    pub const fn open_below(min: f64, max: f64, unit: &'static str) -> Self {
+        Self {
+            min,
+            min_open: true,
+            max,
+            unit,
+        }
+    }
+
+    /// `[min, max]`.
+    pub const fn between(min: f64, max: f64, unit: &'static str) -> Self {
+        Self {
+            min,
+            min_open: false,
+            max,
+            unit,
+        }
+    }
+
+    /// Is `v` in the range (finite)?
+    pub fn contains(&self, v: f64) -> bool {
+        v.is_finite()
+            && (if self.min_open {
+                v > self.min
+            } else {
+                v >= self.min
+            })
+            && v <= self.max
+    }
+
+    /// The range in words (`must be greater than 0 and at most 1e7 N`).
+    pub fn words(&self) -> String {
+        let unit = if self.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {}", self.unit)
+        };
+        format!(
+            "must be {} {} and at most {}{unit}",
+            if self.min_open {
+                "greater than"
+            } else {
+                "at least"
+            },
+            compact(self.min),
+            compact(self.max)
+        )
+    }
+
+    /// Probability mass of `d` outside the range (NaN-free: 1 when the
+    /// distribution's numbers overflow).
+    pub fn mass_outside(&self, d: &Distribution) -> f64 {
+        let below = if self.min_open {
+            d.cdf(self.min)
+        } else {
+            d.cdf(self.min.next_down())
+        };
+        let outside = below + (1.0 - d.cdf(self.max));
+        if outside.is_finite() {
+            outside.clamp(0.0, 1.0)
+        } else {
+            1.0
+        }
+    }
+}
+
 /// A numeric field of a request that may be uncertain.
 pub trait UncertainField: Copy + Send + Sync + PartialEq {
     /// The request path (`aerostat.net_buoyancy_n`).
     fn path(self) -> &'static str;
+    /// The physical range of a drawn value.
+    fn range(self) -> FieldRange;
     /// Is a drawn value physical?
-    fn in_range(self, v: f64) -> bool;
-    /// The range in words (`must be greater than zero`).
-    fn range_words(self) -> &'static str;
+    fn in_range(self, v: f64) -> bool {
+        self.range().contains(v)
+    }
+    /// The range in words (`must be greater than 0 and at most 1e7 N`).
+    fn range_words(self) -> String {
+        self.range().words()
+    }
     /// Probability mass of `d` outside the range.
-    fn mass_outside(self, d: &Distribution) -> f64;
+    fn mass_outside(self, d: &Distribution) -> f64 {
+        self.range().mass_outside(d)
+    }
+}
+
+/// Refuses a distribution of `path` whose own numbers (mean, low, high)
+/// lie outside `range`, naming the parameter (`uncertainty.inputs[0].mean`),
+/// or that puts more than [`MAX_OUT_OF_RANGE`] of its mass outside it.
+pub fn check_distribution(
+    at: &str,
+    path: &str,
+    range: FieldRange,
+    d: &Distribution,
+) -> Result<(), RequestError> {
+    let params: Vec<(&str, f64)> = match *d {
+        Distribution::Normal { mean, .. } | Distribution::Lognormal { mean, .. } => {
+            vec![("mean", mean)]
+        }
+        Distribution::Uniform { low, high } => vec![("low", low), ("high", high)],
+    };
+    for (name, v) in params {
+        if !range.contains(v) {
+            return Err(InvalidInput::new(
+                format!("{at}.{name}"),
+                format!(
+                    "must lie in the range of {path} ({}), got {}",
+                    range.words(),
+                    compact(v)
+                ),
+            )
+            .into());
+        }
+    }
+    let outside = range.mass_outside(d);
+    if !(outside <= MAX_OUT_OF_RANGE) {
+        return Err(InvalidInput::new(
+            at,
+            format!(
+                "puts {:.2} % of its draws outside the range of {path} ({}); at most {} % may fall outside: narrow it, or use a lognormal",
+                100.0 * outside,
+                range.words(),
+                100.0 * MAX_OUT_OF_RANGE
+            ),
+        )
+        .into());
+    }
+    Ok(())
+}
+
+/// The field a failed draw counts against: the uncertain field the
+/// validation error names, else the first uncertain field.
+pub fn culprit<F: UncertainField>(fields: &[F], error: &InvalidInput) -> usize {
+    fields
+        .iter()
+        .position(|f| f.path() == error.field)
+        .unwrap_or(0)
 }
 
 /// The ensemble of `uncertainty` (sample count, seed, distributions).
@@ -100,19 +251,7 @@ pub fn resolve_fields<F: UncertainField>(
             )
             .into());
         }
-        let outside = f.mass_outside(&ensemble.inputs[i]);
-        if outside > MAX_OUT_OF_RANGE {
-            return Err(InvalidInput::new(
-                at,
-                format!(
-                    "puts {:.2} % of its draws outside the range of {path} ({}); at most {} % may fall outside: narrow it, or use a lognormal",
-                    100.0 * outside,
-                    f.range_words(),
-                    100.0 * MAX_OUT_OF_RANGE
-                ),
-            )
-            .into());
-        }
+        check_distribution(&at, path, f.range(), &ensemble.inputs[i])?;
         fields.push(f);
     }
     Ok(fields)
@@ -127,13 +266,15 @@ pub struct EnsembleResults<T> {
 
 /// Runs `eval(values)` for every sample whose draws are all in range (a
 /// sample with an out-of-range draw is counted against its first such
-/// field). `eval` returning `None` means cancelled.
+/// field). `eval` returning `None` means cancelled, `Some(Err(k))` a
+/// sample whose combination of draws is invalid (counted against field
+/// `k`: a failed draw is an outcome, never a panic).
 pub fn run_ensemble<F: UncertainField, T: Send>(
     ensemble: &Ensemble,
     fields: &[F],
     parallelism: Parallelism,
     progress: &dyn Progress,
-    eval: impl Fn(&[f64]) -> Option<T> + Sync,
+    eval: impl Fn(&[f64]) -> Option<SampleOutcome<T>> + Sync,
 ) -> Result<EnsembleResults<T>, RequestError> {
     let results = run_ensemble_range(
         ensemble,
@@ -158,9 +299,9 @@ pub fn run_ensemble_range<F: UncertainField, T: Send>(
     range: std::ops::Range<usize>,
     parallelism: Parallelism,
     progress: &dyn Progress,
-    eval: impl Fn(&[f64]) -> Option<T> + Sync,
+    eval: impl Fn(&[f64]) -> Option<SampleOutcome<T>> + Sync,
 ) -> Result<Vec<SampleOutcome<T>>, RequestError> {
-    let results: Vec<Result<Option<T>, usize>> = ensemble
+    let results: Vec<Result<Option<SampleOutcome<T>>, usize>> = ensemble
         .run_range(
             range,
             parallelism,
@@ -179,7 +320,7 @@ pub fn run_ensemble_range<F: UncertainField, T: Send>(
     results
         .into_iter()
         .map(|r| match r {
-            Ok(Some(t)) => Ok(Ok(t)),
+            Ok(Some(t)) => Ok(t),
             Ok(None) => Err(RequestError::Cancelled),
             Err(k) => Ok(Err(k)),
         })
@@ -246,12 +387,6 @@ pub fn split_uncertainty(body: &[u8]) -> Result<(Value, Map<String, Value>), Req
         params.insert("uncertainty".into(), u);
     }
     Ok((Value::Object(obj), params))
-}
-
-/// A field that must be `> 0` (or `≥ 0` with `zero_allowed`): the mass of
-/// `d` outside.
-pub fn mass_below_zero(d: &Distribution) -> f64 {
-    d.cdf(0.0)
 }
 
 /// Progress that reports nothing but passes cancellation on (the nominal

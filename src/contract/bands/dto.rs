@@ -52,7 +52,7 @@ pub struct BandsParams {
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(untagged)]
 pub enum RatesInput {
-    /// The rates (m/s), each > 0.
+    /// The rates (m/s), each between 1e-6 and 1000.
     List(Vec<f64>),
     Grid(BandsRateGrid),
 }
@@ -62,10 +62,10 @@ pub enum RatesInput {
 #[serde(deny_unknown_fields)]
 pub struct BandsRateGrid {
     /// Smallest rate (m/s).
-    #[schema(example = 1.0, exclusive_minimum = 0.0)]
+    #[schema(example = 1.0, minimum = 0.000001, maximum = 1000.0)]
     pub min: f64,
     /// Largest rate (m/s).
-    #[schema(example = 100.0, exclusive_minimum = 0.0)]
+    #[schema(example = 100.0, minimum = 0.000001, maximum = 1000.0)]
     pub max: f64,
     /// Number of rates.
     #[schema(example = 100, minimum = 1, maximum = 1000)]

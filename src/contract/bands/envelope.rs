@@ -21,7 +21,9 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::contract::bands::common::{self, ProbabilityOutput, UncertainField, UncertaintyParams};
+use crate::contract::bands::common::{
+    self, FieldRange, ProbabilityOutput, UncertainField, UncertaintyParams,
+};
 use crate::contract::bands::dto::{PercentileBand, RejectedSamplesOutput, UncertainInput};
 use crate::contract::envelope::dto::{EnvelopeRequest, EnvelopeResponse};
 use crate::contract::{Progress, RequestError, parse_value};
@@ -29,7 +31,7 @@ use crate::numerics::chart::Parallelism;
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::envelope::EnvelopeProblem;
 use crate::numerics::tether::{EquilibriumConfig, EquilibriumProblem};
-use crate::numerics::uncertainty::{self, Distribution};
+use crate::numerics::uncertainty;
 
 /// Most sample × cell equilibria of one envelope bands request (a job).
 pub const MAX_ENVELOPE_BAND_EVALUATIONS: usize = 2_000_000;
@@ -131,11 +133,6 @@ impl EnvelopeField {
         Self::Gravity,
     ];
 
-    /// `≥ 0` rather than `> 0`?
-    fn zero_allowed(self) -> bool {
-        matches!(self, Self::DragCoefficient | Self::NormalDragCoefficient)
-    }
-
     fn set(self, p: &mut EquilibriumProblem, v: f64) {
         match self {
             Self::NetBuoyancy => p.body.net_buoyancy_n = v,
@@ -178,25 +175,20 @@ impl UncertainField for EnvelopeField {
             Self::Gravity => "gravity_m_s2",
         }
     }
-    fn in_range(self, v: f64) -> bool {
-        v.is_finite()
-            && match self {
-                Self::LiftCoefficient => true,
-                f if f.zero_allowed() => v >= 0.0,
-                _ => v > 0.0,
-            }
-    }
-    fn range_words(self) -> &'static str {
+    fn range(self) -> FieldRange {
+        // The bounds of the equilibrium request's schema.
         match self {
-            Self::LiftCoefficient => "must be finite",
-            f if f.zero_allowed() => "must not be negative",
-            _ => "must be greater than zero",
-        }
-    }
-    fn mass_outside(self, d: &Distribution) -> f64 {
-        match self {
-            Self::LiftCoefficient => 0.0,
-            _ => common::mass_below_zero(d),
+            Self::NetBuoyancy => FieldRange::open_below(0.0, 1e8, "N"),
+            Self::DragCoefficient => FieldRange::between(0.0, 10.0, ""),
+            Self::LiftCoefficient => FieldRange::between(-10.0, 10.0, ""),
+            Self::ReferenceArea => FieldRange::open_below(0.0, 1e5, "m²"),
+            Self::MassPerLength => FieldRange::open_below(0.0, 1000.0, "kg/m"),
+            Self::Diameter => FieldRange::open_below(0.0, 1.0, "m"),
+            Self::NormalDragCoefficient => FieldRange::between(0.0, 10.0, ""),
+            Self::AxialStiffness => FieldRange::open_below(0.0, 1e12, "N"),
+            Self::BreakingStrength => FieldRange::open_below(0.0, 1e9, "N"),
+            Self::AirDensity => FieldRange::open_below(0.0, 5.0, "kg/m³"),
+            Self::Gravity => FieldRange::open_below(0.0, 100.0, "m/s²"),
         }
     }
 }
@@ -325,25 +317,23 @@ fn sample_cells(
             for (&f, &v) in prep.fields.iter().zip(values) {
                 f.set(&mut p.base, v);
             }
-            // The envelope's own validation: every draw is in range, so
-            // only a cancellation ends it early.
-            let env = p
-                .solve(config, Parallelism::Serial, &never, &cancelled)
-                .ok()??;
-            Some(
-                env.points
-                    .iter()
-                    .map(|pt| CellValue {
-                        max_tension_n: pt.equilibrium.max_tension_n,
-                        tension_exceeded: pt
-                            .equilibrium
-                            .safety_factor
-                            .is_some_and(|f| f < required),
-                        unstable: pt.verdict.stable == Some(false),
-                        outside: pt.verdict.limit.is_some(),
-                    })
-                    .collect::<Vec<_>>(),
-            )
+            // Every draw is in its field's range; should the envelope's
+            // own validation still refuse the sample, it is rejected.
+            let env = match p.solve(config, Parallelism::Serial, &never, &cancelled) {
+                Ok(Some(env)) => env,
+                Ok(None) => return None,
+                Err(e) => return Some(Err(common::culprit(&prep.fields, &e))),
+            };
+            Some(Ok(env
+                .points
+                .iter()
+                .map(|pt| CellValue {
+                    max_tension_n: pt.equilibrium.max_tension_n,
+                    tension_exceeded: pt.equilibrium.safety_factor.is_some_and(|f| f < required),
+                    unstable: pt.verdict.stable == Some(false),
+                    outside: pt.verdict.limit.is_some(),
+                })
+                .collect::<Vec<_>>()))
         },
     )
 }

@@ -30,7 +30,9 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::contract::bands::common::{self, ProbabilityOutput, UncertainField, UncertaintyParams};
+use crate::contract::bands::common::{
+    self, FieldRange, ProbabilityOutput, UncertainField, UncertaintyParams,
+};
 use crate::contract::bands::dto::{PercentileBand, RejectedSamplesOutput, UncertainInput};
 use crate::contract::bands::run::{RawSystem, SystemField};
 use crate::contract::dto::SystemInput;
@@ -39,7 +41,7 @@ use crate::contract::{Progress, RequestError, parse_value};
 use crate::numerics::chart::Parallelism;
 use crate::numerics::params::{AerostatSystem, InvalidInput};
 use crate::numerics::plan::STABILITY_MARGIN;
-use crate::numerics::uncertainty::{self, Distribution};
+use crate::numerics::uncertainty;
 
 /// Most sample × instant values of one plan bands request (a job).
 pub const MAX_PLAN_BAND_VALUES: usize = 20_000_000;
@@ -141,20 +143,11 @@ impl UncertainField for PlanField {
             Self::BreakingStrength => "cable.breaking_strength_n",
         }
     }
-    fn in_range(self, v: f64) -> bool {
+    fn range(self) -> FieldRange {
         match self {
-            Self::System(f) => f.in_range(v),
-            Self::BreakingStrength => v.is_finite() && v > 0.0,
+            Self::System(f) => f.valid_range(),
+            Self::BreakingStrength => FieldRange::open_below(0.0, 1e9, "N"),
         }
-    }
-    fn range_words(self) -> &'static str {
-        match self {
-            Self::System(f) => f.range_words(),
-            Self::BreakingStrength => "must be greater than zero",
-        }
-    }
-    fn mass_outside(self, d: &Distribution) -> f64 {
-        common::mass_below_zero(d)
     }
 }
 
@@ -398,10 +391,12 @@ fn sample_traces(
                     PlanField::BreakingStrength => breaking = Some(v),
                 }
             }
-            let sys = raw
-                .system()
-                .expect("the base system is valid and every draw is in range");
-            Some(trace(prep, instants, reserve, &sys, breaking))
+            // Each draw is in its field's range, but a combination (ρ·A)
+            // may still fall outside: a rejected sample.
+            Some(match raw.system() {
+                Ok(sys) => Ok(trace(prep, instants, reserve, &sys, breaking)),
+                Err(e) => Err(common::culprit(&prep.fields, &e)),
+            })
         },
     )
 }

@@ -18,11 +18,12 @@ use std::sync::Arc;
 
 use serde_json::{Map, Value};
 
+use crate::contract::bands::common::{FieldRange, UncertainField, check_distribution, culprit};
 use crate::contract::bands::dto::*;
 use crate::contract::dto::SystemInput;
 use crate::contract::{Progress, RequestError, parse_value};
 use crate::numerics::chart::{self, Discretisation, Parallelism};
-use crate::numerics::params::{AerostatSystem, InvalidInput, require_positive};
+use crate::numerics::params::{AerostatSystem, InvalidInput, ranges, require_positive};
 use crate::numerics::string::StringModel;
 use crate::numerics::string::critical::Onset;
 use crate::numerics::string::operators::StringOperators;
@@ -81,26 +82,26 @@ impl SystemField {
         Self::ALL.into_iter().find(|f| f.path() == path)
     }
 
-    /// Is zero allowed (`≥ 0`) or not (`> 0`)?
-    pub(crate) fn zero_allowed(self) -> bool {
-        matches!(self, Self::AerostatMass)
+    /// The validated range of the field (the system's own validation).
+    pub(crate) fn valid_range(self) -> FieldRange {
+        FieldRange::closed(match self {
+            Self::NetBuoyancy => ranges::NET_BUOYANCY_N,
+            Self::AerostatMass => ranges::AEROSTAT_MASS_KG,
+            Self::MassPerLength => ranges::MASS_PER_LENGTH_KG_M,
+            Self::Density => ranges::DENSITY_KG_M3,
+            Self::Area => ranges::AREA_M2,
+            Self::InitialLength => ranges::INITIAL_LENGTH_M,
+            Self::Gravity => ranges::GRAVITY_M_S2,
+        })
     }
+}
 
-    pub(crate) fn in_range(self, v: f64) -> bool {
-        v.is_finite()
-            && if self.zero_allowed() {
-                v >= 0.0
-            } else {
-                v > 0.0
-            }
+impl UncertainField for SystemField {
+    fn path(self) -> &'static str {
+        SystemField::path(self)
     }
-
-    pub(crate) fn range_words(self) -> &'static str {
-        if self.zero_allowed() {
-            "must not be negative"
-        } else {
-            "must be greater than zero"
-        }
+    fn range(self) -> FieldRange {
+        self.valid_range()
     }
 }
 
@@ -220,7 +221,8 @@ pub fn prepare(req: &BandsRequest) -> Result<Prepared, RequestError> {
                 .into());
             }
             for (i, &v) in list.iter().enumerate() {
-                require_positive(&format!("rates_m_s[{i}]"), v)?;
+                // the chart grid's range: a far slower rate has no finite t*
+                ranges::POSITIVE_RATE_M_S.check(&format!("rates_m_s[{i}]"), v)?;
             }
             list.clone()
         }
@@ -232,6 +234,8 @@ pub fn prepare(req: &BandsRequest) -> Result<Prepared, RequestError> {
                 )
                 .into());
             }
+            ranges::POSITIVE_RATE_M_S.check("rates_m_s.min", g.min)?;
+            ranges::POSITIVE_RATE_M_S.check("rates_m_s.max", g.max)?;
             chart::rate_grid(g.min, g.max, g.count)?
         }
     };
@@ -301,20 +305,7 @@ pub fn prepare(req: &BandsRequest) -> Result<Prepared, RequestError> {
             )
             .into());
         }
-        let dist = ensemble.inputs[i];
-        let outside = dist.cdf(0.0);
-        if outside > MAX_OUT_OF_RANGE {
-            return Err(InvalidInput::new(
-                at,
-                format!(
-                    "puts {:.2} % of its draws outside the range of {path} ({}); at most {} % may fall outside: narrow it, or use a lognormal",
-                    100.0 * outside,
-                    f.range_words(),
-                    100.0 * MAX_OUT_OF_RANGE
-                ),
-            )
-            .into());
-        }
+        check_distribution(&at, path, f.range(), &ensemble.inputs[i])?;
         fields.push(f);
     }
     Ok(Prepared {
@@ -426,10 +417,12 @@ fn sample_results(
                     }
                     raw.set(f, v);
                 }
-                let sys = raw
-                    .system()
-                    .expect("the base system is valid and every draw is in range");
-                Ok(evaluator.chart(sys, &prep.rates))
+                // Each draw is in its field's range, but a combination
+                // (ρ·A) may still fall outside: a rejected sample.
+                match raw.system() {
+                    Ok(sys) => Ok(evaluator.chart(sys, &prep.rates)),
+                    Err(e) => Err(culprit(&prep.fields, &e)),
+                }
             },
         )
         .ok_or(RequestError::Cancelled)

@@ -128,7 +128,7 @@ pub struct PlanRequest {
     /// Altitude of the aerostat to end at (m): in calm air the cable length, in
     /// wind the altitude in that wind (the answer's `wind.target_length_m` is the
     /// tether it needs); below `initial_length_m` plans a retrieval.
-    #[schema(example = 1200.0, exclusive_minimum = 0.0, maximum = 1e6)]
+    #[schema(example = 1200.0, minimum = 0.001, maximum = 1e6)]
     pub target_elevation_m: f64,
     pub winch: WinchInput,
     /// Stay stable with the net buoyancy reduced by this fraction

@@ -73,6 +73,10 @@ fn steady_wind(req: &PlanRequest, w: &WindInput) -> Result<SteadyWind, InvalidIn
     Ok(SteadyWind::new(cable, body, profile, rho))
 }
 
+/// Shortest target of a plan (m): the shortest length of the system
+/// ([`crate::numerics::params::ranges::LENGTH_M`]).
+pub const MIN_TARGET_M: f64 = crate::numerics::params::ranges::LENGTH_M.min;
+
 fn bounded(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64, InvalidInput> {
     require_finite(field, value)?;
     if !(lo..=hi).contains(&value) {
@@ -131,7 +135,14 @@ fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidI
     system_check::lift_reserve(req.lift_reserve_nondim)?;
     let breaking = req.cable.breaking_strength()?;
     let allowable = breaking.map(|b| b / sf);
-    require_finite("target_elevation_m", req.target_elevation_m)?;
+    // A target below a millimetre has no finite transient check (the
+    // string's length scale goes to zero).
+    bounded(
+        "target_elevation_m",
+        req.target_elevation_m,
+        MIN_TARGET_M,
+        1e6,
+    )?;
     // In wind the target is an altitude: the length that flies there.
     let (target_length, wind) = if air.is_calm() || (!resolve && air.has_ge()) {
         (req.target_elevation_m, None)

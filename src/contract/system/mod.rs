@@ -189,7 +189,7 @@ pub enum WindFlowInput {
         #[schema(example = 10.0, exclusive_minimum = 0.0, maximum = 10000.0)]
         reference_height_m: f64,
         /// Roughness length z0 (m): 0.0002 sea, 0.03 open terrain, 0.1 farmland, 1 city.
-        #[schema(example = 0.03, exclusive_minimum = 0.0, maximum = 10.0)]
+        #[schema(example = 0.03, minimum = 0.000001, maximum = 10.0)]
         roughness_length_m: f64,
     },
 }

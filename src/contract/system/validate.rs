@@ -463,8 +463,8 @@ impl WindFlowInput {
                 require_range(
                     &f("roughness_length_m"),
                     *roughness_length_m,
-                    0.0,
-                    true,
+                    MIN_ROUGHNESS_M,
+                    false,
                     10.0,
                 )?;
                 WindProfile::log_law(*speed_m_s, *reference_height_m, *roughness_length_m, at)?
@@ -544,3 +544,7 @@ pub fn check_rest(
     }
     Ok(())
 }
+
+/// Smallest roughness length z0 (m): below it ln(z/z0) overflows in
+/// double precision long before any real surface (smooth ice ≈ 1e-5 m).
+pub const MIN_ROUGHNESS_M: f64 = 1e-6;
