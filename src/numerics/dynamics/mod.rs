@@ -168,8 +168,9 @@ pub struct DynamicsConfig {
     pub sample_interval_s: f64,
     /// Times at which the shape is kept (s).
     pub shape_times_s: Vec<f64>,
-    /// Newton stops when the position correction is below this (m).
-    pub newton_tolerance_m: f64,
+    /// Newton stops when every velocity correction is below this (m/s);
+    /// positions are then corrected by less than `tol · β h/γ`.
+    pub newton_tolerance_m_s: f64,
     pub max_newton_iterations: usize,
     /// Sample spacing of a turbulence series (s).
     pub turbulence_time_step_s: f64,
@@ -186,7 +187,7 @@ impl Default for DynamicsConfig {
             spectral_radius: 0.8,
             sample_interval_s: 1.0,
             shape_times_s: vec![],
-            newton_tolerance_m: 1e-7,
+            newton_tolerance_m_s: 1e-7,
             max_newton_iterations: 30,
             turbulence_time_step_s: 0.1,
             turbulence_level_spacing_m: 25.0,
@@ -674,7 +675,7 @@ impl Stepper<'_> {
         } = self.alpha;
         self.an.copy_from_slice(&self.a);
         let ta = self.t + (1.0 - af) * h;
-        for it in 0..self.max_it {
+        for _ in 0..self.max_it {
             for k in 0..n {
                 for c in 0..2 {
                     let xn = self.x[k][c]
@@ -724,7 +725,8 @@ impl Stepper<'_> {
             if !big.is_finite() {
                 return false;
             }
-            if big * beta * h * h <= self.tol && it + 1 >= 1 {
+            // Converged when every velocity correction is below `tol` (m/s).
+            if big * gamma * h <= self.tol {
                 for k in 0..n {
                     for c in 0..2 {
                         self.x[k][c] += h * self.v[k][c]
@@ -798,7 +800,7 @@ pub fn simulate_from(
         alpha: Alpha::new(config.spectral_radius),
         schedule: &problem.length,
         air: &air,
-        tol: config.newton_tolerance_m,
+        tol: config.newton_tolerance_m_s,
         max_it: config.max_newton_iterations.max(1),
         x: state.positions,
         v: state.velocities,
