@@ -4,6 +4,7 @@
 
 pub mod aero;
 pub mod chart;
+pub mod dynamics;
 pub mod ge;
 pub mod ge_reduced;
 pub mod mesh;

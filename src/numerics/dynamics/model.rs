@@ -1,0 +1,398 @@
+//! The lumped-mass tether on a moving mesh: forces, convective terms and
+//! their Jacobian (SPEC §11).
+//!
+//! **Mesh.** Nodes `i = 0 … N` sit at fixed mapped coordinates
+//! `ζ_i = i/N`, `ζ = s/L(t)` (`s` the unstretched arc length from the
+//! winch): every segment has the unstretched length `l = L(t)/N`, node 0
+//! is the winch (fixed), node `N` the aerostat. Material enters at the
+//! winch, so a material point keeps its distance `L − s` from the top and
+//! moves through the mesh at `ζ̇ = (1 − ζ) L̇/L`. With `R(ζ, t)` the nodal
+//! positions, the material velocity and acceleration are
+//!
+//! ```text
+//! V = Ṙ + ζ̇ R_ζ
+//! A = R̈ + 2 ζ̇ Ṙ_ζ + ζ̇² R_ζζ + ζ̈ R_ζ,     ζ̈ = (1 − ζ)(L̈/L − 2 L̇²/L²)
+//! ```
+//!
+//! (`R_ζ`, `R_ζζ` by central differences; one-sided at the winch, where
+//! `V_0 = L̇ (1 + ε_1) t_1`: the material leaves the drum along the tether
+//! with the payout speed). The aerostat is a material node (`ζ̇ = 0`). No
+//! node is ever inserted or removed, the lumped masses `ρA l` grow with
+//! `L`, and the equation of every node is `m_i A_i = F_i`, so paying out
+//! or hauling in produces no tension spike: it is the continuum balance
+//! `ρA D²r/Dt² = ∂τ/∂s + f` sampled on nodes that slide along the
+//! material (the same mapping as the string model of SPEC §1, whose linear
+//! limit it reproduces, effective tension `T − ρA (1 − ζ)² L̇²` included).
+//!
+//! **Forces.** Segment `j` (nodes `j−1, j`): stretch `ε = ℓ/l − 1`,
+//! material strain rate `ε̇ = t·(V_j − V_{j−1})/l`, tension
+//! `T = max(0, EA ε + c ε̇)` for `ε > 0`, else 0 (a tether takes no
+//! compression; `c` the Kelvin–Voigt damping in N s). Weight `ρA g` per
+//! unstretched length, lumped; the aerostat adds its net buoyancy `F`
+//! upwards. Drag at node `i` on the relative velocity `u_r = U − V_i`
+//! split along the node tangent `q` (the chord of the neighbours):
+//! normal `½ρ C_n d λ |u_n| u_n`, tangential `½ρ C_t π d λ |u_t| u_t`,
+//! with `λ` the stretched length around the node (SPEC §6) or the
+//! unstretched one (as MoorDyn does). The aerostat: mass
+//! `m + C_a ρ V_d` (`V_d = (F + m g)/(ρ g)`), drag `½ρ C_D A |u_r| u_r`,
+//! lift `½ρ C_L A |u_r|²` normal to `u_r` (to the left of it: upwards in
+//! a wind blowing towards `+x`). No pressure-gradient (Froude–Krylov)
+//! force on the aerostat: SPEC §11 lists the forces above.
+//!
+//! **Jacobian.** `P = F − M (A − R̈)` (forces minus the convective part
+//! of the inertia) is differentiated exactly in the elastic, damping and
+//! convective terms and in the drag's dependence on the node's own
+//! velocity; the drag's dependence on the tangent and on the shear of
+//! `U(z)`, and the convective part of the material velocity inside drag
+//! and strain rate, are left out. That keeps the matrix block-tridiagonal
+//! (2×2 blocks); Newton then converges linearly at a rate set by those
+//! small terms, and the converged step is that of the exact residual.
+
+use crate::numerics::dynamics::blocks::{
+    self, B2, V2, ZERO, add, add_identity, add_to, dot, norm, outer, scale, sub,
+};
+
+/// Constant parameters of the discretised system (SI).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parameters {
+    pub segments: usize,
+    pub mass_per_length_kg_m: f64,
+    pub gravity_m_s2: f64,
+    pub axial_stiffness_n: f64,
+    pub damping_n_s: f64,
+    /// `½ ρ C_n d`.
+    pub normal_drag: f64,
+    /// `½ ρ C_t π d`.
+    pub tangential_drag: f64,
+    pub drag_on_stretched_length: bool,
+    pub net_buoyancy_n: f64,
+    /// `m + C_a ρ V_d` (kg).
+    pub aerostat_inertia_kg: f64,
+    /// `½ ρ C_D A`.
+    pub aerostat_drag: f64,
+    /// `½ ρ C_L A`.
+    pub aerostat_lift: f64,
+}
+
+/// Length, rate and acceleration of the unstretched tether at one instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Length {
+    pub length_m: f64,
+    pub rate_m_s: f64,
+    pub acceleration_m_s2: f64,
+}
+
+/// Work arrays and the results of one evaluation.
+#[derive(Clone, Debug)]
+pub struct Evaluation {
+    /// `P_i`, `i = 1 … N` (index `i − 1`).
+    pub force: Vec<V2>,
+    /// Diagonal mass `m_i` (kg), `i = 1 … N`.
+    pub mass: Vec<f64>,
+    /// `∂P/∂R`: lower / diagonal / upper blocks.
+    pub kx: [Vec<B2>; 3],
+    /// `∂P/∂Ṙ`.
+    pub cv: [Vec<B2>; 3],
+    /// Segment tensions `T_j`, `j = 1 … N` (index `j − 1`).
+    pub tension: Vec<f64>,
+    /// Segment unit tangents.
+    pub tangent: Vec<V2>,
+    /// Stretched segment lengths.
+    pub stretched: Vec<f64>,
+    /// Material velocities `V_i`, `i = 0 … N`.
+    pub material_velocity: Vec<V2>,
+    /// Tension vector at the winch `τ(0)` (N): `T_1 t_1` less the lower
+    /// half segment's weight plus its drag.
+    pub winch_force: V2,
+    /// Tension vector at the top `τ(L)` (N): `T_N t_N` plus the upper half
+    /// segment's weight less its drag.
+    pub top_force: V2,
+    /// Drag on the tether (excluding the aerostat), summed over the nodes `1 … N` (N).
+    pub tether_drag: V2,
+}
+
+impl Evaluation {
+    pub fn new(segments: usize) -> Self {
+        let n = segments;
+        Self {
+            force: vec![[0.0; 2]; n],
+            mass: vec![0.0; n],
+            kx: [vec![ZERO; n], vec![ZERO; n], vec![ZERO; n]],
+            cv: [vec![ZERO; n], vec![ZERO; n], vec![ZERO; n]],
+            tension: vec![0.0; n],
+            tangent: vec![[0.0; 2]; n],
+            stretched: vec![0.0; n],
+            material_velocity: vec![[0.0; 2]; n + 1],
+            winch_force: [0.0; 2],
+            top_force: [0.0; 2],
+            tether_drag: [0.0; 2],
+        }
+    }
+}
+
+/// Drag of a tether piece of length `lam` with tangent `q` on `u_r`;
+/// with `jac`, adds `−∂f/∂V` (= `∂f/∂u_r`, times −1 for the node velocity) to it.
+#[inline]
+fn tether_drag(p: &Parameters, q: V2, lam: f64, ur: V2, jac: Option<&mut B2>) -> V2 {
+    let n = [-q[1], q[0]];
+    let un = dot(ur, n);
+    let ut = dot(ur, q);
+    let kn = p.normal_drag * lam;
+    let kt = p.tangential_drag * lam;
+    let f = add(scale(kn * un.abs() * un, n), scale(kt * ut.abs() * ut, q));
+    if let Some(j) = jac {
+        add_to(j, -1.0, &outer(2.0 * kn * un.abs(), n, n));
+        add_to(j, -1.0, &outer(2.0 * kt * ut.abs(), q, q));
+    }
+    f
+}
+
+#[inline]
+fn unit(v: V2) -> V2 {
+    let r = norm(v);
+    if r > 0.0 {
+        scale(1.0 / r, v)
+    } else {
+        [0.0, 1.0]
+    }
+}
+
+/// Evaluates `P(t, R, Ṙ)` and, when `jacobian`, its blocks. `pos`, `vel`
+/// hold nodes `1 … N` (the winch is the origin, at rest); `wind(x, z)`
+/// is the air velocity `(u, 0)` at a point at this instant.
+pub fn evaluate(
+    p: &Parameters,
+    len: Length,
+    pos: &[V2],
+    vel: &[V2],
+    wind: &dyn Fn(f64, f64) -> f64,
+    jacobian: bool,
+    out: &mut Evaluation,
+) {
+    let n = p.segments;
+    let big_l = len.length_m;
+    let l = big_l / n as f64;
+    let dzeta = 1.0 / n as f64;
+    let rate = len.rate_m_s / big_l;
+    let accel_term = len.acceleration_m_s2 / big_l - 2.0 * rate * rate;
+    let node = |i: usize| -> V2 { if i == 0 { [0.0; 2] } else { pos[i - 1] } };
+    let nvel = |i: usize| -> V2 { if i == 0 { [0.0; 2] } else { vel[i - 1] } };
+    let rho_a = p.mass_per_length_kg_m;
+
+    // Mapped derivatives and material velocities.
+    let zeta_dot = |i: usize| (1.0 - i as f64 * dzeta) * rate;
+    for i in 0..=n {
+        let zd = zeta_dot(i);
+        let d = if i == 0 {
+            scale(1.0 / dzeta, sub(node(1), node(0)))
+        } else if i < n {
+            scale(0.5 / dzeta, sub(node(i + 1), node(i - 1)))
+        } else {
+            [0.0; 2]
+        };
+        out.material_velocity[i] = add(nvel(i), scale(zd, d));
+    }
+
+    for k in 0..n {
+        out.force[k] = [0.0; 2];
+        out.mass[k] = if k + 1 == n {
+            0.5 * rho_a * l + p.aerostat_inertia_kg
+        } else {
+            rho_a * l
+        };
+        if jacobian {
+            for b in 0..3 {
+                out.kx[b][k] = ZERO;
+                out.cv[b][k] = ZERO;
+            }
+        }
+    }
+
+    // Segments.
+    let ea_l = p.axial_stiffness_n / l;
+    let c_l = p.damping_n_s / l;
+    for j in 1..=n {
+        let e = sub(node(j), node(j - 1));
+        let ell = norm(e);
+        let t = unit(e);
+        let strain = ell / l - 1.0;
+        let strain_rate = dot(
+            t,
+            sub(out.material_velocity[j], out.material_velocity[j - 1]),
+        ) / l;
+        let raw = p.axial_stiffness_n * strain + p.damping_n_s * strain_rate;
+        let active = strain > 0.0 && raw > 0.0;
+        let tension = if active { raw } else { 0.0 };
+        out.tension[j - 1] = tension;
+        out.tangent[j - 1] = t;
+        out.stretched[j - 1] = ell;
+        let f = scale(tension, t);
+        // Node j (index j−1) is pulled back, node j−1 forward.
+        out.force[j - 1] = sub(out.force[j - 1], f);
+        if j >= 2 {
+            out.force[j - 2] = add(out.force[j - 2], f);
+        }
+        if jacobian && active {
+            let mut ks = outer(ea_l, t, t);
+            if ell > 0.0 {
+                let g = tension / ell;
+                add_identity(&mut ks, g);
+                add_to(&mut ks, -1.0, &outer(g, t, t));
+            }
+            let cs = outer(c_l, t, t);
+            let b = j - 1;
+            add_to(&mut out.kx[1][b], -1.0, &ks);
+            add_to(&mut out.cv[1][b], -1.0, &cs);
+            if j >= 2 {
+                let a = j - 2;
+                add_to(&mut out.kx[0][b], 1.0, &ks);
+                add_to(&mut out.cv[0][b], 1.0, &cs);
+                add_to(&mut out.kx[1][a], -1.0, &ks);
+                add_to(&mut out.cv[1][a], -1.0, &cs);
+                add_to(&mut out.kx[2][a], 1.0, &ks);
+                add_to(&mut out.cv[2][a], 1.0, &cs);
+            }
+        }
+    }
+
+    // Weight, buoyancy, drag.
+    let lam = |j: usize| {
+        if p.drag_on_stretched_length {
+            out.stretched[j - 1]
+        } else {
+            l
+        }
+    };
+    let mut tether_drag_sum = [0.0; 2];
+    for i in 1..=n {
+        let k = i - 1;
+        let r = node(i);
+        let v = out.material_velocity[i];
+        let (q, length, wmass) = if i < n {
+            (
+                unit(sub(node(i + 1), node(i - 1))),
+                0.5 * (lam(i) + lam(i + 1)),
+                rho_a * l,
+            )
+        } else {
+            (out.tangent[n - 1], 0.5 * lam(n), 0.5 * rho_a * l)
+        };
+        out.force[k][1] -= wmass * p.gravity_m_s2;
+        let u = wind(r[0], r[1]);
+        let ur = sub([u, 0.0], v);
+        let jac = if jacobian {
+            Some(&mut out.cv[1][k])
+        } else {
+            None
+        };
+        let fd = if p.normal_drag > 0.0 || p.tangential_drag > 0.0 {
+            tether_drag(p, q, length, ur, jac)
+        } else {
+            [0.0; 2]
+        };
+        tether_drag_sum = add(tether_drag_sum, fd);
+        out.force[k] = add(out.force[k], fd);
+        if i == n {
+            out.top_force = add(
+                add(
+                    scale(out.tension[n - 1], out.tangent[n - 1]),
+                    [0.0, 0.5 * rho_a * l * p.gravity_m_s2],
+                ),
+                scale(-1.0, fd),
+            );
+            out.force[k][1] += p.net_buoyancy_n;
+            let speed = norm(ur);
+            let fa = [
+                p.aerostat_drag * speed * ur[0] - p.aerostat_lift * speed * ur[1],
+                p.aerostat_drag * speed * ur[1] + p.aerostat_lift * speed * ur[0],
+            ];
+            out.force[k] = add(out.force[k], fa);
+            if jacobian && speed > 0.0 {
+                // ∂f/∂u_r of k_D |u| u + k_L |u| J u; the node velocity enters with −1.
+                let mut d = outer(p.aerostat_drag / speed, ur, ur);
+                add_identity(&mut d, p.aerostat_drag * speed);
+                let ju = [-ur[1], ur[0]];
+                add_to(&mut d, 1.0, &outer(p.aerostat_lift / speed, ju, ur));
+                d[0][1] -= p.aerostat_lift * speed;
+                d[1][0] += p.aerostat_lift * speed;
+                add_to(&mut out.cv[1][k], -1.0, &d);
+            }
+        }
+    }
+    out.tether_drag = tether_drag_sum;
+
+    // The winch's half segment.
+    {
+        let t = out.tangent[0];
+        let u = wind(0.0, 0.0);
+        let ur = sub([u, 0.0], out.material_velocity[0]);
+        let fd = if p.normal_drag > 0.0 || p.tangential_drag > 0.0 {
+            tether_drag(p, t, 0.5 * lam(1), ur, None)
+        } else {
+            [0.0; 2]
+        };
+        out.winch_force = add(
+            sub(
+                scale(out.tension[0], t),
+                [0.0, 0.5 * rho_a * l * p.gravity_m_s2],
+            ),
+            fd,
+        );
+    }
+
+    // Convective inertia −m_i (2 ζ̇ Ṙ_ζ + ζ̇² R_ζζ + ζ̈ R_ζ) at the interior nodes.
+    if rate != 0.0 || len.acceleration_m_s2 != 0.0 {
+        for i in 1..n {
+            let k = i - 1;
+            let zd = zeta_dot(i);
+            let zdd = (1.0 - i as f64 * dzeta) * accel_term;
+            let m = out.mass[k];
+            let (rm, r0, rp) = (node(i - 1), node(i), node(i + 1));
+            let (vm, vp) = (nvel(i - 1), nvel(i + 1));
+            let c_v = 2.0 * zd * 0.5 / dzeta; // on Ṙ_{i+1} − Ṙ_{i−1}
+            let c_2 = zd * zd / (dzeta * dzeta); // on R_{i+1} − 2R_i + R_{i−1}
+            let c_1 = zdd * 0.5 / dzeta; // on R_{i+1} − R_{i−1}
+            for c in 0..2 {
+                let conv = c_v * (vp[c] - vm[c])
+                    + c_2 * (rp[c] - 2.0 * r0[c] + rm[c])
+                    + c_1 * (rp[c] - rm[c]);
+                out.force[k][c] -= m * conv;
+            }
+            if jacobian {
+                add_identity(&mut out.kx[1][k], 2.0 * m * c_2);
+                add_identity(&mut out.kx[2][k], -m * (c_2 + c_1));
+                add_identity(&mut out.cv[2][k], -m * c_v);
+                if i >= 2 {
+                    add_identity(&mut out.kx[0][k], -m * (c_2 - c_1));
+                    add_identity(&mut out.cv[0][k], m * c_v);
+                }
+            }
+        }
+    }
+}
+
+/// Energy of the tether and aerostat at constant length (J): kinetic
+/// `Σ ½ m_i |Ṙ_i|²`, strain `Σ ½ (EA/l) (ℓ − l)²` over stretched segments,
+/// gravity of the tether's lumped masses, and `−F z_N` of the net buoyancy.
+pub fn energy(p: &Parameters, length_m: f64, pos: &[V2], vel: &[V2]) -> f64 {
+    let n = p.segments;
+    let l = length_m / n as f64;
+    let mut e = 0.0;
+    let mut prev = [0.0; 2];
+    for i in 1..=n {
+        let r = pos[i - 1];
+        let tether_mass = if i == n { 0.5 } else { 1.0 } * p.mass_per_length_kg_m * l;
+        let m = tether_mass + if i == n { p.aerostat_inertia_kg } else { 0.0 };
+        e += 0.5 * m * dot(vel[i - 1], vel[i - 1]);
+        e += tether_mass * p.gravity_m_s2 * r[1];
+        let stretch = norm(sub(r, prev)) - l;
+        if stretch > 0.0 {
+            e += 0.5 * p.axial_stiffness_n / l * stretch * stretch;
+        }
+        prev = r;
+    }
+    e - p.net_buoyancy_n * pos[n - 1][1]
+}
+
+/// Block-tridiagonal solve helper re-exported for the integrator.
+pub use blocks::solve_tridiagonal;
