@@ -129,7 +129,7 @@ pub struct GeStabilityOutput {
     pub bending_stiffness_n_m2: f64,
     pub aerostat_mass_kg: f64,
     pub elements: usize,
-    /// Rotary inertia per length used by the model (kg m): ρA · (0.1 m)² (the stand-in of a given mesh).
+    /// Rotary inertia per length used by the model (kg m): ρA · (0.1 m)².
     pub rotary_inertia_kg_m: f64,
     /// Per grid wind speed.
     pub per_wind: Vec<GeWindLimitOutput>,
