@@ -130,6 +130,69 @@ fn bench_quasi_static(c: &mut Criterion) {
         });
     }
     g.finish();
+    // Issue 21 (target ≤ 5 ms): the converged quasi-static critical time
+    // (length) at 10 m/s, thesis tether with the solid 5 mm section's
+    // rotary inertia and EI = 1000 and 1 N m², calm air; and in a 10 m/s
+    // wind (divergence by det K, one base-mesh QEP).
+    use tetherplan::numerics::ge::qs_converged::{ConvergenceConfig, converged_critical_length};
+    let tether = |ei: f64| {
+        let s = Section::new(1e6, 1e6, ei, 0.078, 0.078 * 0.005 * 0.005 / 16.0).unwrap();
+        let mut m = GeModel::new(
+            s,
+            20,
+            TipBody {
+                mass_kg: 10.0,
+                link_length_m: 0.0,
+            },
+            9.81,
+        )
+        .unwrap();
+        m.slow_spectrum = true;
+        m
+    };
+    let windy5 = AirLoads {
+        cable_diameter_m: 0.005,
+        ..windy_air()
+    };
+    let mut g = c.benchmark_group("ge_quasi_static_converged");
+    g.sample_size(10);
+    for (name, ei, air) in [
+        (
+            "converged_critical_time_calm_ei_1000",
+            1000.0,
+            AirLoads::calm(),
+        ),
+        ("converged_critical_time_calm_ei_1", 1.0, AirLoads::calm()),
+        ("converged_critical_time_wind_10_m_s_ei_1", 1.0, windy5),
+    ] {
+        let m = tether(ei);
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                converged_critical_length(
+                    &m,
+                    1000.0,
+                    &air,
+                    10.0,
+                    &ConvergenceConfig::default(),
+                    (1.0, 1.5 * 1000.0 / (0.078 * 9.81)),
+                    &never,
+                )
+                .unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
+fn windy_air() -> tetherplan::numerics::ge::air_load::AirLoads {
+    tetherplan::numerics::ge::air_load::AirLoads {
+        wind: tetherplan::numerics::tether::wind::WindProfile::uniform(10.0),
+        air_density_kg_m3: 1.225,
+        cable_diameter_m: 0.0036,
+        cable_normal_drag_coefficient: 1.2,
+        aerostat_drag_area_m2: 0.9,
+        aerostat_lift_area_m2: 0.0,
+    }
 }
 
 criterion_group!(benches, bench, bench_quasi_static);

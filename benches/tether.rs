@@ -82,6 +82,7 @@ fn benches(c: &mut Criterion) {
         aerostat_mass_kg: 100.0,
         elements: DEFAULT_ELEMENTS,
         critical_rate_length_m: 3000.0,
+        converge: None,
     };
     let mut group = c.benchmark_group("envelope_qs_ge");
     group.sample_size(10);
@@ -90,6 +91,28 @@ fn benches(c: &mut Criterion) {
             solve_ge(
                 &ge_env,
                 &spec,
+                &config,
+                Parallelism::Rayon,
+                &|_, _| {},
+                &|| false,
+            )
+            .unwrap()
+            .unwrap()
+        })
+    });
+    // Issue 21: the same envelope with the critical length and rate of
+    // each wind converged (nested meshes from 20 elements, tolerance 1e-3,
+    // safe side) and the cells judged by the converged length when the
+    // base mesh's QEP confirms the divergence [target ≤ 2 s].
+    let converged = GeStabilitySpec {
+        converge: Some(tetherplan::numerics::ge::qs_converged::ConvergenceConfig::default()),
+        ..spec
+    };
+    group.bench_function("envelope_40x50_qs_ge_stability_converged_rayon", |b| {
+        b.iter(|| {
+            solve_ge(
+                &ge_env,
+                &converged,
                 &config,
                 Parallelism::Rayon,
                 &|_, _| {},

@@ -234,7 +234,7 @@ impl EnvelopeRequest {
             None => None,
         };
         if let (Some(spec), Some(v)) = (&spec, self.payout_rate_m_s) {
-            spec.validate_rate(problem.base.cable.mass_per_length_kg_m, v)?;
+            spec.validate_rate(&problem, v)?;
         }
         Ok((problem, config, spec))
     }
@@ -363,6 +363,7 @@ pub(crate) fn envelope_of(
             stability::ge_output(
                 spec,
                 problem.base.cable.mass_per_length_kg_m,
+                problem.base.cable.diameter_m,
                 &problem.wind_speeds_m_s,
                 ge,
             )

@@ -11,7 +11,7 @@ use crate::contract::equilibrium::require_range;
 use crate::numerics::ge::qs_critical::{QsOnset, QsSearch};
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::envelope_ge::{
-    DEFAULT_ELEMENTS, GeEnvelope, GeStabilitySpec, MAX_ELEMENTS, ROTARY_INERTIA_RADIUS_M,
+    DEFAULT_ELEMENTS, GeEnvelope, GeStabilitySpec, MAX_ELEMENTS,
 };
 
 fn default_ge_elements() -> usize {
@@ -89,6 +89,7 @@ impl EnvelopeStabilityInput {
             aerostat_mass_kg,
             elements,
             critical_rate_length_m: at,
+            converge: None,
         }))
     }
 }
@@ -149,6 +150,7 @@ fn outcome(s: &QsSearch) -> (&'static str, Option<f64>) {
 pub fn ge_output(
     spec: &GeStabilitySpec,
     mass_per_length_kg_m: f64,
+    diameter_m: f64,
     winds: &[f64],
     ge: &GeEnvelope,
 ) -> GeStabilityOutput {
@@ -181,9 +183,16 @@ pub fn ge_output(
         bending_stiffness_n_m2: spec.bending_stiffness_n_m2,
         aerostat_mass_kg: spec.aerostat_mass_kg,
         elements: spec.elements,
-        rotary_inertia_kg_m: mass_per_length_kg_m
-            * ROTARY_INERTIA_RADIUS_M
-            * ROTARY_INERTIA_RADIUS_M,
+        rotary_inertia_kg_m: if spec.converge.is_some() {
+            crate::numerics::ge::tether_system::solid_rotary_inertia_kg_m(
+                mass_per_length_kg_m,
+                diameter_m,
+            )
+        } else {
+            mass_per_length_kg_m
+                * crate::numerics::tether::envelope_ge::ROTARY_INERTIA_RADIUS_M
+                * crate::numerics::tether::envelope_ge::ROTARY_INERTIA_RADIUS_M
+        },
         per_wind,
     }
 }

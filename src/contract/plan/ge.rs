@@ -55,6 +55,7 @@ pub(super) fn ge_options(req: &PlanRequest) -> Result<Option<GeStabilityOptions>
         check_elements: st.check_elements,
         table_lengths: st.table_samples,
         min_length_m: req.initial_length_m.min(req.target_elevation_m),
+        converge: None,
     };
     o.validate()?;
     if !(2..=MAX_GE_CHECK_SAMPLES).contains(&st.check_samples) {

@@ -49,6 +49,7 @@ pub mod critical;
 pub mod diagnostics;
 pub mod element;
 pub mod extensible;
+pub mod qs_converged;
 pub mod qs_critical;
 pub mod quasi_static;
 pub mod solver;
@@ -157,6 +158,10 @@ pub struct GeModel {
     /// Gravity on the cable, along `−E1` (m/s²).
     pub gravity_m_s2: f64,
     pub rule: StiffnessRule,
+    /// Solve local QEPs for the slow modes ([`stability::spectrum_of`]):
+    /// set by the tether bridge, whose solid-section rotary inertia puts
+    /// the rotation–shear modes at `√(GA/I_ρ) ~ 10⁷ 1/s`.
+    pub slow_spectrum: bool,
     pub(crate) ops: element::InertiaOperators,
 }
 
@@ -182,6 +187,7 @@ impl GeModel {
             tip,
             gravity_m_s2,
             rule: StiffnessRule::Reduced,
+            slow_spectrum: false,
             ops: element::InertiaOperators::new(elements),
         })
     }
@@ -189,6 +195,15 @@ impl GeModel {
     pub fn with_rule(mut self, rule: StiffnessRule) -> Self {
         self.rule = rule;
         self
+    }
+
+    /// The same model with `elements` elements (section, tip, gravity,
+    /// rule and spectrum solve kept).
+    pub fn with_elements(&self, elements: usize) -> Result<Self, InvalidInput> {
+        let mut m = Self::new(self.section, elements, self.tip, self.gravity_m_s2)?;
+        m.rule = self.rule;
+        m.slow_spectrum = self.slow_spectrum;
+        Ok(m)
     }
 
     /// Number of unknowns: three per node, the clamped root excluded.

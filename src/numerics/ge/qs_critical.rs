@@ -10,8 +10,8 @@
 //!
 //! 1. **scan** — equilibria at `scan_points` evenly spaced values of `p`,
 //!    each Newton started from the previous one, and the number of
-//!    negative eigenvalues of (the symmetric part of) `K` at each
-//!    (Sylvester inertia of a band `LDLᵀ`, O(n));
+//!    negative eigenvalues of `K` at each in calm air (Sylvester inertia
+//!    of a band `LDLᵀ`, O(n)), in wind the sign of `det K` (band LU);
 //! 2. **divergence root** — where that count first grows, an eigenvalue
 //!    of `K` passes through zero, and with it a real eigenvalue of the
 //!    QEP; the root is bisected on the count to `1e-12` relative
@@ -40,8 +40,22 @@ use super::GeModel;
 use super::air_load::AirLoads;
 use super::element::{TipLoad, node};
 use super::quasi_static::{
-    QsConfig, state_at, stiffness_negative_count, wind_equilibrium, wind_matrices,
+    QsConfig, divergence_indicator, state_at, wind_equilibrium, wind_matrices,
 };
+
+/// The divergence count of a state ([`divergence_indicator`]): the inertia
+/// of `K` in calm air, the parity of `det K` in wind (issue 21: the
+/// inertia of the symmetric part of the non-symmetric `K` changes where no
+/// real eigenvalue crosses zero).
+fn stiffness_negative_count(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    q: &[f64],
+) -> Option<usize> {
+    divergence_indicator(model, kin, load, air, q).map(|x| x.0)
+}
 use super::solver::NewtonFailure;
 use super::stability::{StateMotion, spectrum_of};
 use crate::numerics::params::{InvalidInput, Kinematics, require_finite, require_positive};

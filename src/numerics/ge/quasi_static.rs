@@ -323,9 +323,35 @@ pub fn stiffness_negative_count(
     symmetric_negative_count(&k)
 }
 
+/// As [`stiffness_negative_count`], with `ln |det|` of the symmetric part.
+pub fn stiffness_inertia(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    q: &[f64],
+) -> Option<(usize, f64)> {
+    let zero = vec![0.0; q.len()];
+    let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
+    if !air.is_calm() {
+        k.add_scaled(
+            1.0,
+            &air.terms(model, kin.length_m, q, &zero, true).stiffness,
+        );
+    }
+    symmetric_inertia(&k)
+}
+
 /// Negative pivots of `LDLᵀ` of `(A + Aᵀ)/2` for a band `A` (no pivoting).
 pub fn symmetric_negative_count(a: &Band) -> Option<usize> {
+    symmetric_inertia(a).map(|x| x.0)
+}
+
+/// Negative pivots of `LDLᵀ` of `(A + Aᵀ)/2` and `ln |det|` (the sum of
+/// `ln |d_i|`): the determinant is `(−1)^count · exp(ln |det|)`.
+pub fn symmetric_inertia(a: &Band) -> Option<(usize, f64)> {
     let n = a.n;
+    let mut log_det = 0.0;
     let b = a.kl.min(a.ku);
     // l[i][k] for k in i-b..i stored at offset (k + b − i); d[i]
     let mut l = vec![0.0; n * (b + 1)];
@@ -351,15 +377,48 @@ pub fn symmetric_negative_count(a: &Band) -> Option<usize> {
             return None;
         }
         d[i] = s;
+        log_det += s.abs().ln();
         if s < 0.0 {
             negative += 1;
         }
     }
-    Some(negative)
+    Some((negative, log_det))
 }
 
 /// Sign of the determinant of a band matrix (LU with partial pivoting on a copy).
 pub fn band_determinant_sign(a: &Band) -> i8 {
+    band_determinant(a).map_or(0, |d| d.0)
+}
+
+/// The divergence indicator of the quasi-static state: in calm air the
+/// inertia of `K` (symmetric) and `ln |det K|`; in wind the parity of
+/// `det K` itself (`K` with the air stiffness, not symmetric: a real
+/// eigenvalue of the QEP crosses zero exactly where `det K` changes sign;
+/// the inertia of its symmetric part changes elsewhere) as a count of 0
+/// (positive) or 1 (negative), and `ln |det K|`.
+pub fn divergence_indicator(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    q: &[f64],
+) -> Option<(usize, f64)> {
+    if air.is_calm() {
+        return stiffness_inertia(model, kin, load, air, q);
+    }
+    let zero = vec![0.0; q.len()];
+    let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
+    k.add_scaled(
+        1.0,
+        &air.terms(model, kin.length_m, q, &zero, true).stiffness,
+    );
+    band_determinant(&k).map(|(sign, ld)| (usize::from(sign < 0), ld))
+}
+
+/// Sign and `ln |det|` of a band matrix (LU with partial pivoting on a
+/// copy); `None` when singular or not finite.
+pub fn band_determinant(a: &Band) -> Option<(i8, f64)> {
+    let mut log_det = 0.0;
     let n = a.n;
     let (kl, ku) = (a.kl, a.ku);
     let w = 2 * kl + ku + 1;
@@ -384,7 +443,7 @@ pub fn band_determinant_sign(a: &Band) -> i8 {
             }
         }
         if !best.is_finite() || best == 0.0 {
-            return 0;
+            return None;
         }
         let last_col = (k + kl + ku).min(n - 1);
         if p != k {
@@ -394,6 +453,7 @@ pub fn band_determinant_sign(a: &Band) -> i8 {
             }
         }
         let pivot = d[idx(k, k)];
+        log_det += pivot.abs().ln();
         if pivot < 0.0 {
             sign = -sign;
         }
@@ -406,5 +466,5 @@ pub fn band_determinant_sign(a: &Band) -> i8 {
             }
         }
     }
-    sign
+    Some((sign, log_det))
 }

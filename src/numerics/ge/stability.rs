@@ -31,8 +31,106 @@ pub fn drive_spectrum(model: &GeModel, drive: &Drive, state: &State) -> Result<S
     spectrum_of(model, solver::drive_matrices(model, drive, state))
 }
 
-/// The QEP spectrum of the linearised system `sys` (companion form, scaled).
+/// The QEP spectrum of the linearised system `sys` (companion form,
+/// scaled); for a model with [`GeModel::slow_spectrum`] its slow modes
+/// ([`slow_spectrum_of`]).
 pub fn spectrum_of(model: &GeModel, sys: SystemMatrices) -> Result<Spectrum, QepError> {
+    if model.slow_spectrum {
+        if let Some(s) = slow_spectrum_of(model, &sys)? {
+            return Ok(s);
+        }
+    }
+    full_spectrum_of(model, sys)
+}
+
+/// Of the inverted problem, eigenvalues `μ = 1/λ` below this fraction of
+/// the largest `|μ|` are dropped (see [`slow_spectrum_of`]).
+pub const SLOW_SPECTRUM_CUT: f64 = 1e-6;
+
+/// The slow modes of `λ² M + λ C + K = 0` by the inverted problem
+/// `μ² K + μ C + M = 0`, `μ = 1/λ` (a shift-invert about `λ = 0`, on the
+/// imaginary axis): companion `[[0, I], [−K⁻¹M, −K⁻¹C]]` with band LU of
+/// `K`. The slowest modes, which decide stability, have the largest `|μ|`
+/// and are resolved to roundoff of the *slowest* scale, not of the
+/// stiffest: the rotation–shear modes of a thin solid section
+/// (`√(GA/I_ρ) ≈ 10⁷ 1/s`) no longer swamp them, so no stand-in radius of
+/// gyration is needed. Eigenvalues with `|μ| < `[`SLOW_SPECTRUM_CUT`]` ·
+/// max |μ|` (modes more than 10⁶ times faster than the slowest, where
+/// the roundoff of `Re λ = Re μ/|μ|²` would pass the stability tolerance)
+/// are dropped: those modes are treated as quasi-static, the static
+/// condensation of the rotation's inertia in the limit. The roundoff of
+/// the kept ones is at most 10⁻⁷ of the spectrum's tolerance
+/// ([`Spectrum::tolerance`], 10⁻⁹ of the kept radius) times the ratio of
+/// radii, ≤ 0.1 of it. `None` when `K` is singular (then the caller
+/// solves the full problem).
+pub fn slow_spectrum_of(
+    model: &GeModel,
+    sys: &SystemMatrices,
+) -> Result<Option<Spectrum>, QepError> {
+    let n = model.dofs();
+    let m = sys.mass.to_dense();
+    let c = sys.damping.to_dense();
+    if (0..n).any(|i| (0..n).any(|j| !m[(i, j)].is_finite() || !c[(i, j)].is_finite())) {
+        return Err(QepError::NonFinite);
+    }
+    let Some(lu) = sys.stiffness.clone().factor() else {
+        return Ok(None);
+    };
+    let mut inv = Mat::<f64>::zeros(n, 2 * n);
+    let mut col = vec![0.0; n];
+    for j in 0..2 * n {
+        for i in 0..n {
+            col[i] = if j < n { m[(i, j)] } else { c[(i, j - n)] };
+        }
+        lu.solve_in_place(&mut col);
+        if col.iter().any(|x| !x.is_finite()) {
+            return Ok(None);
+        }
+        for i in 0..n {
+            inv[(i, j)] = col[i];
+        }
+    }
+    let row_norm = |off: usize| {
+        (0..n)
+            .map(|i| (0..n).map(|j| inv[(i, j + off)].abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+    };
+    let sigma = row_norm(0).sqrt().max(row_norm(n)).max(1e-300);
+    let companion = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| {
+        if i < n {
+            if j == i + n { 1.0 } else { 0.0 }
+        } else if j < n {
+            -inv[(i - n, j)] / (sigma * sigma)
+        } else {
+            -inv[(i - n, j)] / sigma
+        }
+    });
+    let (re, im) = qep::eigenvalues_real(&companion)?;
+    let mu: Vec<(f64, f64)> = re
+        .into_iter()
+        .zip(im)
+        .map(|(r, i)| (sigma * r, sigma * i))
+        .collect();
+    let top = mu.iter().map(|&(r, i)| r.hypot(i)).fold(0.0, f64::max);
+    if !(top > 0.0 && top.is_finite()) {
+        return Ok(None);
+    }
+    let eigenvalues = mu
+        .into_iter()
+        .filter(|&(r, i)| r.hypot(i) >= SLOW_SPECTRUM_CUT * top)
+        .map(|(r, i)| {
+            let d = r * r + i * i;
+            Eigenvalue {
+                re: r / d,
+                im: -i / d,
+            }
+        })
+        .collect();
+    Ok(Some(Spectrum::from_eigenvalues(eigenvalues)))
+}
+
+/// The full QEP spectrum of `sys` (companion form with `M⁻¹`, scaled).
+pub fn full_spectrum_of(model: &GeModel, sys: SystemMatrices) -> Result<Spectrum, QepError> {
     let n = model.dofs();
     let k = sys.stiffness.to_dense();
     let c = sys.damping.to_dense();

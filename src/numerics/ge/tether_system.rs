@@ -12,7 +12,10 @@
 //! * `EA` as given; an inextensible tether (no `EA`) gets
 //!   `EA = 1e5 · max(F, ρA g L_ref)`, a strain of at most `1e-5`;
 //! * shear stiffness `GA = EA` (the thesis's convention, Table 7.1);
-//! * rotary inertia of a solid round section `I_ρ = ρA d²/16`.
+//! * rotary inertia of a solid round section `I_ρ = ρA d²/16`; the local
+//!   QEPs are solved for the slow modes
+//!   ([`super::stability::slow_spectrum_of`]), so the stiff rotation of
+//!   the thin section does not swamp them.
 //!
 //! The tip load is the net buoyancy along `E1`; drag and lift of the
 //! aerostat and the tether's normal drag are the [`AirLoads`].
@@ -22,6 +25,13 @@ use super::element::TipLoad;
 use super::{GeModel, Section, TipBody};
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 use crate::numerics::tether::equilibrium::EquilibriumProblem;
+
+/// Rotary inertia per length of the solid round section of diameter `d`,
+/// `ρA d²/16` (kg m); a very thin tether still gets a positive one
+/// (`d = 0` is allowed for the static problem: no tether drag).
+pub fn solid_rotary_inertia_kg_m(mass_per_length_kg_m: f64, diameter_m: f64) -> f64 {
+    mass_per_length_kg_m * (diameter_m * diameter_m / 16.0).max(1e-12)
+}
 
 /// Strain bound that sets `EA` of an inextensible tether.
 pub const INEXTENSIBLE_STRAIN: f64 = 1e-5;
@@ -68,11 +78,8 @@ pub fn ge_tether_system(
             f.max(weight) / INEXTENSIBLE_STRAIN
         }
     };
-    // A very thin tether still gets a positive rotary inertia (d = 0 is
-    // allowed for the static problem: no tether drag).
-    let radius_term = (d * d / 16.0).max(1e-12);
-    let section = Section::new(ea, ea, ei, rho_a, rho_a * radius_term)?;
-    let model = GeModel::new(
+    let section = Section::new(ea, ea, ei, rho_a, solid_rotary_inertia_kg_m(rho_a, d))?;
+    let mut model = GeModel::new(
         section,
         options.elements,
         TipBody {
@@ -81,6 +88,9 @@ pub fn ge_tether_system(
         },
         problem.gravity_m_s2,
     )?;
+    // The solid section's rotation–shear modes (~10⁷ 1/s) are left out of
+    // the local QEPs: they are solved for the slow modes (issue 21).
+    model.slow_spectrum = true;
     let b = &problem.body;
     let air = AirLoads {
         wind: problem.wind.clone(),

@@ -4,6 +4,11 @@
 //! start so that the aerostat is down before the wind first exceeds the
 //! limit: `t_start = t_exceed − D`, `D` the duration of the fastest safe
 //! retrieval ([`super::schedule::fastest`]).
+//!
+//! With gusts (issue 21, SPEC §10) the limit is passed at the first
+//! forecast time at which the mean passes `max_operating_wind_m_s` **or**
+//! the gust passes `max_gust_m_s` ([`first_limit_exceedance`],
+//! [`haul_down_with_gusts`]): whichever comes first sets the deadline.
 
 use crate::numerics::params::{InvalidInput, require_finite, require_non_negative};
 
@@ -156,9 +161,98 @@ pub fn haul_down(
     }
 }
 
+/// Which forecast series passed its limit first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExceededBy {
+    Mean,
+    Gust,
+}
+
+/// The first time (s) at which the mean passes `mean_limit_m_s` or the
+/// gust series passes its limit, and which one (the mean on a tie).
+pub fn first_limit_exceedance(
+    mean: &Forecast,
+    mean_limit_m_s: f64,
+    gust: Option<(&Forecast, f64)>,
+) -> Option<(f64, ExceededBy)> {
+    let m = mean.first_exceedance_s(mean_limit_m_s);
+    let g = gust.and_then(|(f, limit)| f.first_exceedance_s(limit));
+    match (m, g) {
+        (Some(a), Some(b)) if b < a => Some((b, ExceededBy::Gust)),
+        (Some(a), _) => Some((a, ExceededBy::Mean)),
+        (None, Some(b)) => Some((b, ExceededBy::Gust)),
+        (None, None) => None,
+    }
+}
+
+/// The deadline with gusts: [`haul_down`] at the earlier of the mean's and
+/// the gust's first exceedance; the reason names the one that binds.
+/// Without a gust series it is [`haul_down`] exactly.
+pub fn haul_down_with_gusts(
+    mean: &Forecast,
+    mean_limit_m_s: f64,
+    gust: Option<(&Forecast, f64)>,
+    retrieval_duration_s: f64,
+    aloft_from_s: f64,
+) -> (HaulDown, Option<ExceededBy>) {
+    let first = first_limit_exceedance(mean, mean_limit_m_s, gust);
+    match (first, gust) {
+        (Some((_, ExceededBy::Gust)), Some((g, limit))) => {
+            let mut h = haul_down(g, limit, retrieval_duration_s, aloft_from_s);
+            h.reason = h.reason.replacen("the wind exceeds", "the gust exceeds", 1);
+            (h, Some(ExceededBy::Gust))
+        }
+        _ => {
+            let mut h = haul_down(mean, mean_limit_m_s, retrieval_duration_s, aloft_from_s);
+            if let Some((g, limit)) = gust
+                && h.exceeds_at_s.is_none()
+            {
+                h.reason = format!(
+                    "{}; the gust stays within {limit:.1} m/s up to {:.0} s",
+                    h.reason,
+                    g.horizon_s()
+                );
+            }
+            (h, first.map(|f| f.1))
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Gusts that pass their limit before the mean passes its own give the
+    /// earlier deadline; gusts within their limit leave the mean's.
+    #[test]
+    fn gusts_passing_first_give_the_earlier_deadline() {
+        let mean = Forecast::new(&[(0.0, 6.0), (3600.0, 14.0)], "f").unwrap();
+        // mean passes 12 at 2700 s; gust (×1.45) passes 15 at t where 1.45·U = 15
+        let gust_pts: Vec<(f64, f64)> = [(0.0, 6.0), (3600.0, 14.0)]
+            .iter()
+            .map(|&(t, u)| (t, 1.45 * u))
+            .collect();
+        let gust = Forecast::new(&gust_pts, "g").unwrap();
+        let t_mean = 2700.0;
+        let t_gust = (15.0 / 1.45 - 6.0) / 8.0 * 3600.0;
+        let (h, by) = haul_down_with_gusts(&mean, 12.0, Some((&gust, 15.0)), 300.0, 0.0);
+        assert_eq!(by, Some(ExceededBy::Gust));
+        assert!((h.exceeds_at_s.unwrap() - t_gust).abs() < 1e-9 && t_gust < t_mean);
+        assert!((h.latest_start_s.unwrap() - (t_gust - 300.0)).abs() < 1e-9);
+        assert!(h.reason.contains("gust exceeds"), "{}", h.reason);
+        // a gust limit the gusts never reach: the mean's deadline, as without gusts
+        let (h2, by2) = haul_down_with_gusts(&mean, 12.0, Some((&gust, 30.0)), 300.0, 0.0);
+        assert_eq!(by2, Some(ExceededBy::Mean));
+        assert_eq!(
+            h2.exceeds_at_s,
+            haul_down(&mean, 12.0, 300.0, 0.0).exceeds_at_s
+        );
+        assert!((h2.exceeds_at_s.unwrap() - t_mean).abs() < 1e-9);
+        assert_eq!(
+            haul_down_with_gusts(&mean, 12.0, None, 300.0, 0.0).0,
+            haul_down(&mean, 12.0, 300.0, 0.0)
+        );
+    }
 
     #[test]
     fn exceedance_interpolates() {

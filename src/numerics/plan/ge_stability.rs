@@ -26,11 +26,22 @@
 //! string's closed form `S₀(L) = (1 − r)F − ρA g L` plus the deviation
 //! `D = S − S₀` of the **lower** of the two neighbouring nodes (exact at
 //! the nodes). In calm air `D` is the bending offset (nearly constant);
-//! in wind it varies slowly with the blow-down. The error against the
-//! node values is at most `max |D_{i+1} − D_i|` (reported,
-//! [`GeTable::interpolation_error_n`]; ρA g of it is one metre of
-//! critical length). Past `L_max` the deviation at `L_max` continues
-//! (`S ≈ ρA g (L_max − L) < 0`: unstable).
+//! in wind it varies slowly with the blow-down. Between the nodes the
+//! rule is at or below the chord of `D`; a smooth `D` departs from its
+//! chord by at most `h² max|D''|/8`, estimated by an eighth of the
+//! larger second difference of `D` at the interval's nodes and **taken
+//! off** the interpolated `S` ([`GeTable::curvature_margins_n`]), so the rule errs on
+//! the safe side; the stated bound [`GeTable::interpolation_error_n`] is
+//! the largest jump `|D_{i+1} − D_i|` (the most the rule takes off) plus
+//! the interval's margin (ρA g of it is one metre of critical length). Past `L_max`
+//! the deviation at `L_max` continues (`S ≈ ρA g (L_max − L) < 0`:
+//! unstable).
+//!
+//! **Converged** ([`GeStabilityOptions::converge`], issue 21): `L_max`
+//! and every row's rate are the safe sides of the converged divergence
+//! onsets of [`crate::numerics::ge::qs_converged`] (nested meshes from
+//! `elements` up, Richardson, best estimate minus its error), with their
+//! error estimates in the table.
 //!
 //! **The check.** At schedule samples the local QEP of the GE model at
 //! `(L, L̇, L̈)` with the reserve buoyancy
@@ -46,6 +57,9 @@ use rayon::prelude::*;
 use crate::numerics::ge::GeModel;
 use crate::numerics::ge::air_load::AirLoads;
 use crate::numerics::ge::element::TipLoad;
+use crate::numerics::ge::qs_converged::{
+    ConvergedOutcome, ConvergenceConfig, converged_critical_length, converged_critical_rate,
+};
 use crate::numerics::ge::qs_critical::lift_limit_length_m;
 use crate::numerics::ge::quasi_static::{
     QsConfig, stiffness_negative_count, wind_equilibrium, wind_stability,
@@ -78,6 +92,11 @@ pub struct GeStabilityOptions {
     pub table_lengths: usize,
     /// Shortest length of the table (m).
     pub min_length_m: f64,
+    /// Converge the table (issue 21): the maximum safe length and each
+    /// row's critical rate are the safe sides of converged onsets
+    /// ([`crate::numerics::ge::qs_converged`], divergence only, from
+    /// `elements` up); `None`: on the `elements` mesh as given.
+    pub converge: Option<ConvergenceConfig>,
 }
 
 impl GeStabilityOptions {
@@ -137,9 +156,23 @@ pub struct GeTable {
     pub rate_cap_m_s: f64,
     /// `(1 − r)F` the table was made for (N).
     pub reserve_buoyancy_n: f64,
-    /// Largest jump of the deviation `D` between neighbouring rows (N):
-    /// the most the lower-neighbour rule takes off between nodes.
+    /// Bound on the interpolation error (N): the largest jump of the
+    /// deviation `D` between neighbouring rows (the most the
+    /// lower-neighbour rule takes off between nodes) plus the curvature
+    /// margin taken off on the safe side ([`GeTable::curvature_margin_n`]).
     pub interpolation_error_n: f64,
+    /// Largest of the per-interval curvature margins (N).
+    pub curvature_margin_n: f64,
+    /// Taken off `S` inside each interval between rows (N): an eighth of
+    /// the larger second difference of `D` at the interval's two nodes,
+    /// the bound `h² max|D''|/8` of the departure of a smooth `D` from its
+    /// chord (0 at the nodes).
+    pub curvature_margins_n: Vec<f64>,
+    /// Converged table: per row the estimated discretisation error of its
+    /// critical rate (m/s) (empty unless converged).
+    pub rate_error_m_s: Vec<f64>,
+    /// Converged table: the estimated error of the maximum safe length (m).
+    pub max_safe_length_error_m: Option<f64>,
     /// Searches run and QEPs solved.
     pub qep_solves: usize,
     pub equilibria: usize,
@@ -168,6 +201,7 @@ impl GeTable {
                 self.deviation[i]
             } else {
                 self.deviation[i].min(self.deviation[i + 1])
+                    - self.curvature_margins_n.get(i).copied().unwrap_or(0.0)
             }
         };
         self.closed_form(length_m) + d
@@ -416,11 +450,35 @@ fn build(
         )
         .0
     };
+    let never = || false;
+    let conv = options.converge.map(|c| ConvergenceConfig {
+        base_elements: options.elements,
+        max_elements: c.max_elements.max(4 * options.elements),
+        qep_in_wind: false,
+        ..c
+    });
     // The maximum safe length: at rest.
-    let max_len = match last_stable(lo, search_hi, |l| stable(l, 0.0)) {
-        Ok(l) => l,
-        Err(true) => search_hi,
-        Err(false) => lo,
+    let mut max_len_error = None;
+    let max_len = match &conv {
+        None => match last_stable(lo, search_hi, |l| stable(l, 0.0)) {
+            Ok(l) => l,
+            Err(true) => search_hi,
+            Err(false) => lo,
+        },
+        Some(c) => {
+            let r =
+                converged_critical_length(&gm.model, b, &gm.air, 0.0, c, (lo, search_hi), &never)
+                    .map_err(|e| e.to_string())?;
+            evaluations.fetch_add(r.equilibria, std::sync::atomic::Ordering::Relaxed);
+            match r.outcome {
+                ConvergedOutcome::During(o) => {
+                    max_len_error = Some(o.error_estimate);
+                    o.safe_value.max(lo)
+                }
+                ConvergedOutcome::Never { .. } => search_hi,
+                _ => lo,
+            }
+        }
     };
     let n = options.table_lengths;
     let lengths: Vec<f64> = (0..n)
@@ -432,15 +490,36 @@ fn build(
             }
         })
         .collect();
-    let found: Vec<Result<f64, bool>> = lengths[..n - 1]
+    let found: Vec<(Result<f64, bool>, f64)> = lengths[..n - 1]
         .par_iter()
         .map(|&l| {
             if max_len <= lo {
-                return Err(false);
+                return (Err(false), 0.0);
             }
-            last_stable(0.0, cap, |v| stable(l, v))
+            let Some(c) = &conv else {
+                return (last_stable(0.0, cap, |v| stable(l, v)), 0.0);
+            };
+            match converged_critical_rate(&gm.model, b, &gm.air, l, cap, c, &never, None) {
+                Ok(r) => {
+                    evaluations.fetch_add(r.equilibria, std::sync::atomic::Ordering::Relaxed);
+                    match r.outcome {
+                        ConvergedOutcome::During(o) => {
+                            (Ok(o.safe_value.max(0.0)), o.error_estimate)
+                        }
+                        ConvergedOutcome::Never { .. } => (Err(true), 0.0),
+                        _ => (Err(false), 0.0),
+                    }
+                }
+                Err(_) => (Err(false), 0.0),
+            }
         })
         .collect();
+    let rate_error_m_s: Vec<f64> = if conv.is_some() {
+        found.iter().map(|f| f.1).collect()
+    } else {
+        Vec::new()
+    };
+    let found: Vec<Result<f64, bool>> = found.into_iter().map(|f| f.0).collect();
     let mut rows = Vec::with_capacity(n);
     for (&l, f) in lengths.iter().zip(&found) {
         let (v, capped, unstable) = match f {
@@ -472,11 +551,30 @@ fn build(
         .iter()
         .map(|r| r.stability_tension_n - closed(r.length_m))
         .collect();
+    let usable = |r: &TableRow| !r.capped && !r.unstable;
+    // second differences at the interior nodes (None where a row is not usable)
+    let second: Vec<Option<f64>> = (0..rows.len())
+        .map(|k| {
+            if k == 0 || k + 1 >= rows.len() || !rows[k - 1..=k + 1].iter().all(usable) {
+                return None;
+            }
+            Some((deviation[k + 1] - 2.0 * deviation[k] + deviation[k - 1]).abs() / 8.0)
+        })
+        .collect();
+    let curvature_margins_n: Vec<f64> = (0..rows.len().saturating_sub(1))
+        .map(|i| {
+            second[i]
+                .unwrap_or(0.0)
+                .max(second.get(i + 1).copied().flatten().unwrap_or(0.0))
+        })
+        .collect();
+    let curvature_margin_n = curvature_margins_n.iter().copied().fold(0.0, f64::max);
     let interpolation_error_n = rows
         .windows(2)
         .zip(deviation.windows(2))
-        .filter(|(r, _)| !r[0].capped && !r[1].capped && !r[0].unstable && !r[1].unstable)
-        .map(|(_, d)| (d[1] - d[0]).abs())
+        .zip(&curvature_margins_n)
+        .filter(|((r, _), _)| usable(&r[0]) && usable(&r[1]))
+        .map(|((_, d), m)| (d[1] - d[0]).abs() + m)
         .fold(0.0, f64::max);
     Ok((
         GeTable {
@@ -485,6 +583,10 @@ fn build(
             rate_cap_m_s: cap,
             reserve_buoyancy_n: b,
             interpolation_error_n,
+            curvature_margin_n,
+            curvature_margins_n,
+            rate_error_m_s,
+            max_safe_length_error_m: max_len_error,
             qep_solves,
             equilibria,
             rho_a,
@@ -492,7 +594,12 @@ fn build(
             deviation,
         },
         GePlanModel {
-            check_model: Some(check_sys.model),
+            // The check keeps the full spectrum (its `judge` already
+            // discounts the roundoff splitting of slow real pairs).
+            check_model: Some(GeModel {
+                slow_spectrum: false,
+                ..check_sys.model
+            }),
             ..gm
         },
     ))

@@ -21,23 +21,36 @@
 //! neighbouring length is a close guess); rows fan out on rayon.
 //!
 //! **Rotary inertia.** [`ge_tether_system`] gives the solid-section
-//! `I_ρ = ρA d²/16`; with it the rotation–shear mode of a thin tether has
-//! `ω ≈ √(GA/I_ρ)` ≈ 4·10⁷ 1/s (GA = EA ≈ 10⁸ N), the spectrum's tolerance
-//! (10⁻⁹ of the spectral radius) is 0.04 1/s, and the roundoff in the
-//! slow transverse eigenvalues is larger still: calm-air states that are
-//! stable by the Kelvin–Tait–Chetaev theorem come out with spurious growth
-//! rates of 0.05–0.2 1/s (measured, 10–40 elements). The envelope
-//! therefore uses `I_ρ = ρA r²` with `r = 0.1 m` ([`ROTARY_INERTIA_RADIUS_M`]):
-//! the tolerance drops to 4·10⁻⁴ 1/s and the calm-air verdicts follow the
-//! Kelvin–Tait–Chetaev divergence root; the slow transverse modes that
-//! decide stability (wavelengths ≥ the tether length ≫ r) change by
-//! `O((2π r/L)²)`, and a divergence boundary (calm air) does not depend on
-//! the inertia at all. The price is the rotation wave speed
-//! `c_r = √(EI/I_ρ)`: a sliding beam paid out near it is unstable for that
-//! reason alone (measured with `r = 1 m`, EI = 1 N m²: `c_r` = 3.6 m/s, a
-//! 100 m tether paid out at 30 m/s grows at 3 1/s). Payout rates at or
-//! above [`ROTATION_WAVE_FRACTION`] `· c_r` are refused, and the rate
-//! search stops there.
+//! `I_ρ = ρA d²/16`; its rotation–shear mode `√(GA/I_ρ) ≈ 4·10⁷ 1/s`
+//! used to swamp the slow transverse eigenvalues with roundoff (spurious
+//! growth rates of 0.05–0.2 1/s in calm air, where the states are stable
+//! by the Kelvin–Tait–Chetaev theorem), so a stand-in radius of gyration of
+//! 0.1 m was used. The tether's model now solves the slow modes by the
+//! inverted problem ([`crate::numerics::ge::stability::slow_spectrum_of`],
+//! a shift-invert about `λ = 0`): the spectrum is that of the solid
+//! section itself, no stand-in (issue 21), in the converged mode. *Not
+//! yet* when the mesh is given (no [`GeStabilitySpec::converge`]): that
+//! path keeps the stand-in `I_ρ = ρA (0.1 m)²`
+//! ([`ROTARY_INERTIA_RADIUS_M`]) and the full spectrum, because with the
+//! solid section its rate search reaches rates (47 m/s at 1150 m in a
+//! 5 m/s wind) where `det K` changes sign while the scan's QEP growth
+//! stays below the tolerance (measured, `tests/verification_envelope_ge.rs`),
+//! a disagreement not yet resolved. The rotation wave speed
+//! `c_r = √(EI/I_ρ)` still bounds the payout rate (a sliding beam paid out
+//! near it is unstable for that reason alone: its effective bending
+//! stiffness is `EI − I_ρ L̇²`); with the solid section `c_r = (4/d)√(EI/ρA)`
+//! is far above any winch (≈ 1900 m/s for a 6 mm Dyneema braid). Payout
+//! rates at or above [`ROTATION_WAVE_FRACTION`] `· c_r` are refused.
+//!
+//! **Converged** (issue 21, [`GeStabilitySpec::converge`]): the critical
+//! length and rate of each wind speed are the converged, conservative
+//! onsets of [`crate::numerics::ge::qs_converged`] (nested meshes,
+//! Richardson, safe side), the maximum safe altitude the blown-down
+//! altitude at the safe length on the finest mesh. A cell longer than the
+//! safe critical length of its wind is unstable; when the base mesh's QEP
+//! search confirms that the onset along the length is a divergence, every
+//! shorter cell is stable with no further eigenvalue solve (its growth rate
+//! is not reported); otherwise each cell also needs its base-mesh QEP.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -47,8 +60,13 @@ use crate::numerics::chart::Parallelism;
 use crate::numerics::ge::GeModel;
 use crate::numerics::ge::air_load::AirLoads;
 use crate::numerics::ge::element::TipLoad;
+use crate::numerics::ge::qs_converged::{
+    ConvergedOutcome, ConvergedSearch, ConvergenceConfig, converged_critical_length,
+    converged_critical_rate,
+};
 use crate::numerics::ge::qs_critical::{
-    QsSearch, QsSearchConfig, critical_length, critical_rate_from, lift_limit_length_m,
+    OnsetState, QsOnset, QsSearch, QsSearchConfig, critical_length, critical_rate_from,
+    lift_limit_length_m,
 };
 use crate::numerics::ge::quasi_static::{QsConfig, WindStateStability, wind_stability};
 use crate::numerics::ge::stability::{GeStateFailure, StateMotion};
@@ -59,18 +77,17 @@ use crate::numerics::tether::envelope::{
 };
 use crate::numerics::tether::equilibrium::EquilibriumConfig;
 
-/// Radius of gyration (m) of the rotary inertia `I_ρ = ρA r²` of the
-/// envelope's GE model (see the module docs).
-pub const ROTARY_INERTIA_RADIUS_M: f64 = 0.1;
 /// Fastest payout (and top of the rate search) as a fraction of the rotation
 /// wave speed `√(EI/I_ρ)` (see the module docs).
 pub const ROTATION_WAVE_FRACTION: f64 = 0.5;
+/// Radius of gyration (m) of the stand-in rotary inertia `I_ρ = ρA r²`
+/// that the envelope keeps **when `elements` is given** (no `converge`):
+/// its cells are judged by the full QEP of that mesh, as in issue 12.
+pub const ROTARY_INERTIA_RADIUS_M: f64 = 0.1;
 
-/// The rotation wave speed `√(EI/I_ρ)` of the envelope's GE model (m/s).
-pub fn rotation_wave_speed_m_s(bending_stiffness_n_m2: f64, mass_per_length_kg_m: f64) -> f64 {
-    (bending_stiffness_n_m2
-        / (mass_per_length_kg_m * ROTARY_INERTIA_RADIUS_M * ROTARY_INERTIA_RADIUS_M))
-        .sqrt()
+/// The rotation wave speed `√(EI/I_ρ)` of a GE model (m/s).
+pub fn rotation_wave_speed_m_s(model: &GeModel) -> f64 {
+    (model.section.bending_stiffness_n_m2 / model.section.rotary_inertia_kg_m).sqrt()
 }
 /// Default elements of the envelope's GE model.
 pub const DEFAULT_ELEMENTS: usize = 20;
@@ -88,6 +105,9 @@ pub struct GeStabilitySpec {
     pub elements: usize,
     /// Length (m) at which the critical payout rate is searched.
     pub critical_rate_length_m: f64,
+    /// Converge the critical length and rate (module docs); `None`: on the
+    /// `elements` mesh as given.
+    pub converge: Option<ConvergenceConfig>,
 }
 
 /// Per wind speed: the quasi-static critical length at the payout rate and
@@ -100,6 +120,54 @@ pub struct GeWindLimits {
     /// Searched over `[10⁻³, 1] · rate_search_max_m_s`.
     pub critical_rate: QsSearch,
     pub rate_search_max_m_s: f64,
+    /// The converged searches (with [`GeStabilitySpec::converge`]).
+    pub converged: Option<ConvergedLimits>,
+}
+
+/// The converged critical length and rate of one wind speed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConvergedLimits {
+    pub critical_length: ConvergedSearch,
+    pub critical_rate: ConvergedSearch,
+}
+
+/// A converged search as a [`QsSearch`] at its safe side (the onset the
+/// operator acts on), for the answer's per-wind fields; a flutter onset
+/// on the base mesh is kept as it is (not converged).
+pub fn safe_search(c: &ConvergedSearch) -> QsSearch {
+    let (onset, at_onset) = match (&c.outcome, c.flutter) {
+        (_, Some(f)) => (f, None),
+        (ConvergedOutcome::During(o), None) => {
+            (QsOnset::During { at: o.safe_value }, Some(o.at_safe))
+        }
+        (ConvergedOutcome::Immediate, None) => (
+            QsOnset::Immediate {
+                max_real_1_s: f64::NAN,
+            },
+            None,
+        ),
+        (ConvergedOutcome::Never { up_to }, None) => (QsOnset::Never { up_to: *up_to }, None),
+        (ConvergedOutcome::Failed { at }, None) => (
+            QsOnset::EquilibriumFailed {
+                at: *at,
+                failure: crate::numerics::ge::solver::NewtonFailure {
+                    time_s: 0.0,
+                    iterations: 0,
+                    residual_norm: f64::NAN,
+                },
+            },
+            None,
+        ),
+        (ConvergedOutcome::Cancelled, None) => (QsOnset::Cancelled, None),
+    };
+    QsSearch {
+        onset,
+        bracket: None,
+        divergence: c.flutter.is_none(),
+        qep_solves: 0,
+        equilibria: c.equilibria,
+        at_onset: at_onset.map(|s: OnsetState| s),
+    }
 }
 
 /// The envelope with the GE verdicts.
@@ -126,16 +194,16 @@ impl GeStabilitySpec {
     /// rotation wave speed of the model.
     pub fn validate_rate(
         &self,
-        mass_per_length_kg_m: f64,
+        problem: &EnvelopeProblem,
         rate_m_s: f64,
     ) -> Result<(), InvalidInput> {
-        let cap = ROTATION_WAVE_FRACTION
-            * rotation_wave_speed_m_s(self.bending_stiffness_n_m2, mass_per_length_kg_m);
+        let sys = ge_system(problem, self, 0.0)?;
+        let cap = ROTATION_WAVE_FRACTION * rotation_wave_speed_m_s(&sys.model);
         if rate_m_s.abs() >= cap {
             return Err(InvalidInput::new(
                 "payout_rate_m_s",
                 format!(
-                    "must be below {cap:.4} m/s with the quasi-static GE stability: {ROTATION_WAVE_FRACTION} of the rotation wave speed √(EI/I_ρ) of the model (I_ρ = ρA·({ROTARY_INERTIA_RADIUS_M} m)²); raise stability.bending_stiffness_n_m2 or lower the rate"
+                    "must be below {cap:.4} m/s with the quasi-static GE stability: {ROTATION_WAVE_FRACTION} of the rotation wave speed √(EI/I_ρ) of the tether (I_ρ = ρA d²/16, solid section); raise the bending stiffness or lower the rate"
                 ),
             ));
         }
@@ -166,7 +234,7 @@ impl GeStabilitySpec {
 
 /// The GE system of the envelope at one wind speed: [`ge_tether_system`]
 /// of the problem at that wind and the longest grid length (which sets the
-/// stiffness of an inextensible tether), with `I_ρ = ρA r²`.
+/// stiffness of an inextensible tether), solid section.
 pub fn ge_system(
     problem: &EnvelopeProblem,
     spec: &GeStabilitySpec,
@@ -185,8 +253,13 @@ pub fn ge_system(
             elements: spec.elements,
         },
     )?;
-    sys.model.section.rotary_inertia_kg_m =
-        problem.base.cable.mass_per_length_kg_m * ROTARY_INERTIA_RADIUS_M * ROTARY_INERTIA_RADIUS_M;
+    if spec.converge.is_none() {
+        // The mesh as given keeps issue 12's stand-in (module docs).
+        sys.model.section.rotary_inertia_kg_m = problem.base.cable.mass_per_length_kg_m
+            * ROTARY_INERTIA_RADIUS_M
+            * ROTARY_INERTIA_RADIUS_M;
+        sys.model.slow_spectrum = false;
+    }
     Ok(sys)
 }
 
@@ -228,7 +301,8 @@ fn rate_search_max(model: &GeModel, air: &AirLoads, load: TipLoad, length_m: f64
         .min(ROTATION_WAVE_FRACTION * rotation)
 }
 
-/// The two searches of one wind speed.
+/// The two searches of one wind speed (converged with
+/// [`GeStabilitySpec::converge`], else on the `elements` mesh).
 pub fn wind_limits(
     problem: &EnvelopeProblem,
     sys: &GeTetherSystem,
@@ -247,6 +321,43 @@ pub fn wind_limits(
     let length_search_max_m = lift_limit_length_m(&sys.model, sys.net_buoyancy_n, &sys.air)
         .max(lmax)
         .max(lmin);
+    let rate_search_max_m_s = rate_search_max(
+        &sys.model,
+        &sys.air,
+        sys.tip_load,
+        spec.critical_rate_length_m,
+    );
+    if let Some(cfg) = &spec.converge {
+        let cl = converged_critical_length(
+            &sys.model,
+            sys.net_buoyancy_n,
+            &sys.air,
+            rate_m_s,
+            cfg,
+            (lmin, length_search_max_m),
+            cancel,
+        )?;
+        let cr = converged_critical_rate(
+            &sys.model,
+            sys.net_buoyancy_n,
+            &sys.air,
+            spec.critical_rate_length_m,
+            rate_search_max_m_s,
+            cfg,
+            cancel,
+            rate_start,
+        )?;
+        return Ok(GeWindLimits {
+            critical_length: safe_search(&cl),
+            length_search_max_m,
+            critical_rate: safe_search(&cr),
+            rate_search_max_m_s,
+            converged: Some(ConvergedLimits {
+                critical_length: cl,
+                critical_rate: cr,
+            }),
+        });
+    }
     let critical_length = critical_length(
         &sys.model,
         sys.net_buoyancy_n,
@@ -258,12 +369,6 @@ pub fn wind_limits(
         (lmin, length_search_max_m),
         cancel,
     )?;
-    let rate_search_max_m_s = rate_search_max(
-        &sys.model,
-        &sys.air,
-        sys.tip_load,
-        spec.critical_rate_length_m,
-    );
     let critical_rate = critical_rate_from(
         &sys.model,
         sys.net_buoyancy_n,
@@ -280,6 +385,7 @@ pub fn wind_limits(
         length_search_max_m,
         critical_rate,
         rate_search_max_m_s,
+        converged: None,
     })
 }
 
@@ -298,13 +404,33 @@ pub fn ge_row(
             "the quasi-static GE stability needs the payout rate",
         )
     })?;
-    spec.validate_rate(problem.base.cable.mass_per_length_kg_m, rate)?;
     let config = EquilibriumConfig {
         keep_shape: false,
         ..*config
     };
     let sys = ge_system(problem, spec, wind_speed_m_s)?;
+    let cap = ROTATION_WAVE_FRACTION * rotation_wave_speed_m_s(&sys.model);
+    if rate.abs() >= cap {
+        spec.validate_rate(problem, rate)?;
+    }
     let rho_a = problem.base.cable.mass_per_length_kg_m;
+    // Converged: the wind's limits first; they judge the cells by length.
+    let converged_limits = match spec.converge {
+        Some(_) => Some(wind_limits(problem, &sys, spec, rate, None, cancel)?),
+        None => None,
+    };
+    // (longest safe length, whether no cell QEP is needed below it)
+    let by_length: Option<(f64, bool)> = converged_limits.as_ref().map(|w| {
+        let c = w.converged.as_ref().map(|c| &c.critical_length);
+        let confirmed = c.is_some_and(|c| c.flutter.is_none());
+        match (w.critical_length.onset, c.map(|c| &c.outcome)) {
+            (QsOnset::During { at }, _) if confirmed => (at, true),
+            (_, Some(ConvergedOutcome::During(o))) => (o.safe_value, confirmed),
+            (QsOnset::Never { .. }, _) if confirmed => (f64::INFINITY, true),
+            (QsOnset::Immediate { .. }, _) if confirmed => (f64::NEG_INFINITY, true),
+            _ => (f64::INFINITY, false),
+        }
+    });
     let mut start: Option<Vec<f64>> = None;
     let mut rate_seed: Option<Vec<f64>> = None;
     let mut points = Vec::with_capacity(problem.tether_lengths_m.len());
@@ -316,6 +442,12 @@ pub fn ge_row(
             (None, None)
         } else if eq.slack || eq.min_tension_n <= 0.0 {
             (Some(false), None)
+        } else if let Some((safe, _)) = by_length
+            && l > safe
+        {
+            (Some(false), None)
+        } else if let Some((_, true)) = by_length {
+            (Some(true), None)
         } else {
             match cell_stability(&sys, l, rate, start.as_deref()) {
                 Ok(w) => {
@@ -344,7 +476,10 @@ pub fn ge_row(
     }
     // The rate search starts from the row's tensioned branch: the GE
     // equilibrium of the longest cell at or below its length.
-    let wind_limits = wind_limits(problem, &sys, spec, rate, rate_seed.as_deref(), cancel)?;
+    let wind_limits = match converged_limits {
+        Some(w) => w,
+        None => wind_limits(problem, &sys, spec, rate, rate_seed.as_deref(), cancel)?,
+    };
     Ok(GeRow {
         points,
         max_growth_rate_1_s: growth,

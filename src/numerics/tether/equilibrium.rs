@@ -146,7 +146,8 @@ pub struct Equilibrium {
     pub shape: Vec<ShapePoint>,
     /// Shooting passes made.
     pub iterations: usize,
-    /// `|z(winch)|` of the last pass (m).
+    /// `|z(winch)|` of the last pass (m): the shooting's residual in a
+    /// sheared wind; 0 in a uniform wind (one pass, shifted onto the winch).
     pub residual_m: f64,
     /// Whether the shooting met its tolerance within the cap.
     pub converged: bool,
@@ -433,8 +434,13 @@ impl EquilibriumProblem {
         let l = self.tether_length_m;
         if self.wind.is_uniform() {
             // The shape does not depend on z_top: one pass from z_top = L, shifted.
+            // The pass is shifted down by its z(winch), so the shifted shape
+            // meets the winch exactly: its residual is zero (issue 21: it
+            // used to report the shift, `L − altitude`, as the residual).
             let pass = self.pass(l, config.steps, config.keep_shape);
-            return Ok(self.assemble(pass, l, 1, true));
+            let mut eq = self.assemble(pass, l, 1, true);
+            eq.residual_m = 0.0;
+            return Ok(eq);
         }
         let tol = 1e-11 * l.max(1.0);
         // A coarse solve (an eighth of the steps, loose tolerance) gives the

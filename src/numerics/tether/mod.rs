@@ -8,6 +8,7 @@
 pub mod envelope;
 pub mod envelope_ge;
 pub mod equilibrium;
+pub mod gust;
 pub mod presets;
 pub mod string_tension;
 pub mod wind;

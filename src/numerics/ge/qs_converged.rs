@@ -1,0 +1,688 @@
+//! Converged, conservative quasi-static GE onsets (issue 21, SPEC §5
+//! applied to the GE criterion): the critical length at a payout rate and
+//! the critical rate at a length, in the continuum limit of the mesh, with
+//! an estimate of the discretisation error and the safe side of it.
+//!
+//! **Why.** The FE divergence root of the sliding GE cable converges at
+//! first order, from above: in calm air `K` is symmetric and the FE space
+//! is a subspace of the continuum's, so the smallest Rayleigh quotient of
+//! `K` (and with it the onset, where it passes zero) is over-estimated, by
+//! an amount of the order of the first element (the effective tension
+//! vanishes at the guide at onset, as for the string of
+//! [`crate::numerics::string::converged`]). Measured (thesis tether,
+//! `EI = 1000 N m²`): the critical rate at 1300 m is 29.89 / 25.52 / 21.26
+//! / 19.15 m/s at 10 / 20 / 40 / 80 elements: the default 20-element answer
+//! errs on the unsafe side by about a third.
+//!
+//! **Method.** Uniform nested meshes `n_k = n₀ 2^k` (`n₀ =`
+//! [`BASE_ELEMENTS`]); on each the divergence root (the parameter where the
+//! inertia of the symmetric part of `K` changes, bisected to
+//! [`ROOT_RTOL`]; the Newton of each equilibrium starts from the nearest
+//! one already found (regula falsi on the determinant, safeguarded by the
+//! inertia count), on the first level from the scan, on finer levels
+//! from the coarser level's equilibria prolonged onto the finer mesh, and
+//! the bracket of each level is searched just below the coarser root).
+//! Richardson removes the first order, `R_k = 2 q_k − q_{k−1}`, and the
+//! error of `R_k` is estimated by `|R_k − R_{k−1}|` (three times the true
+//! error when the remainder is second order). Levels are added until the
+//! estimate is below the tolerance (relative, default
+//! [`DEFAULT_RELATIVE_TOLERANCE`]) or [`MAX_CONVERGED_ELEMENTS`] is reached.
+//!
+//! **Conservative.** The answer handed out ([`ConvergedOnset::safe_value`])
+//! is the best estimate minus its error, and never above the finest mesh's
+//! root (itself an upper bound in calm air).
+//!
+//! **Bending layer.** At the guide the bending stiffness acts over the
+//! heavy-column layer `ℓ = (EI/(ρA g))^(1/3)` (11 m at `EI = 1000 N m²`,
+//! 1.1 m at 1 N m², 0.11 m at 10⁻³ N m² for the thesis tether). While the
+//! elements are much longer than `ℓ` the FE cable behaves like the string
+//! and the extrapolation tends to the string's continuum limit, which is
+//! *below* the GE one (bending lifts the boundary, as `EI^(1/3)`): the
+//! answer then stays on the safe side by up to the bending lift (about
+//! `2ℓ` of length); once `h ≲ ℓ` the levels follow the GE limit itself.
+//!
+//! **Calm air and wind.** In calm air at a constant rate the damping is
+//! positive definite while paying out and `K` symmetric, so by the
+//! Kelvin–Tait–Chetaev theorem the divergence root *is* the onset: no
+//! eigenvalues are solved. In wind `K` is not symmetric and a flutter
+//! onset may come first. The divergence is then the sign change of
+//! `det K` itself ([`super::quasi_static::divergence_indicator`]), and
+//! the base mesh's QEP just below its root must have no growing
+//! oscillation; when it has, a flutter onset comes first and the QEP
+//! search of [`super::qs_critical`] on the base mesh is reported
+//! ([`ConvergedSearch::flutter`]), not converged.
+
+use super::GeModel;
+use super::air_load::AirLoads;
+use super::element::{TipLoad, node};
+use super::qs_critical::{OnsetState, QsOnset, QsSearchConfig, search_onset_from};
+use super::quasi_static::{QsConfig, divergence_indicator, wind_equilibrium, wind_stability};
+use super::stability::StateMotion;
+use crate::numerics::params::{InvalidInput, Kinematics, require_finite, require_positive};
+
+/// Relative tolerance of a converged onset unless the caller asks another.
+pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 1e-3;
+/// Tightest and loosest tolerances accepted.
+pub const MIN_RELATIVE_TOLERANCE: f64 = 1e-6;
+pub const MAX_RELATIVE_TOLERANCE: f64 = 0.05;
+/// Elements of the coarsest mesh.
+pub const BASE_ELEMENTS: usize = 20;
+/// Finest mesh of a converged search.
+pub const MAX_CONVERGED_ELEMENTS: usize = 1280;
+/// Relative width of each level's bisection.
+pub const ROOT_RTOL: f64 = 1e-8;
+/// Scan points of the first level.
+const SCAN_POINTS: usize = 16;
+/// Cap on bisection steps per level.
+const MAX_BISECTIONS: usize = 120;
+
+/// Settings of a converged search.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConvergenceConfig {
+    pub relative_tolerance: f64,
+    pub base_elements: usize,
+    pub max_elements: usize,
+    /// In wind: run the base mesh's QEP search to tell a divergence onset
+    /// from a flutter one ([`ConvergedSearch::flutter`]). Off: the
+    /// divergence alone (a caller that checks flutter elsewhere, as the
+    /// plan's schedule check does).
+    pub qep_in_wind: bool,
+}
+
+impl Default for ConvergenceConfig {
+    fn default() -> Self {
+        Self {
+            relative_tolerance: DEFAULT_RELATIVE_TOLERANCE,
+            base_elements: BASE_ELEMENTS,
+            max_elements: MAX_CONVERGED_ELEMENTS,
+            qep_in_wind: true,
+        }
+    }
+}
+
+impl ConvergenceConfig {
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        if !(MIN_RELATIVE_TOLERANCE..=MAX_RELATIVE_TOLERANCE).contains(&self.relative_tolerance) {
+            return Err(InvalidInput::new(
+                "stability.relative_tolerance_nondim",
+                format!(
+                    "must be between {MIN_RELATIVE_TOLERANCE} and {MAX_RELATIVE_TOLERANCE}, got {}",
+                    self.relative_tolerance
+                ),
+            ));
+        }
+        if self.base_elements < 2 || self.max_elements < 4 * self.base_elements {
+            return Err(InvalidInput::new(
+                "stability.elements",
+                format!(
+                    "the converged search needs at least 2 base elements and 3 levels, got {} to {}",
+                    self.base_elements, self.max_elements
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A converged onset (length in m, or rate in m/s).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConvergedOnset {
+    /// Best estimate of the continuum value (Richardson).
+    pub value: f64,
+    /// Estimated bound on `|value − continuum value|` (≥ 0).
+    pub error_estimate: f64,
+    /// The safe side: `value − error_estimate`, and at most the finest root.
+    pub safe_value: f64,
+    /// Whether the tolerance was met within the finest mesh.
+    pub converged: bool,
+    /// Observed order of the last three levels (NaN with fewer).
+    pub order: f64,
+    /// `(elements, divergence root)` per level.
+    pub levels: Vec<(usize, f64)>,
+    /// The equilibrium at the safe value on the finest mesh.
+    pub at_safe: OnsetState,
+}
+
+impl ConvergedOnset {
+    /// The error estimate of the root on an `elements` mesh: its distance
+    /// above the safe value (FE roots converge from above), 0 below it.
+    pub fn error_at(&self, root: f64) -> f64 {
+        (root - self.safe_value).max(0.0)
+    }
+}
+
+/// The outcome of a converged search.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ConvergedOutcome {
+    /// First unstable at the converged onset.
+    During(ConvergedOnset),
+    /// Unstable at the lower end of the range on the base mesh.
+    Immediate,
+    /// Stable up to the upper end on every level searched.
+    Never { up_to: f64 },
+    /// No equilibrium (or stiffness) at the lower end.
+    Failed { at: f64 },
+    /// Stopped by the caller.
+    Cancelled,
+}
+
+/// A converged search and, in wind, the base mesh's QEP search.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConvergedSearch {
+    pub outcome: ConvergedOutcome,
+    /// In wind: the base-mesh QEP onset when it is not the divergence
+    /// (a flutter onset first, or no onset found by the QEP); `None` in
+    /// calm air (the divergence is the onset) or when confirmed.
+    pub flutter: Option<QsOnset>,
+    pub equilibria: usize,
+}
+
+/// One level's divergence root.
+enum LevelRoot {
+    Root {
+        at: f64,
+        /// Equilibria found on this level, by parameter.
+        known: Vec<(f64, Vec<f64>)>,
+    },
+    Immediate,
+    Never,
+    Failed,
+    Cancelled,
+}
+
+struct Level<'a, K: Fn(f64) -> Kinematics> {
+    model: GeModel,
+    load: TipLoad,
+    air: &'a AirLoads,
+    kin: &'a K,
+    known: Vec<(f64, Vec<f64>)>,
+    equilibria: usize,
+}
+
+impl<K: Fn(f64) -> Kinematics> Level<'_, K> {
+    fn equilibrium(&mut self, p: f64) -> Option<Vec<f64>> {
+        self.equilibria += 1;
+        let start = self
+            .known
+            .iter()
+            .min_by(|a, b| (a.0 - p).abs().total_cmp(&(b.0 - p).abs()))
+            .map(|k| k.1.clone());
+        let eq = wind_equilibrium(
+            &self.model,
+            (self.kin)(p),
+            self.load,
+            self.air,
+            &QsConfig::default(),
+            start.as_deref(),
+        )
+        .ok()?;
+        self.known.push((p, eq.q.clone()));
+        Some(eq.q)
+    }
+
+    fn count(&mut self, p: f64) -> Option<usize> {
+        self.inertia(p).map(|x| x.0)
+    }
+
+    /// Negative count and `ln |det|` of the symmetric part of `K` at `p`.
+    fn inertia(&mut self, p: f64) -> Option<(usize, f64)> {
+        let q = self.equilibrium(p)?;
+        divergence_indicator(&self.model, (self.kin)(p), self.load, self.air, &q)
+    }
+
+    fn state(&mut self, p: f64) -> OnsetState {
+        let Some(q) = self.equilibrium(p) else {
+            return OnsetState::default();
+        };
+        let kin = (self.kin)(p);
+        let top = node(&q, self.model.elements);
+        OnsetState {
+            root_axial_force_n: super::critical::root_axial_force_n(&self.model, kin.length_m, &q),
+            tip_altitude_m: kin.length_m + top[0],
+            tip_downwind_m: top[1],
+        }
+    }
+
+    /// The divergence root in `[lo, hi]`; `hint` is the coarser level's root
+    /// and its last step (the root is searched just below it first).
+    fn root(
+        mut self,
+        (lo, hi): (f64, f64),
+        hint: Option<(f64, f64)>,
+        cancel: &dyn Fn() -> bool,
+    ) -> (LevelRoot, usize) {
+        let Some(c_lo) = self.count(lo) else {
+            return (LevelRoot::Failed, self.equilibria);
+        };
+        if c_lo > 0 && self.air.is_calm() {
+            return (LevelRoot::Immediate, self.equilibria);
+        }
+        let same = |c: Option<usize>| c == Some(c_lo);
+        let mut bracket = None;
+        if let Some((prev, step)) = hint {
+            let b = prev.min(hi);
+            if !same(self.count(b)) {
+                let mut d = step.abs().max(1e-4 * prev.abs()).max(1e-12);
+                loop {
+                    if cancel() {
+                        return (LevelRoot::Cancelled, self.equilibria);
+                    }
+                    let a = (b - d).max(lo);
+                    if a <= lo || same(self.count(a)) {
+                        bracket = Some((a, b));
+                        break;
+                    }
+                    d *= 4.0;
+                }
+            }
+        }
+        if bracket.is_none() {
+            let mut prev = lo;
+            for k in 1..=SCAN_POINTS {
+                if cancel() {
+                    return (LevelRoot::Cancelled, self.equilibria);
+                }
+                let p = lo + (hi - lo) * k as f64 / SCAN_POINTS as f64;
+                if same(self.count(p)) {
+                    prev = p;
+                } else {
+                    bracket = Some((prev, p));
+                    break;
+                }
+            }
+        }
+        let Some((mut a, mut b)) = bracket else {
+            return (LevelRoot::Never, self.equilibria);
+        };
+        // Illinois regula falsi on det of the symmetric part of K (its sign
+        // is (−1)^count, smooth through a simple root), safeguarded by the
+        // count: the bracket always has the lower-end count at `a` only.
+        let tol = ROOT_RTOL * b.abs().max(1e-300);
+        let signed = |x: Option<(usize, f64)>, reference: f64| -> f64 {
+            match x {
+                Some((c, ld)) => {
+                    let mag = (ld - reference).clamp(-700.0, 700.0).exp();
+                    if c % 2 == 0 { mag } else { -mag }
+                }
+                None => f64::NAN,
+            }
+        };
+        let ia = self.inertia(a);
+        let reference = ia.map_or(0.0, |x| x.1);
+        let mut fa = signed(ia, reference);
+        let mut fb = signed(self.inertia(b), reference);
+        let mut side = 0i8;
+        for _ in 0..MAX_BISECTIONS {
+            let w = b - a;
+            if w <= tol {
+                break;
+            }
+            if cancel() {
+                return (LevelRoot::Cancelled, self.equilibria);
+            }
+            let mut m = if fa * fb < 0.0 && fa.is_finite() && fb.is_finite() {
+                (a * fb - b * fa) / (fb - fa)
+            } else {
+                0.5 * (a + b)
+            };
+            if !(m > a && m < b) {
+                m = 0.5 * (a + b);
+            }
+            // keep off the ends so that the bracket closes
+            let eps = 0.5 * tol;
+            if m - a < eps {
+                m = a + eps.min(0.5 * w);
+            } else if b - m < eps {
+                m = b - eps.min(0.5 * w);
+            }
+            let im = self.inertia(m);
+            let fm = signed(im, reference);
+            if same(im.map(|x| x.0)) {
+                a = m;
+                fa = fm;
+                if side == -1 {
+                    fb *= 0.5;
+                }
+                side = -1;
+            } else {
+                b = m;
+                fb = fm;
+                if side == 1 {
+                    fa *= 0.5;
+                }
+                side = 1;
+            }
+        }
+        let e = self.equilibria;
+        (
+            LevelRoot::Root {
+                at: 0.5 * (a + b),
+                known: self.known,
+            },
+            e,
+        )
+    }
+}
+
+/// Coarse nodal values linearly interpolated onto the mesh of twice the
+/// elements (nested: the coarse nodes are every other fine node).
+fn prolong(q: &[f64], coarse_elements: usize) -> Vec<f64> {
+    let mut out = vec![0.0; 6 * coarse_elements];
+    for k in 1..=2 * coarse_elements {
+        let v = if k % 2 == 0 {
+            node(q, k / 2)
+        } else {
+            let (a, b) = (node(q, k / 2), node(q, k / 2 + 1));
+            [
+                0.5 * (a[0] + b[0]),
+                0.5 * (a[1] + b[1]),
+                0.5 * (a[2] + b[2]),
+            ]
+        };
+        out[GeModel::dof(k, 0)..GeModel::dof(k, 0) + 3].copy_from_slice(&v);
+    }
+    out
+}
+
+/// `model` with `elements` elements ([`GeModel::with_elements`]).
+pub fn with_elements(model: &GeModel, elements: usize) -> Result<GeModel, InvalidInput> {
+    model.with_elements(elements)
+}
+
+/// Richardson on first-order levels: `(value, error, order)` of the last.
+pub fn richardson(levels: &[f64]) -> (f64, f64, f64) {
+    let k = levels.len();
+    match k {
+        0 => (f64::NAN, f64::INFINITY, f64::NAN),
+        1 => (levels[0], f64::INFINITY, f64::NAN),
+        2 => (
+            2.0 * levels[1] - levels[0],
+            (levels[1] - levels[0]).abs(),
+            f64::NAN,
+        ),
+        _ => {
+            let r = |i: usize| 2.0 * levels[i] - levels[i - 1];
+            let (q0, q1, q2) = (levels[k - 3], levels[k - 2], levels[k - 1]);
+            let order = ((q0 - q1) / (q1 - q2)).log2();
+            (r(k - 1), (r(k - 1) - r(k - 2)).abs(), order)
+        }
+    }
+}
+
+/// The converged divergence onset along `p ∈ [lo, hi]` of the state
+/// `kin(p)` (module docs); `model` gives the section, tip and gravity
+/// (its mesh is replaced by the levels').
+#[allow(clippy::too_many_arguments)]
+pub fn converged_onset(
+    model: &GeModel,
+    net_buoyancy_n: f64,
+    air: &AirLoads,
+    config: &ConvergenceConfig,
+    (lo, hi): (f64, f64),
+    kin: impl Fn(f64) -> Kinematics,
+    cancel: &dyn Fn() -> bool,
+    start: Option<&[f64]>,
+) -> Result<ConvergedSearch, InvalidInput> {
+    config.validate()?;
+    require_positive("net_buoyancy_n", net_buoyancy_n)?;
+    require_finite("range.min", lo)?;
+    require_finite("range.max", hi)?;
+    if hi < lo {
+        return Err(InvalidInput::new(
+            "range.max",
+            format!("must be at least the lower end {lo}, got {hi}"),
+        ));
+    }
+    let load = TipLoad {
+        force_n: [net_buoyancy_n, 0.0],
+        moment_n_m: 0.0,
+    };
+    let mut equilibria = 0;
+    let flutter_check = !air.is_calm() && config.qep_in_wind;
+    let mut flutter = None;
+    let mut roots: Vec<(usize, f64)> = Vec::new();
+    let mut known: Vec<(f64, Vec<f64>)> = start
+        .filter(|q| q.len() == 3 * config.base_elements)
+        .map(|q| vec![(lo, q.to_vec())])
+        .unwrap_or_default();
+    let mut n = config.base_elements;
+    let mut finest: Option<GeModel> = None;
+    let mut finest_known = Vec::new();
+    let outcome = loop {
+        let m = with_elements(model, n)?;
+        let level = Level {
+            model: m.clone(),
+            load,
+            air,
+            kin: &kin,
+            known: std::mem::take(&mut known),
+            equilibria: 0,
+        };
+        let hint = match roots.len() {
+            0 => None,
+            1 => Some((roots[0].1, 0.5 * roots[0].1 * 1e-2)),
+            k => Some((roots[k - 1].1, roots[k - 2].1 - roots[k - 1].1)),
+        };
+        let (r, e) = level.root((lo, hi), hint, cancel);
+        equilibria += e;
+        match r {
+            LevelRoot::Root { at, known: k } => {
+                roots.push((n, at));
+                known = k.iter().map(|(p, q)| (*p, prolong(q, n))).collect();
+                finest = Some(m);
+                finest_known = k;
+            }
+            LevelRoot::Immediate => break ConvergedOutcome::Immediate,
+            LevelRoot::Failed => break ConvergedOutcome::Failed { at: lo },
+            LevelRoot::Cancelled => break ConvergedOutcome::Cancelled,
+            LevelRoot::Never => {
+                if roots.is_empty() {
+                    break ConvergedOutcome::Never { up_to: hi };
+                }
+                // Stable to hi on a finer mesh although a coarser one
+                // diverged: keep the levels found.
+                break ConvergedOutcome::During(summarise(&roots, config, false));
+            }
+        }
+        let values: Vec<f64> = roots.iter().map(|r| r.1).collect();
+        let (value, err, _) = richardson(&values);
+        if roots.len() >= 3 && err <= config.relative_tolerance * value.abs() {
+            break ConvergedOutcome::During(summarise(&roots, config, true));
+        }
+        if 2 * n > config.max_elements {
+            break ConvergedOutcome::During(summarise(&roots, config, false));
+        }
+        n *= 2;
+    };
+    // In wind: the base mesh's QEP just below its own divergence root
+    // (or at the upper end without one) must be free of growing
+    // oscillations; else a flutter onset comes first and the QEP search
+    // of the base mesh is reported instead (not converged).
+    if flutter_check && !matches!(outcome, ConvergedOutcome::Cancelled) {
+        let base = with_elements(model, config.base_elements)?;
+        let probe = match (&outcome, roots.first()) {
+            (_, Some(&(_, r))) => r * (1.0 - 1e-3),
+            (ConvergedOutcome::Never { up_to }, None) => *up_to,
+            _ => lo,
+        };
+        let k = kin(probe);
+        let start_q = start.filter(|q| q.len() == base.dofs());
+        let ok = match wind_stability(
+            &base,
+            k,
+            load,
+            air,
+            StateMotion::AtRest,
+            &QsConfig::default(),
+            start_q,
+        ) {
+            Ok(w) => {
+                let tol = w.spectrum.tolerance();
+                w.spectrum
+                    .eigenvalues
+                    .iter()
+                    .filter(|e| e.im != 0.0)
+                    .all(|e| e.re <= tol)
+            }
+            Err(_) => false,
+        };
+        equilibria += 1;
+        if !ok {
+            let s = search_onset_from(
+                &base,
+                net_buoyancy_n,
+                air,
+                StateMotion::AtRest,
+                &QsSearchConfig::default(),
+                (lo, hi),
+                &kin,
+                cancel,
+                start_q,
+            )?;
+            equilibria += s.equilibria;
+            flutter = Some(s.onset);
+        }
+    }
+    let outcome = match outcome {
+        ConvergedOutcome::During(mut c) => {
+            if let Some(m) = finest {
+                let mut level = Level {
+                    model: m,
+                    load,
+                    air,
+                    kin: &kin,
+                    known: finest_known,
+                    equilibria: 0,
+                };
+                c.at_safe = level.state(c.safe_value.max(lo));
+                equilibria += level.equilibria;
+            }
+            ConvergedOutcome::During(c)
+        }
+        o => o,
+    };
+    Ok(ConvergedSearch {
+        outcome,
+        flutter,
+        equilibria,
+    })
+}
+
+fn summarise(roots: &[(usize, f64)], config: &ConvergenceConfig, met: bool) -> ConvergedOnset {
+    let values: Vec<f64> = roots.iter().map(|r| r.1).collect();
+    let (value, err, order) = richardson(&values);
+    let finest = *values.last().unwrap_or(&f64::NAN);
+    // With fewer than three levels the estimate is the last step.
+    let err = if err.is_finite() {
+        err
+    } else {
+        finest.abs() * config.relative_tolerance.max(0.05)
+    };
+    ConvergedOnset {
+        value,
+        error_estimate: err,
+        safe_value: (value - err).min(finest),
+        converged: met,
+        order,
+        levels: roots.to_vec(),
+        at_safe: OnsetState::default(),
+    }
+}
+
+/// Converged quasi-static critical length of a payout at constant rate
+/// `rate_m_s` between `min_length_m` and `max_length_m`.
+#[allow(clippy::too_many_arguments)]
+pub fn converged_critical_length(
+    model: &GeModel,
+    net_buoyancy_n: f64,
+    air: &AirLoads,
+    rate_m_s: f64,
+    config: &ConvergenceConfig,
+    (min_length_m, max_length_m): (f64, f64),
+    cancel: &dyn Fn() -> bool,
+) -> Result<ConvergedSearch, InvalidInput> {
+    require_positive("min_length_m", min_length_m)?;
+    require_finite("rate_m_s", rate_m_s)?;
+    converged_onset(
+        model,
+        net_buoyancy_n,
+        air,
+        config,
+        (min_length_m, max_length_m),
+        |l| Kinematics {
+            length_m: l,
+            rate_m_s,
+            acceleration_m_s2: 0.0,
+        },
+        cancel,
+        None,
+    )
+}
+
+/// Converged quasi-static critical payout rate at one length (searched on
+/// `[10⁻³, 1] · max_rate_m_s`, as [`super::qs_critical::critical_rate`]).
+#[allow(clippy::too_many_arguments)]
+pub fn converged_critical_rate(
+    model: &GeModel,
+    net_buoyancy_n: f64,
+    air: &AirLoads,
+    length_m: f64,
+    max_rate_m_s: f64,
+    config: &ConvergenceConfig,
+    cancel: &dyn Fn() -> bool,
+    start: Option<&[f64]>,
+) -> Result<ConvergedSearch, InvalidInput> {
+    require_positive("length_m", length_m)?;
+    require_positive("max_rate_m_s", max_rate_m_s)?;
+    converged_onset(
+        model,
+        net_buoyancy_n,
+        air,
+        config,
+        (1e-3 * max_rate_m_s, max_rate_m_s),
+        |v| Kinematics {
+            length_m,
+            rate_m_s: v,
+            acceleration_m_s2: 0.0,
+        },
+        cancel,
+        start,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn richardson_removes_a_first_order_error() {
+        // q_k = 5 + 3/n_k + 7/n_k², n_k = 20·2^k
+        let q: Vec<f64> = (0..4)
+            .map(|k| {
+                let n = 20.0 * 2f64.powi(k);
+                5.0 + 3.0 / n + 7.0 / (n * n)
+            })
+            .collect();
+        let (v, e, order) = richardson(&q);
+        assert!((v - 5.0).abs() < e, "value {v}, error {e}");
+        assert!((order - 1.0).abs() < 0.1, "order {order}");
+    }
+
+    #[test]
+    fn prolongation_is_exact_on_linear_fields() {
+        let n = 3;
+        let q: Vec<f64> = (1..=n)
+            .flat_map(|k| {
+                let z = k as f64 / n as f64;
+                [2.0 * z, -z, 0.5 * z]
+            })
+            .collect();
+        let f = prolong(&q, n);
+        for k in 1..=2 * n {
+            let z = k as f64 / (2 * n) as f64;
+            let v = node(&f, k);
+            assert!((v[0] - 2.0 * z).abs() < 1e-15 && (v[1] + z).abs() < 1e-15);
+            assert!((v[2] - 0.5 * z).abs() < 1e-15);
+        }
+    }
+}

@@ -1,0 +1,222 @@
+//! Gusts (SPEC §10, issue 21): the quasi-static check at the gust speed.
+//!
+//! The gust speed at a height is the mean times the gust factor
+//! `G = 1 + k I` (`I = σ_u/U` the turbulence intensity, `k` the peak
+//! factor, default [`DEFAULT_PEAK_FACTOR`]: about the 3-second gust over 10
+//! minutes), or a gust speed given at the reference height, `G =
+//! gust/U(z_ref)`. The gust enters the equilibrium exactly as a faster mean
+//! wind would: [`gust_profile`] is the mean profile with its speeds scaled
+//! by `G` (for a uniform flow `U(1 + k I)`), and with `G = 1` (`I = 0`) it
+//! is the mean profile bit for bit (every speed times exactly 1).
+//!
+//! The static equilibrium at the gust speed is conservative for the
+//! tension (SPEC §10: a step gust reaches at most 1.00× the new static
+//! tension in MoorDyn runs; periodic gusts swing it by well under half the
+//! quasi-static swing) and gives the lowest altitude in the gust, the one
+//! that must clear terrain and airspace floors.
+
+use crate::numerics::aero::SteadyFlow;
+use crate::numerics::params::{InvalidInput, require_finite, require_non_negative};
+use crate::numerics::tether::wind::WindProfile;
+
+/// Peak factor `k` unless given.
+pub const DEFAULT_PEAK_FACTOR: f64 = 3.0;
+/// Reference height (m) of a gust speed for flows that have none of their
+/// own (uniform, power law, tabulated): the anemometer height of weather
+/// reports (WMO No. 8, 10 m above ground).
+pub const DEFAULT_REFERENCE_HEIGHT_M: f64 = 10.0;
+/// Largest turbulence intensity and peak factor accepted.
+pub const MAX_TURBULENCE_INTENSITY: f64 = 1.0;
+pub const MAX_PEAK_FACTOR: f64 = 10.0;
+
+/// How the gust is given.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Gust {
+    /// `G = 1 + k I`.
+    Intensity {
+        turbulence_intensity: f64,
+        peak_factor: f64,
+    },
+    /// The gust speed at the reference height (m/s).
+    AtReference { gust_m_s: f64 },
+}
+
+impl Gust {
+    /// Checks the fields (named as in the contract, under `field`).
+    pub fn validate(&self, field: &str) -> Result<(), InvalidInput> {
+        match *self {
+            Self::Intensity {
+                turbulence_intensity,
+                peak_factor,
+            } => {
+                let f = format!("{field}.turbulence_intensity_nondim");
+                require_finite(&f, turbulence_intensity)?;
+                require_non_negative(&f, turbulence_intensity)?;
+                if turbulence_intensity > MAX_TURBULENCE_INTENSITY {
+                    return Err(InvalidInput::new(
+                        f,
+                        format!(
+                            "must be at most {MAX_TURBULENCE_INTENSITY}, got {turbulence_intensity}"
+                        ),
+                    ));
+                }
+                let f = format!("{field}.peak_factor_nondim");
+                require_finite(&f, peak_factor)?;
+                require_non_negative(&f, peak_factor)?;
+                if peak_factor > MAX_PEAK_FACTOR {
+                    return Err(InvalidInput::new(
+                        f,
+                        format!("must be at most {MAX_PEAK_FACTOR}, got {peak_factor}"),
+                    ));
+                }
+            }
+            Self::AtReference { gust_m_s } => {
+                let f = format!("{field}.gust_m_s");
+                require_finite(&f, gust_m_s)?;
+                require_non_negative(&f, gust_m_s)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The reference height (m) of a profile: its own for the log law, else
+/// [`DEFAULT_REFERENCE_HEIGHT_M`].
+pub fn reference_height_m(mean: &WindProfile) -> f64 {
+    match mean {
+        WindProfile::LogLaw {
+            reference_height_m, ..
+        } => *reference_height_m,
+        WindProfile::Flow(_) => DEFAULT_REFERENCE_HEIGHT_M,
+    }
+}
+
+/// The gust factor `G` of `gust` over `mean`; an error names `field`
+/// when a gust speed is given over a mean that is zero at the reference
+/// height of a sheared flow (nothing to scale).
+pub fn gust_factor(gust: &Gust, mean: &WindProfile, field: &str) -> Result<f64, InvalidInput> {
+    gust.validate(field)?;
+    Ok(match *gust {
+        Gust::Intensity {
+            turbulence_intensity,
+            peak_factor,
+        } => 1.0 + peak_factor * turbulence_intensity,
+        Gust::AtReference { gust_m_s } => {
+            let u = mean.speed_m_s(reference_height_m(mean)).abs();
+            if u > 0.0 {
+                gust_m_s / u
+            } else if gust_m_s == 0.0 {
+                1.0
+            } else {
+                return Err(InvalidInput::new(
+                    format!("{field}.gust_m_s"),
+                    format!(
+                        "the mean wind is zero at the reference height {:.1} m, so a gust of {gust_m_s} m/s cannot scale it; give a uniform flow or turbulence_intensity_nondim",
+                        reference_height_m(mean)
+                    ),
+                ));
+            }
+        }
+    })
+}
+
+/// The mean profile with every speed scaled by `factor` (see the module docs).
+pub fn scaled_profile(mean: &WindProfile, factor: f64) -> WindProfile {
+    match mean {
+        WindProfile::Flow(SteadyFlow::Uniform { speed_m_s }) => {
+            WindProfile::Flow(SteadyFlow::Uniform {
+                speed_m_s: speed_m_s * factor,
+            })
+        }
+        WindProfile::Flow(SteadyFlow::PowerLaw {
+            coefficient,
+            exponent,
+        }) => WindProfile::Flow(SteadyFlow::PowerLaw {
+            coefficient: coefficient * factor,
+            exponent: *exponent,
+        }),
+        WindProfile::Flow(SteadyFlow::Tabulated {
+            elevations_m,
+            speeds_m_s,
+        }) => WindProfile::Flow(SteadyFlow::Tabulated {
+            elevations_m: elevations_m.clone(),
+            speeds_m_s: speeds_m_s.iter().map(|u| u * factor).collect(),
+        }),
+        &WindProfile::LogLaw {
+            reference_speed_m_s,
+            reference_height_m,
+            roughness_length_m,
+        } => WindProfile::LogLaw {
+            reference_speed_m_s: reference_speed_m_s * factor,
+            reference_height_m,
+            roughness_length_m,
+        },
+    }
+}
+
+/// The gust profile of `mean` (a uniform mean with a gust speed becomes
+/// that uniform speed exactly).
+pub fn gust_profile(
+    gust: &Gust,
+    mean: &WindProfile,
+    field: &str,
+) -> Result<WindProfile, InvalidInput> {
+    if let (Gust::AtReference { gust_m_s }, WindProfile::Flow(SteadyFlow::Uniform { .. })) =
+        (gust, mean)
+    {
+        gust.validate(field)?;
+        return Ok(WindProfile::uniform(*gust_m_s));
+    }
+    Ok(scaled_profile(mean, gust_factor(gust, mean, field)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gust_of_a_uniform_flow_is_u_times_one_plus_k_i() {
+        let g = Gust::Intensity {
+            turbulence_intensity: 0.15,
+            peak_factor: 3.0,
+        };
+        let p = gust_profile(&g, &WindProfile::uniform(8.0), "wind.gust").unwrap();
+        assert_eq!(p, WindProfile::uniform(8.0 * (1.0 + 3.0 * 0.15)));
+        let p = gust_profile(
+            &Gust::AtReference { gust_m_s: 13.0 },
+            &WindProfile::uniform(8.0),
+            "wind.gust",
+        )
+        .unwrap();
+        assert_eq!(p, WindProfile::uniform(13.0));
+    }
+
+    #[test]
+    fn zero_intensity_is_the_mean_profile_bit_for_bit() {
+        let zero = Gust::Intensity {
+            turbulence_intensity: 0.0,
+            peak_factor: 3.0,
+        };
+        for mean in [
+            WindProfile::uniform(7.3),
+            WindProfile::log_law(6.1, 10.0, 0.03, "w").unwrap(),
+            WindProfile::Flow(SteadyFlow::PowerLaw {
+                coefficient: 3.1,
+                exponent: 0.14,
+            }),
+        ] {
+            assert_eq!(gust_profile(&zero, &mean, "wind.gust").unwrap(), mean);
+        }
+    }
+
+    #[test]
+    fn a_gust_speed_scales_a_log_law_at_its_reference_height() {
+        let mean = WindProfile::log_law(6.0, 10.0, 0.03, "w").unwrap();
+        let p = gust_profile(&Gust::AtReference { gust_m_s: 9.0 }, &mean, "wind.gust").unwrap();
+        assert!((p.speed_m_s(10.0) - 9.0).abs() < 1e-12);
+        assert!((p.speed_m_s(500.0) / mean.speed_m_s(500.0) - 1.5).abs() < 1e-12);
+        let calm = WindProfile::log_law(0.0, 10.0, 0.03, "w").unwrap();
+        let e = gust_profile(&Gust::AtReference { gust_m_s: 9.0 }, &calm, "wind.gust").unwrap_err();
+        assert_eq!(e.field, "wind.gust.gust_m_s");
+    }
+}

@@ -1,0 +1,297 @@
+//! Converged, conservative quasi-static GE stability (issue 21, SPEC §5
+//! applied to the GE criterion), on the thesis tether (ρA = 0.078 kg/m,
+//! F = 1000 N, m = 10 kg, EA = 10⁶ N, d = 5 mm with the solid section's
+//! rotary inertia ρA d²/16, no stand-in), calm air, payout at 10 m/s:
+//!
+//! * EI from 10⁻³ to 10³ N m² gives a finite onset (the thesis model's
+//!   `immediate` at EI = 1 and 0.01 N m² came from its rotary inertia
+//!   ρA (1 m)²: the sliding term `−L̇² I_ρ` makes the effective bending
+//!   stiffness `EI − I_ρ L̇²` negative above the rotation wave speed
+//!   √(EI/I_ρ) = 3.6 m/s at EI = 1);
+//! * with EI → 0 the converged critical length meets the string's
+//!   `(F/ρA − v²)/g` = 1296.688 m within 0.2 %;
+//! * the reported (safe) value never exceeds a 320-element root, and the
+//!   error estimate at 20, 40 and 80 elements bounds the true error
+//!   (against a converged reference at a tolerance of 10⁻⁶);
+//! * in a steady wind the converged search keeps its safe side below the
+//!   320-element divergence root too.
+
+use tetherplan::numerics::ge::air_load::AirLoads;
+use tetherplan::numerics::ge::qs_converged::{
+    ConvergedOnset, ConvergedOutcome, ConvergenceConfig, converged_critical_length,
+    converged_critical_rate,
+};
+use tetherplan::numerics::ge::qs_critical::{QsOnset, QsSearchConfig, critical_length};
+use tetherplan::numerics::ge::stability::StateMotion;
+use tetherplan::numerics::ge::{GeModel, Section, TipBody};
+use tetherplan::numerics::tether::WindProfile;
+
+const RHO_A: f64 = 0.078;
+const F: f64 = 1000.0;
+const G: f64 = 9.81;
+const D: f64 = 0.005;
+const V: f64 = 10.0;
+
+fn never() -> bool {
+    false
+}
+
+fn model(ei: f64, elements: usize) -> GeModel {
+    let s = Section::new(1e6, 1e6, ei, RHO_A, RHO_A * D * D / 16.0).unwrap();
+    let mut m = GeModel::new(
+        s,
+        elements,
+        TipBody {
+            mass_kg: 10.0,
+            link_length_m: 0.0,
+        },
+        G,
+    )
+    .unwrap();
+    m.slow_spectrum = true;
+    m
+}
+
+fn string_closed_form() -> f64 {
+    (F / RHO_A - V * V) / G
+}
+
+fn range() -> (f64, f64) {
+    (1.0, 1.5 * F / (RHO_A * G))
+}
+
+fn converged(ei: f64, air: &AirLoads, tol: f64) -> ConvergedOnset {
+    let c = converged_critical_length(
+        &model(ei, 20),
+        F,
+        air,
+        V,
+        &ConvergenceConfig {
+            relative_tolerance: tol,
+            ..Default::default()
+        },
+        range(),
+        &never,
+    )
+    .unwrap();
+    match c.outcome {
+        ConvergedOutcome::During(o) => o,
+        other => panic!("EI = {ei}: {other:?}"),
+    }
+}
+
+/// The divergence root on one uniform mesh (inertia of K, calm air).
+fn root_on(ei: f64, elements: usize) -> f64 {
+    let r = critical_length(
+        &model(ei, elements),
+        F,
+        &AirLoads::calm(),
+        V,
+        0.0,
+        StateMotion::AtRest,
+        &QsSearchConfig {
+            confirm_with_qep: false,
+            ..Default::default()
+        },
+        range(),
+        &never,
+    )
+    .unwrap();
+    match r.onset {
+        QsOnset::During { at } => at,
+        other => panic!("EI = {ei}, {elements} elements: {other:?}"),
+    }
+}
+
+fn table(ei: f64, o: &ConvergedOnset) {
+    eprintln!(
+        "EI = {ei:e}: value {:.4} ± {:.4} m, safe {:.4} m, order {:.2}, converged {}",
+        o.value, o.error_estimate, o.safe_value, o.order, o.converged
+    );
+    for (n, q) in &o.levels {
+        eprintln!("    {n:>5} elements: {q:.4} m");
+    }
+}
+
+/// EI from 10⁻³ to 10³ N m²: a finite onset, converged; and the QEP
+/// search of the 20-element mesh (the solid section's slow spectrum) is
+/// not `immediate` either.
+#[test]
+fn every_bending_stiffness_gives_a_finite_onset() {
+    for ei in [1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0, 1e3] {
+        let o = converged(ei, &AirLoads::calm(), 1e-3);
+        table(ei, &o);
+        assert!(o.converged, "EI = {ei}: not converged");
+        assert!(
+            o.safe_value > 0.9 * string_closed_form() && o.safe_value < 1.2 * string_closed_form(),
+            "EI = {ei}: {}",
+            o.safe_value
+        );
+        let qep = critical_length(
+            &model(ei, 20),
+            F,
+            &AirLoads::calm(),
+            V,
+            0.0,
+            StateMotion::AtRest,
+            &QsSearchConfig::default(),
+            range(),
+            &never,
+        )
+        .unwrap();
+        match qep.onset {
+            QsOnset::During { at } => {
+                assert!(
+                    qep.divergence,
+                    "EI = {ei}: the QEP did not confirm the divergence"
+                );
+                assert!(
+                    (at - o.levels[0].1).abs() <= 1e-6 * at,
+                    "EI = {ei}: QEP {at} vs divergence {}",
+                    o.levels[0].1
+                );
+            }
+            other => panic!("EI = {ei}: QEP search {other:?}"),
+        }
+    }
+}
+
+/// EI → 0: the converged GE critical length is the string's closed form.
+#[test]
+fn flexible_limit_is_the_string_closed_form() {
+    let want = string_closed_form();
+    for ei in [1e-3, 1e-2] {
+        let o = converged(ei, &AirLoads::calm(), 1e-3);
+        table(ei, &o);
+        for got in [o.value, o.safe_value] {
+            assert!(
+                (got - want).abs() <= 2e-3 * want,
+                "EI = {ei}: {got} vs (F/ρA − v²)/g = {want}"
+            );
+        }
+    }
+}
+
+/// The safe value never exceeds a 320-element root (itself above the
+/// continuum: first order from above), and the error estimate of the 20,
+/// 40 and 80 element roots bounds their true error.
+#[test]
+fn safe_value_and_error_estimates_are_conservative() {
+    for ei in [1e-2, 1.0, 1e3] {
+        let o = converged(ei, &AirLoads::calm(), 1e-3);
+        let reference = converged(ei, &AirLoads::calm(), 1e-6);
+        table(ei, &o);
+        table(ei, &reference);
+        let q320 = root_on(ei, 320);
+        assert!(
+            o.safe_value <= q320,
+            "EI = {ei}: safe {} above the 320-element root {q320}",
+            o.safe_value
+        );
+        for n in [20, 40, 80] {
+            let q = o
+                .levels
+                .iter()
+                .find(|l| l.0 == n)
+                .map(|l| l.1)
+                .unwrap_or_else(|| root_on(ei, n));
+            assert!(
+                (q - root_on(ei, n)).abs() <= 1e-6 * q,
+                "EI = {ei}, {n}: level root"
+            );
+            let truth = (q - reference.value).abs();
+            let estimate = o.error_at(q);
+            eprintln!("EI = {ei:e}, {n} elements: error {truth:.4} m, estimate {estimate:.4} m");
+            assert!(
+                estimate >= truth,
+                "EI = {ei}, {n} elements: estimate {estimate} below the error {truth}"
+            );
+            // and meaningful: not more than the error plus the converged bound, doubled
+            assert!(
+                estimate <= 2.0 * (truth + o.error_estimate) + 1e-3 * q,
+                "EI = {ei}, {n} elements: estimate {estimate} vs error {truth}"
+            );
+        }
+    }
+}
+
+/// The critical payout rate at 1300 m (EI = 1000 N m²): first order from
+/// above on the levels, the safe rate below the 80-element one.
+#[test]
+fn critical_rate_converges_from_above() {
+    let c = converged_critical_rate(
+        &model(1e3, 20),
+        F,
+        &AirLoads::calm(),
+        1300.0,
+        300.0,
+        &ConvergenceConfig::default(),
+        &never,
+        None,
+    )
+    .unwrap();
+    let ConvergedOutcome::During(o) = c.outcome else {
+        panic!("{:?}", c.outcome)
+    };
+    eprintln!(
+        "rate at 1300 m: {:.3} ± {:.3} m/s, safe {:.3}, order {:.2}",
+        o.value, o.error_estimate, o.safe_value, o.order
+    );
+    for (n, q) in &o.levels {
+        eprintln!("    {n:>5} elements: {q:.4} m/s");
+    }
+    // 1280 elements reach an estimate of 0.17 % (the levels turn second
+    // order once the bending layer is resolved; first-order Richardson is
+    // then pessimistic): not within 1e-3, and said so.
+    assert!(o.error_estimate <= 2e-3 * o.value, "{}", o.error_estimate);
+    assert!(
+        o.levels[1].1 < 21.3 && o.levels[1].1 > 21.2,
+        "40 elements: issue 21's 21.26 m/s"
+    );
+    for w in o.levels.windows(2) {
+        assert!(w[1].1 < w[0].1, "not from above: {:?}", o.levels);
+    }
+    assert!(o.safe_value < o.levels.last().unwrap().1);
+}
+
+/// In a steady 8 m/s wind the safe side lies below every level's root
+/// and below the calm-air one. (Measured: the 20-element mesh finds a
+/// sign change of det K at 142 m that the 40-element mesh does not; the
+/// search then stops, not converged, on the coarse root's safe side.)
+#[test]
+fn wind_keeps_the_safe_side() {
+    let air = AirLoads {
+        wind: WindProfile::uniform(8.0),
+        air_density_kg_m3: 1.225,
+        cable_diameter_m: D,
+        cable_normal_drag_coefficient: 1.2,
+        aerostat_drag_area_m2: 0.3 * 3.0,
+        aerostat_lift_area_m2: 0.0,
+    };
+    let c = converged_critical_length(
+        &model(1.0, 20),
+        F,
+        &air,
+        V,
+        &ConvergenceConfig::default(),
+        range(),
+        &never,
+    )
+    .unwrap();
+    eprintln!("wind: {:?}", c.outcome);
+    let ConvergedOutcome::During(o) = c.outcome else {
+        panic!("{:?}", c.outcome)
+    };
+    if o.converged {
+        let k = o.levels.len();
+        let (d1, d2) = (
+            (o.levels[k - 2].1 - o.levels[k - 3].1).abs(),
+            (o.levels[k - 1].1 - o.levels[k - 2].1).abs(),
+        );
+        assert!(d2 < d1, "levels do not converge: {:?}", o.levels);
+    }
+    let lowest = o.levels.iter().map(|l| l.1).fold(f64::INFINITY, f64::min);
+    assert!(o.safe_value <= lowest);
+    // blown down: shorter than in calm air
+    assert!(o.safe_value < converged(1.0, &AirLoads::calm(), 1e-3).safe_value);
+}
