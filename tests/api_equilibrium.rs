@@ -217,13 +217,14 @@ fn envelope_points_equal_single_point_answers() {
                 } => WindFlowInput::PowerLaw {
                     coefficient_m_s: u / 10f64.powf(0.14),
                     exponent_nondim,
+                    reference_height_m: 1.0,
                 },
                 WindFlowInput::LogLaw {
                     reference_height_m,
                     roughness_length_m,
                     ..
                 } => WindFlowInput::LogLaw {
-                    reference_speed_m_s: u,
+                    speed_m_s: u,
                     reference_height_m,
                     roughness_length_m,
                 },
@@ -439,7 +440,8 @@ fn critical_and_chart_answers_carry_the_tensions() {
     let bad: Result<CriticalRequest, _> = contract::parse(&serde_json::to_vec(&json!({
         "cable": {"mass_per_length_kg_m": 0.078, "breaking_strength_n": -1.0},
         "aerostat": {"net_buoyancy_n": 1000.0}, "profile": {"kind": "constant_rate", "rate_m_s": 10.0}})).unwrap());
-    let err = tetherplan::contract::run::critical(&bad.unwrap()).unwrap_err();
+    // Refused as the request is parsed (one validation for every route and jobs).
+    let err = bad.unwrap_err();
     assert_eq!(
         err.body().error.field.as_deref(),
         Some("cable.breaking_strength_n")

@@ -145,6 +145,31 @@ fn every_route_is_documented_with_its_statuses() {
             "delete_job",
             &["200", "401", "404", "409", "500"],
         ),
+        (
+            "put",
+            "/api/v1/systems/{name}",
+            "put_system",
+            &["200", "201", "400", "401", "413", "415", "422", "500"],
+        ),
+        (
+            "get",
+            "/api/v1/systems/{name}",
+            "get_system",
+            &["200", "401", "404", "422", "500"],
+        ),
+        (
+            "delete",
+            "/api/v1/systems/{name}",
+            "delete_system",
+            &["204", "401", "404", "422", "500"],
+        ),
+        (
+            "get",
+            "/api/v1/systems",
+            "list_systems",
+            &["200", "401", "500"],
+        ),
+        ("get", "/api/v1/presets", "list_presets", &["200", "401"]),
         ("get", "/healthz", "get_health", &["200"]),
         ("get", "/openapi.json", "get_openapi", &["200"]),
     ];

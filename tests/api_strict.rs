@@ -182,7 +182,7 @@ fn initial(g: &mut Gen, l0: f64) -> Value {
 fn ge_system(g: &mut Gen, elements: usize) -> Value {
     json!({
         "cable": cable(g),
-        "aerostat": {"net_buoyancy_n": g.in_range(GE_NET_BUOYANCY_N), "mass_kg": g.in_range(AEROSTAT_MASS_KG),
+        "aerostat": {"net_buoyancy_n": g.in_range(NET_BUOYANCY_N), "mass_kg": g.in_range(AEROSTAT_MASS_KG),
                      "link_length_m": if g.coin() { 0.0 } else { g.in_range(LINK_LENGTH_M) }},
         "initial_length_m": g.in_range(INITIAL_LENGTH_M),
         "gravity_m_s2": g.in_range(GE_GRAVITY_M_S2),

@@ -917,7 +917,7 @@ fn cases() -> Vec<Case> {
             "simulate",
             ge_simulate(json!({})),
             "aerostat.net_buoyancy_n",
-            GE_NET_BUOYANCY_N,
+            NET_BUOYANCY_N,
         ),
         case(
             "simulate",

@@ -281,7 +281,7 @@ pub struct SafeRateParams {
 
 /// The rates of a chart (m/s, each above 0 and at most 1000): a list, or
 /// `{min, max, count}` evenly spaced (the one [`GridInput`] of every grid).
-pub type RateGrid = crate::contract::system::GridInput;
+pub type RateGrid = crate::contract::system::grid::RateGridInput;
 
 /// `POST /api/v1/charts`: t* and h* against rate, one series per buoyancy.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]

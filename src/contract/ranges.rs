@@ -151,12 +151,13 @@ impl CheckRanges for SafeRateParams {
 }
 
 fn check_rate_grid(grid: &RateGrid, prefix: &str) -> Checked {
-    match grid {
-        RateGrid::Range(r) => {
+    use crate::contract::system::GridInput;
+    match &grid.0 {
+        GridInput::Range(r) => {
             POSITIVE_RATE_M_S.check(&at(prefix, "min"), r.min)?;
             POSITIVE_RATE_M_S.check(&at(prefix, "max"), r.max).map(drop)
         }
-        RateGrid::List(v) => each(POSITIVE_RATE_M_S, prefix, v),
+        GridInput::List(v) => each(POSITIVE_RATE_M_S, prefix, v),
     }
 }
 

@@ -17,9 +17,7 @@ use crate::numerics::chart::Parallelism;
 
 /// Wind rows of the request.
 pub fn envelope_row_count(req: &EnvelopeRequest) -> usize {
-    req.wind_speeds_m_s
-        .as_ref()
-        .map_or(1, crate::contract::system::GridInput::count)
+    req.wind_speeds_m_s.as_ref().map_or(1, |g| g.count())
 }
 
 /// The envelope of the wind rows `range`.

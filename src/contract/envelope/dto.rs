@@ -7,7 +7,8 @@ use crate::contract::equilibrium::dto::{
     ResolvedAerostatOutput, ResolvedCableOutput, TetherAerostatInput, TetherCableInput,
     default_gravity, default_safety_factor, default_steps,
 };
-use crate::contract::system::{GridInput, WinchInput, WindInput};
+use crate::contract::system::grid::{LengthGrid, WindSpeedGrid};
+use crate::contract::system::{WinchInput, WindInput};
 
 /// `POST /api/v1/envelope`: equilibria over wind speed × tether length,
 /// each judged against slack, tension, ceiling and (with a payout rate) stability.
@@ -36,9 +37,9 @@ pub struct EnvelopeRequest {
     /// Wind speeds (m/s, 0 to 150, at most 1000): a list or `{min, max, count}`;
     /// absent: the flow's own speed only (today's wind).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub wind_speeds_m_s: Option<GridInput>,
+    pub wind_speeds_m_s: Option<WindSpeedGrid>,
     /// Tether lengths (m, above 0 and at most 100 000, at most 1000): a list or `{min, max, count}`.
-    pub tether_lengths_m: GridInput,
+    pub tether_lengths_m: LengthGrid,
     #[serde(default = "default_gravity")]
     #[schema(example = 9.81, exclusive_minimum = 0.0, maximum = 100.0)]
     pub gravity_m_s2: f64,

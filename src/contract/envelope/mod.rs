@@ -10,7 +10,6 @@ pub mod stability;
 use crate::contract::equilibrium::dto::WindFlowInput;
 use crate::contract::equilibrium::dto::{ResolvedAerostatOutput, ResolvedCableOutput};
 use crate::contract::equilibrium::{require_count, require_range};
-use crate::contract::system::GridInput;
 use crate::contract::system::grid::GridBounds;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::chart::Parallelism;
@@ -31,23 +30,8 @@ pub const MAX_SYNC_GE_ENVELOPE_POINTS: usize = 500;
 /// What "stable" means in the envelope.
 pub const STABILITY_CRITERION: &str = "continuum linear-string criterion of SPEC §1 applied to the blown-down tether: stable while the smallest tension exceeds the kinematic term ρA v² (calm air: h* = (F/ρA − v²)/g)";
 
-/// Wind speeds of the envelope grid.
-const WIND_GRID: GridBounds = GridBounds {
-    min: 0.0,
-    exclusive_min: false,
-    max: 150.0,
-    max_count: 1000,
-    unit: "m/s",
-};
-
-/// Tether lengths of the envelope grid.
-const LENGTH_GRID: GridBounds = GridBounds {
-    min: 0.0,
-    exclusive_min: true,
-    max: 1e5,
-    max_count: 1000,
-    unit: "m",
-};
+const WIND_GRID: GridBounds = crate::contract::system::grid::WindSpeedGrid::BOUNDS;
+const LENGTH_GRID: GridBounds = crate::contract::system::grid::LengthGrid::BOUNDS;
 
 impl EnvelopeRequest {
     /// The shape of the flow (scaled by each grid speed) and its own speed.
@@ -138,7 +122,7 @@ impl EnvelopeRequest {
     pub fn points(&self) -> usize {
         self.wind_speeds_m_s
             .as_ref()
-            .map_or(1, GridInput::count)
+            .map_or(1, |g| g.count())
             .saturating_mul(self.tether_lengths_m.count())
     }
 

@@ -116,8 +116,12 @@ fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidI
     if let Some(w) = &req.wind {
         w.check()?;
     }
-    // A wind of zero speed everywhere is calm air (no drag data needed).
-    let wind = req.wind.as_ref().filter(|w| !w.flow.is_calm());
+    // A wind of zero speed everywhere without drag data is calm air; with
+    // them it runs through the wind path (the same plan: tests/verification_plan.rs).
+    let wind = req.wind.as_ref().filter(|w| {
+        !w.flow.is_calm()
+            || (req.cable.cable("cable").is_ok() && req.aerostat.body("aerostat").is_ok())
+    });
     let air = match (wind, ge) {
         (Some(w), None) => Air::Wind(Box::new(steady_wind(req, w)?)),
         (None, None) => Air::Calm,

@@ -197,16 +197,7 @@ impl GridInput {
         match self {
             Self::Range(r) => crate::numerics::chart::rate_grid(r.min, r.max, r.count)
                 .map_err(|e| InvalidInput::new(e.field.replacen("rates_m_s", at, 1), e.reason)),
-            Self::List(_) => self.values(
-                at,
-                GridBounds {
-                    min: 0.0,
-                    exclusive_min: true,
-                    max: 1000.0,
-                    max_count: crate::numerics::chart::MAX_CHART_POINTS,
-                    unit: "m/s",
-                },
-            ),
+            Self::List(_) => self.values(at, RateGridInput::BOUNDS),
         }
     }
 }
@@ -252,3 +243,94 @@ mod tests {
         assert_eq!(e.field, "g[1]");
     }
 }
+
+/// The schema of a grid with its bounds (a list, or `{min, max, count}`).
+fn bounded_schema(b: GridBounds, description: &str) -> serde_json::Value {
+    let mut value = serde_json::json!({"type": "number", "format": "double", "maximum": b.max});
+    value[if b.exclusive_min {
+        "exclusiveMinimum"
+    } else {
+        "minimum"
+    }] = serde_json::json!(b.min);
+    serde_json::json!({
+        "description": description,
+        "oneOf": [
+            {"title": "list", "type": "array", "items": value, "minItems": 1, "maxItems": b.max_count},
+            {"title": "even grid", "type": "object", "required": ["min", "max", "count"],
+             "additionalProperties": false,
+             "properties": {
+                 "min": value, "max": value,
+                 "count": {"type": "integer", "minimum": 1, "maximum": b.max_count}
+             }}
+        ]
+    })
+}
+
+/// A [`GridInput`] of one quantity, with the bounds its schema states and
+/// its validation applies (the same numbers).
+macro_rules! bounded_grid {
+    ($(#[$doc:meta])* $name:ident, $desc:literal, $bounds:expr) => {
+        $(#[$doc])*
+        #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+        #[serde(transparent)]
+        pub struct $name(pub GridInput);
+
+        impl $name {
+            pub const BOUNDS: GridBounds = $bounds;
+        }
+
+        impl std::ops::Deref for $name {
+            type Target = GridInput;
+            fn deref(&self) -> &GridInput {
+                &self.0
+            }
+        }
+
+        impl utoipa::PartialSchema for $name {
+            fn schema() -> utoipa::openapi::RefOr<utoipa::openapi::schema::Schema> {
+                serde_json::from_value(bounded_schema(Self::BOUNDS, $desc)).expect("a valid schema")
+            }
+        }
+
+        impl utoipa::ToSchema for $name {}
+    };
+}
+
+bounded_grid!(
+    /// Wind speeds of the envelope (m/s).
+    WindSpeedGrid,
+    "Wind speeds (m/s): a list, or {min, max, count} evenly spaced.",
+    GridBounds {
+        min: 0.0,
+        exclusive_min: false,
+        max: 150.0,
+        max_count: 1000,
+        unit: "m/s",
+    }
+);
+
+bounded_grid!(
+    /// Tether lengths of the envelope (m).
+    LengthGrid,
+    "Tether lengths (m): a list, or {min, max, count} evenly spaced.",
+    GridBounds {
+        min: 0.0,
+        exclusive_min: true,
+        max: 1e5,
+        max_count: 1000,
+        unit: "m",
+    }
+);
+
+bounded_grid!(
+    /// Winch rates of a chart (m/s).
+    RateGridInput,
+    "Rates (m/s): a list, or {min, max, count} evenly spaced.",
+    GridBounds {
+        min: 1e-6,
+        exclusive_min: false,
+        max: 1000.0,
+        max_count: crate::numerics::chart::MAX_CHART_POINTS,
+        unit: "m/s",
+    }
+);

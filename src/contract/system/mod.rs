@@ -50,7 +50,7 @@ pub struct CableInput {
     pub diameter_m: Option<f64>,
     /// Mass per unit (unstretched) length ρA (kg/m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(example = 0.078, exclusive_minimum = 0.0, maximum = 1000.0)]
+    #[schema(example = 0.078, minimum = 1e-5, maximum = 100.0)]
     pub mass_per_length_kg_m: Option<f64>,
     /// Material density ρ (kg/m³), with `area_m2` (e.g. 7800 for steel).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -118,7 +118,7 @@ pub struct AerostatInput {
     pub volume_m3: Option<f64>,
     /// Net buoyancy F = buoyancy − weight (N): the upward pull on the tether.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(example = 1000.0, exclusive_minimum = 0.0, maximum = 1e7)]
+    #[schema(example = 1000.0, minimum = 0.001, maximum = 1e7)]
     pub net_buoyancy_n: Option<f64>,
     /// Aerostat mass m (kg), default 0 (or the preset's).
     #[serde(default, skip_serializing_if = "Option::is_none")]

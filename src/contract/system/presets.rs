@@ -104,10 +104,10 @@ pub struct CablePresetOutput {
     pub name: String,
     /// Effective density on the circumscribed area π d²/4 (kg/m³): ρA = this × π d²/4.
     pub density_kg_m3: f64,
-    /// Effective axial modulus on the circumscribed area (Pa).
-    pub axial_modulus_pa: f64,
-    /// Effective breaking stress on the circumscribed area (Pa).
-    pub breaking_stress_pa: f64,
+    /// Effective axial modulus on the circumscribed area (N/m², Pa).
+    pub axial_modulus_n_m2: f64,
+    /// Effective breaking stress on the circumscribed area (N/m², Pa).
+    pub breaking_stress_n_m2: f64,
     pub normal_drag_coefficient_nondim: f64,
     /// The figures of a 6 mm tether of this material.
     pub at_6_mm: CableAtDiameterOutput,
@@ -186,8 +186,8 @@ pub fn presets() -> PresetsResponse {
             CablePresetOutput {
                 name: (*name).into(),
                 density_kg_m3: rho,
-                axial_modulus_pa: e,
-                breaking_stress_pa: sigma,
+                axial_modulus_n_m2: e,
+                breaking_stress_n_m2: sigma,
                 normal_drag_coefficient_nondim: at.normal_drag_coefficient,
                 at_6_mm: CableAtDiameterOutput {
                     diameter_m: 0.006,

@@ -230,19 +230,10 @@ impl AerostatInput {
         }
     }
 
-    /// Net buoyancy for the GE models (zero allowed).
+    /// Net buoyancy for the GE models: the one bound of the system's
+    /// schema (0.001 to 10⁷ N; the GE bodies took 0 before SPEC §9).
     pub fn net_buoyancy_ge(&self, at: &str) -> Result<f64, InvalidInput> {
-        let field = format!("{at}.net_buoyancy_n");
-        match self
-            .net_buoyancy_n
-            .or(self.named().map(|n| n.net_buoyancy_n))
-        {
-            Some(f) => crate::numerics::params::ranges::GE_NET_BUOYANCY_N.check(&field, f),
-            None => Err(InvalidInput::new(
-                field,
-                "give the aerostat's net buoyancy in newtons (its lift minus its weight), or a named aerostat preset",
-            )),
-        }
+        self.net_buoyancy(at)
     }
 
     /// Mass m (kg): given, the named preset's, or 0.
