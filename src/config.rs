@@ -92,6 +92,9 @@ pub struct JobArgs {
     /// Largest estimated answer of one job (bytes of JSON); larger: 422.
     #[arg(long, env = "TETHERPLAN_JOB_MAX_RESULT_BYTES", default_value_t = Limits::default().max_job_result_bytes)]
     pub job_max_result_bytes: u64,
+    /// Seconds a finished job (and its answer) is kept; then it is deleted.
+    #[arg(long, env = "TETHERPLAN_JOB_RETENTION_S", default_value_t = Limits::default().job_retention.as_secs_f64())]
+    pub job_retention_s: f64,
 }
 
 /// Limits of the HTTP service.
@@ -121,6 +124,8 @@ pub struct Limits {
     pub max_job_run_time: Duration,
     /// Largest estimated answer of one job, bytes of JSON.
     pub max_job_result_bytes: u64,
+    /// How long a finished job is kept before it is deleted.
+    pub job_retention: Duration,
 }
 
 impl Default for Limits {
@@ -139,6 +144,7 @@ impl Default for Limits {
             max_job_attempts: 3,
             max_job_run_time: Duration::from_secs(3600),
             max_job_result_bytes: 64 << 20,
+            job_retention: Duration::from_secs(7 * 24 * 3600),
         }
     }
 }
@@ -208,6 +214,7 @@ impl JobArgs {
             max_job_attempts: self.job_max_attempts.max(1),
             max_job_run_time: Duration::from_secs_f64(self.job_max_run_s.clamp(0.01, 1e7)),
             max_job_result_bytes: self.job_max_result_bytes,
+            job_retention: Duration::from_secs_f64(self.job_retention_s.clamp(0.0, 1e10)),
             ..Limits::default()
         }
     }
@@ -269,6 +276,7 @@ impl From<ServeArgs> for Config {
                 max_job_attempts: a.jobs.job_max_attempts.max(1),
                 max_job_run_time: Duration::from_secs_f64(a.jobs.job_max_run_s.clamp(0.01, 1e7)),
                 max_job_result_bytes: a.jobs.job_max_result_bytes,
+                job_retention: Duration::from_secs_f64(a.jobs.job_retention_s.clamp(0.0, 1e10)),
                 ..Limits::default()
             },
             connections: ConnectionLimits {

@@ -323,15 +323,34 @@ const IDLE_POLL: Duration = Duration::from_millis(250);
 /// How often a worker records that it is alive.
 pub const PRESENCE_INTERVAL: Duration = Duration::from_secs(1);
 
+/// How often a worker purges expired jobs, assembled chunks and stale
+/// worker rows ([`store::JobBackend::housekeeping`]).
+pub const HOUSEKEEPING_INTERVAL: Duration = Duration::from_secs(60);
+
+/// A worker row silent this long is deleted (its process is gone).
+pub const STALE_WORKER_AGE: Duration = Duration::from_secs(60);
+
 /// A worker is counted live while its last heartbeat is this recent.
 pub const PRESENCE_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// Heartbeats this worker into the store's live workers until shutdown,
 /// then leaves the list.
 fn presence(queue: &JobQueue, role: &str) {
+    let mut last_housekeeping: Option<std::time::Instant> = None;
     while !queue.is_shut_down() {
         if let Err(e) = queue.store.worker_heartbeat(role) {
             tracing::warn!(error = %e, "worker heartbeat not recorded");
+        }
+        if last_housekeeping.is_none_or(|t| t.elapsed() >= HOUSEKEEPING_INTERVAL) {
+            last_housekeeping = Some(std::time::Instant::now());
+            match queue
+                .store
+                .housekeeping(queue.limits.job_retention, STALE_WORKER_AGE)
+            {
+                Ok(0) => {}
+                Ok(n) => tracing::info!(purged = n, "finished jobs past their retention deleted"),
+                Err(e) => tracing::warn!(error = %e, "housekeeping failed"),
+            }
         }
         let (lock, cvar) = &queue.stopping;
         let guard = lock.lock().unwrap_or_else(|e| e.into_inner());

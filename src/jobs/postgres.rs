@@ -458,14 +458,25 @@ impl JobBackend for PgStore {
     }
 
     fn finish_done(&self, lease: &Lease, result: &str) -> Result<bool, StoreError> {
-        self.fenced(
+        let done = self.fenced(
             &format!(
                 "status = 'done', progress = 1, result = $4, error = NULL, finished_at = {NOW},
                  lease_expires_ms = NULL"
             ),
             lease,
             Some(&result),
-        )
+        )?;
+        if done {
+            // the chunks' results are in the answer now: not kept twice
+            self.with(|c| {
+                c.execute(
+                    "UPDATE job_chunks SET result = NULL WHERE job_id = $1",
+                    &[&lease.job_id],
+                )?;
+                Ok(())
+            })?;
+        }
+        Ok(done)
     }
 
     fn finish_failed(&self, lease: &Lease, error: &str) -> Result<bool, StoreError> {
@@ -738,7 +749,7 @@ impl JobBackend for PgStore {
     fn chunk_results(&self, job_id: i64) -> Result<Vec<(usize, String)>, StoreError> {
         self.with(|c| {
             Ok(c.query(
-                "SELECT idx, result FROM job_chunks WHERE job_id = $1 AND status = 'done'
+                "SELECT idx, result FROM job_chunks WHERE job_id = $1 AND status = 'done' AND result IS NOT NULL
                  ORDER BY idx",
                 &[&job_id],
             )?
@@ -766,6 +777,37 @@ impl JobBackend for PgStore {
         self.with(|c| {
             c.execute("DELETE FROM workers WHERE id = $1", &[&me])?;
             Ok(())
+        })
+    }
+
+    fn housekeeping(
+        &self,
+        retention: Duration,
+        stale_workers: Duration,
+    ) -> Result<usize, StoreError> {
+        let seconds = retention.as_secs_f64().min(1e12);
+        let since = now_ms() - millis(stale_workers);
+        self.with(|c| {
+            let mut tx = c.transaction()?;
+            tx.execute(
+                "UPDATE job_chunks SET result = NULL WHERE result IS NOT NULL AND job_id IN
+                     (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled'))",
+                &[],
+            )?;
+            let expired = "status IN ('done', 'failed', 'cancelled')
+                     AND finished_at IS NOT NULL
+                     AND finished_at <= to_char((clock_timestamp() - make_interval(secs => $1))
+                         AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.MS\"Z\"')";
+            tx.execute(
+                &format!(
+                    "DELETE FROM job_chunks WHERE job_id IN (SELECT id FROM jobs WHERE {expired})"
+                ),
+                &[&seconds],
+            )?;
+            let purged = tx.execute(&format!("DELETE FROM jobs WHERE {expired}"), &[&seconds])?;
+            tx.execute("DELETE FROM workers WHERE heartbeat_ms < $1", &[&since])?;
+            tx.commit()?;
+            Ok(purged as usize)
         })
     }
 

@@ -433,14 +433,22 @@ impl JobBackend for JobStore {
     }
 
     fn finish_done(&self, lease: &Lease, result: &str) -> Result<bool, StoreError> {
-        self.fenced(
+        let done = self.fenced(
             &format!(
                 "status = 'done', progress = 1, result = ?4, error = NULL, finished_at = {NOW},
                  lease_expires_ms = NULL"
             ),
             lease,
             Some(&result),
-        )
+        )?;
+        if done {
+            // the chunks' results are in the answer now: not kept twice
+            self.conn().execute(
+                "UPDATE job_chunks SET result = NULL WHERE job_id = ?1",
+                [lease.job_id],
+            )?;
+        }
+        Ok(done)
     }
 
     fn finish_failed(&self, lease: &Lease, error: &str) -> Result<bool, StoreError> {
@@ -725,7 +733,7 @@ impl JobBackend for JobStore {
     fn chunk_results(&self, job_id: i64) -> Result<Vec<(usize, String)>, StoreError> {
         let conn = self.conn();
         let mut stmt = conn.prepare(
-            "SELECT idx, result FROM job_chunks WHERE job_id = ?1 AND status = 'done' ORDER BY idx",
+            "SELECT idx, result FROM job_chunks WHERE job_id = ?1 AND status = 'done' AND result IS NOT NULL ORDER BY idx",
         )?;
         let rows = stmt.query_map([job_id], |r| {
             Ok((r.get::<_, i64>(0)? as usize, r.get::<_, String>(1)?))
@@ -747,6 +755,41 @@ impl JobBackend for JobStore {
         self.conn()
             .execute("DELETE FROM workers WHERE id = ?1", [self.worker.as_str()])?;
         Ok(())
+    }
+
+    fn housekeeping(
+        &self,
+        retention: Duration,
+        stale_workers: Duration,
+    ) -> Result<usize, StoreError> {
+        let mut conn = self.conn();
+        let tx = conn.transaction()?;
+        let seconds = retention.as_secs_f64().min(1e12);
+        let cutoff: String = tx.query_row(
+            "SELECT strftime('%Y-%m-%dT%H:%M:%fZ', 'now', ?1)",
+            [format!("-{seconds:.3} seconds")],
+            |r| r.get(0),
+        )?;
+        tx.execute(
+            "UPDATE job_chunks SET result = NULL WHERE result IS NOT NULL AND job_id IN
+                 (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled'))",
+            [],
+        )?;
+        tx.execute(
+            "DELETE FROM job_chunks WHERE job_id IN
+                 (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled')
+                     AND finished_at IS NOT NULL AND finished_at <= ?1)",
+            [&cutoff],
+        )?;
+        let purged = tx.execute(
+            "DELETE FROM jobs WHERE status IN ('done', 'failed', 'cancelled')
+                 AND finished_at IS NOT NULL AND finished_at <= ?1",
+            [&cutoff],
+        )?;
+        let since = now_ms() - stale_workers.as_millis().min(i64::MAX as u128) as i64;
+        tx.execute("DELETE FROM workers WHERE heartbeat_ms < ?1", [since])?;
+        tx.commit()?;
+        Ok(purged)
     }
 
     fn live_workers(&self, within: Duration) -> Result<usize, StoreError> {

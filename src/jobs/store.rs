@@ -261,6 +261,17 @@ pub trait JobBackend: Send + Sync {
     fn worker_leave(&self) -> Result<(), StoreError>;
     /// Workers whose last heartbeat is at most `within` old.
     fn live_workers(&self, within: Duration) -> Result<usize, StoreError>;
+    /// Retention (issue 22): deletes the finished jobs (done, failed,
+    /// cancelled) that finished more than `retention` ago with their chunk
+    /// rows, empties the chunk results of every finished job (its answer
+    /// is assembled, or it failed), and
+    /// the worker rows whose last heartbeat is older than `stale_workers`.
+    /// Returns the jobs deleted.
+    fn housekeeping(
+        &self,
+        retention: Duration,
+        stale_workers: Duration,
+    ) -> Result<usize, StoreError>;
 
     /// One job, any owner.
     fn get(&self, id: i64) -> Result<Option<JobRecord>, StoreError> {
