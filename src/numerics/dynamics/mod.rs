@@ -187,10 +187,10 @@ impl Default for DynamicsConfig {
             spectral_radius: 0.8,
             sample_interval_s: 1.0,
             shape_times_s: vec![],
-            newton_tolerance_m_s: 1e-7,
+            newton_tolerance_m_s: 1e-6,
             max_newton_iterations: 30,
-            turbulence_time_step_s: 0.1,
-            turbulence_level_spacing_m: 25.0,
+            turbulence_time_step_s: 0.2,
+            turbulence_level_spacing_m: 50.0,
         }
     }
 }

@@ -276,43 +276,44 @@ impl TurbulenceField {
         let speeds: Vec<f64> = (0..levels)
             .map(|k| mean.speed_m_s(k as f64 * dz).abs())
             .collect();
-        // Complex coefficients per level, built frequency by frequency.
-        let mut spectra = vec![(0.0f64, 0.0f64); levels * m];
+        // Level by level, carrying the Markov chain of every frequency up.
         let normal = |stream: u64, dim: u64| inverse_normal_cdf(uniform01(t.seed, stream, dim));
         let half = 1.0 / 2f64.sqrt();
-        for j in 1..m / 2 {
-            let f = j as f64 * df;
-            let (mut gr, mut gi) = (0.0, 0.0);
-            for k in 0..levels {
+        let mut chain = vec![(0.0f64, 0.0f64); m / 2];
+        let mut data = vec![0.0; levels * m];
+        let mut buf = vec![(0.0, 0.0); m];
+        for k in 0..levels {
+            let u = speeds[k];
+            let ubar = if k > 0 {
+                0.5 * (speeds[k] + speeds[k - 1])
+            } else {
+                0.0
+            };
+            buf.iter_mut().for_each(|c| *c = (0.0, 0.0));
+            for j in 1..m / 2 {
+                let f = j as f64 * df;
                 let xr = normal(j as u64, 2 * k as u64) * half;
                 let xi = normal(j as u64, 2 * k as u64 + 1) * half;
-                if k == 0 {
-                    (gr, gi) = (xr, xi);
+                let (gr, gi) = if k == 0 {
+                    (xr, xi)
                 } else {
-                    let ubar = 0.5 * (speeds[k] + speeds[k - 1]);
                     let rho = if ubar > 0.0 {
                         (-DAVENPORT_DECAY * f * dz / ubar).exp()
                     } else {
                         0.0
                     };
                     let s = (1.0 - rho * rho).max(0.0).sqrt();
-                    gr = rho * gr + s * xr;
-                    gi = rho * gi + s * xi;
-                }
-                let u = speeds[k];
+                    (rho * chain[j].0 + s * xr, rho * chain[j].1 + s * xi)
+                };
+                chain[j] = (gr, gi);
                 let amp = if u > 1e-6 && t.intensity > 0.0 {
                     // a_m cos + b_m sin with a, b ~ N(0, S Δf): coefficient a − i b.
                     (2.0 * t.model.density(f, t.intensity * u, t.length_scale_m, u) * df).sqrt()
                 } else {
                     0.0
                 };
-                spectra[k * m + j] = (amp * gr, -amp * gi);
+                buf[j] = (amp * gr, -amp * gi);
             }
-        }
-        let mut data = vec![0.0; levels * m];
-        let mut buf = vec![(0.0, 0.0); m];
-        for k in 0..levels {
-            buf.copy_from_slice(&spectra[k * m..(k + 1) * m]);
             fft_in_place(&mut buf, 1.0);
             for (d, c) in data[k * m..(k + 1) * m].iter_mut().zip(&buf) {
                 *d = c.0;
