@@ -69,8 +69,8 @@ impl EnvelopeRequest {
                 let z0 = require_range(
                     "wind.flow.roughness_length_m",
                     *roughness_length_m,
-                    0.0,
-                    true,
+                    crate::contract::system::validate::MIN_ROUGHNESS_M,
+                    false,
                     10.0,
                 )?;
                 let zr = require_range(
