@@ -7,7 +7,7 @@
 
 use axum::Extension;
 use axum::extract::{Path, State};
-use axum::http::{StatusCode, header};
+use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
@@ -46,22 +46,7 @@ pub struct SystemList {
     pub systems: Vec<SystemEntry>,
 }
 
-fn json_response(status: StatusCode, value: &impl Serialize) -> Response {
-    (
-        status,
-        [(header::CONTENT_TYPE, "application/json")],
-        serde_json::to_vec(value).expect("views serialise"),
-    )
-        .into_response()
-}
-
-async fn blocking<T: Send + 'static>(
-    f: impl FnOnce() -> Result<T, ApiError> + Send + 'static,
-) -> Result<T, ApiError> {
-    tokio::task::spawn_blocking(f)
-        .await
-        .map_err(|e| ApiError::internal(format!("job store task failed: {e}")))?
-}
+use crate::api::jobs::{blocking, json_response};
 
 fn owner(caller: &Caller) -> String {
     caller.owner.clone().unwrap_or_default()
