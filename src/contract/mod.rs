@@ -4,26 +4,27 @@
 //! ([`run`]). Everything here is synchronous and CPU-bound.
 
 pub mod bands;
-pub mod chart_chunks;
-pub mod dto;
 pub mod envelope;
 pub mod equilibrium;
 pub mod finite;
 pub mod ge;
-pub mod ge_charts;
-pub mod ge_critical;
-pub mod ge_numerics;
-pub mod ge_quasi_static;
 pub mod json_keys;
 pub mod plan;
 pub mod ranges;
-pub mod run;
-pub mod simulate;
+pub mod string;
 pub mod system;
-pub mod tension;
 pub mod transient;
 
-pub use run::{Progress, RequestError};
+// The old paths of the modules that moved into their domain folders, kept
+// for the API, the jobs, the CLI and the tests.
+pub use ge::{
+    charts as ge_charts, critical as ge_critical, numerics as ge_numerics,
+    quasi_static as ge_quasi_static,
+};
+pub use string::{chunks as chart_chunks, dto, run, tension};
+pub use transient::any as simulate;
+
+pub use string::run::{Progress, RequestError};
 
 use crate::numerics::params::InvalidInput;
 

@@ -4,14 +4,14 @@
 //! message: the field path and the accepted range.
 
 use crate::contract::dto::*;
-use crate::contract::ge::{
+use crate::contract::ge::simulate::{
     EndLoadInput, GeAerostatInput, GeModelInput, GeSimulateRequest, LoadTimeInput,
 };
 use crate::contract::ge_charts::{
     self, GeBaseFrequencyResponseRequest, GeChartRequest, GeWindInput, WindProfileInput,
 };
 use crate::contract::ge_critical::{GeCriticalRequest, GeStabilityRequest};
-use crate::contract::transient::{
+use crate::contract::transient::simulate::{
     AeroBodyInput, AirFlowInput, FlowPointInput, ForceModelInput, FrequencyResponseParams,
     InitialStateInput, SimulateParams, SteadyFlowInput,
 };

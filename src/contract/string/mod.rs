@@ -1,0 +1,7 @@
+//! The linear string model's requests: stability, critical time, safe
+//! rate and the deployment chart.
+
+pub mod chunks;
+pub mod dto;
+pub mod run;
+pub mod tension;
