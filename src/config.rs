@@ -8,6 +8,9 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 pub use crate::api::server::ConnectionLimits;
+pub use crate::jobs::store::StoreConfig;
+pub use crate::jobs::worker::WorkerConfig;
+pub use crate::limits::Limits;
 
 /// `tetherplan serve` flags.
 #[derive(Clone, Debug, clap::Args)]
@@ -97,58 +100,6 @@ pub struct JobArgs {
     pub job_retention_s: f64,
 }
 
-/// Limits of the HTTP service.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Limits {
-    pub max_body_bytes: usize,
-    pub max_in_flight: usize,
-    pub solve_timeout: Duration,
-    pub max_pending_jobs: usize,
-    /// Largest chart answered synchronously (points = rates × buoyancies).
-    pub max_sync_chart_points: usize,
-    /// Largest synchronous chart work, points × elements.
-    pub max_sync_chart_work: usize,
-    /// Largest model answered synchronously when the answer needs a dense
-    /// QEP solve (stability; critical time with QEP confirmation or an
-    /// accelerating profile). 400 elements ≈ 0.4 s per solve.
-    pub max_sync_qep_elements: usize,
-    /// Largest number of requests in one batch job.
-    pub max_batch_items: usize,
-    /// Jobs queued or running at once for one API token.
-    pub max_pending_jobs_per_token: usize,
-    /// How long a job claim lasts unless renewed (heartbeat every third of it).
-    pub job_lease: Duration,
-    /// Claims of one job whose process died before it is failed.
-    pub max_job_attempts: u32,
-    /// Longest run of one job.
-    pub max_job_run_time: Duration,
-    /// Largest estimated answer of one job, bytes of JSON.
-    pub max_job_result_bytes: u64,
-    /// How long a finished job is kept before it is deleted.
-    pub job_retention: Duration,
-}
-
-impl Default for Limits {
-    fn default() -> Self {
-        Self {
-            max_body_bytes: 1 << 20,
-            max_in_flight: 64,
-            solve_timeout: Duration::from_secs(30),
-            max_pending_jobs: 1000,
-            max_sync_chart_points: 20_000,
-            max_sync_chart_work: 2_000_000,
-            max_sync_qep_elements: 400,
-            max_batch_items: 1000,
-            max_pending_jobs_per_token: 100,
-            job_lease: Duration::from_secs(30),
-            max_job_attempts: 3,
-            max_job_run_time: Duration::from_secs(3600),
-            max_job_result_bytes: 64 << 20,
-            job_retention: Duration::from_secs(7 * 24 * 3600),
-        }
-    }
-}
-
 /// `tetherplan worker` flags: the job store and the job limits.
 #[derive(Clone, Debug, clap::Args)]
 pub struct WorkerArgs {
@@ -163,40 +114,6 @@ pub struct WorkerArgs {
     pub job_threads: Option<usize>,
     #[command(flatten)]
     pub jobs: JobArgs,
-}
-
-/// The job store a process opens: SQLite at a path, or PostgreSQL.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum StoreConfig {
-    Sqlite(PathBuf),
-    Postgres(String),
-}
-
-impl StoreConfig {
-    pub fn new(db: PathBuf, database_url: Option<String>) -> Self {
-        match database_url.filter(|u| !u.trim().is_empty()) {
-            Some(url) => Self::Postgres(url),
-            None => Self::Sqlite(db),
-        }
-    }
-
-    /// Where the jobs are, for logs (no password).
-    pub fn describe(&self) -> String {
-        match self {
-            Self::Sqlite(p) => format!("sqlite:{}", p.display()),
-            Self::Postgres(u) => crate::jobs::postgres::redact(u),
-        }
-    }
-
-    /// Opens (and migrates) the store.
-    pub fn open(
-        &self,
-    ) -> Result<Box<dyn crate::jobs::store::JobBackend>, crate::jobs::store::StoreError> {
-        Ok(match self {
-            Self::Sqlite(p) => Box::new(crate::jobs::store::JobStore::open(p)?),
-            Self::Postgres(u) => Box::new(crate::jobs::postgres::PgStore::open(u)?),
-        })
-    }
 }
 
 fn cores() -> usize {
@@ -218,14 +135,6 @@ impl JobArgs {
             ..Limits::default()
         }
     }
-}
-
-/// Everything `worker` needs.
-#[derive(Clone, Debug)]
-pub struct WorkerConfig {
-    pub store: StoreConfig,
-    pub job_threads: usize,
-    pub limits: Limits,
 }
 
 impl From<WorkerArgs> for WorkerConfig {

@@ -8,7 +8,10 @@
 //!   and the functions that run one request.
 //! * [`api`]: the HTTP service (axum), its OpenAPI document and error body.
 //! * [`jobs`]: persisted batch jobs (SQLite) and their worker.
-//! * [`config`]: settings of `serve` (flags with `TETHERPLAN_*` fallbacks).
+//! * [`config`]: settings of `serve` (flags with `TETHERPLAN_*` fallbacks);
+//!   above [`jobs`], which never names it.
+//! * [`limits`]: the service's and the job queue's limits (a plain struct
+//!   `config` fills and the queue carries).
 //!
 //! Invariants: `numerics` never touches serde, tokio, axum or SQLite;
 //! invalid input is an `Err` naming the field; physical outcomes
@@ -18,4 +21,5 @@ pub mod api;
 pub mod config;
 pub mod contract;
 pub mod jobs;
+pub mod limits;
 pub mod numerics;

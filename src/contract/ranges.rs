@@ -331,6 +331,35 @@ impl CheckRanges for FrequencyResponseParams {
     }
 }
 
+// The parameters of each linear-string request checked after parsing
+// (`crate::contract::parse`), with its system part.
+macro_rules! system_request {
+    ($($req:ty => $params:ty),* $(,)?) => {$(
+        impl crate::contract::dto::SystemRequest for $req {
+            type Params = $params;
+            fn from_parts(system: SystemInput, params: $params) -> Self {
+                Self { system, params }
+            }
+            fn check_ranges(&self) -> Result<(), crate::numerics::params::InvalidInput> {
+                check_system(&self.system)?;
+                CheckRanges::check_ranges(
+                    &self.params,
+                    self.system.initial_length_m,
+                )
+            }
+        }
+    )*};
+}
+
+system_request!(
+    StabilityRequest => StabilityParams,
+    CriticalRequest => CriticalParams,
+    SafeRateRequest => SafeRateParams,
+    ChartRequest => ChartParams,
+    crate::contract::transient::SimulateRequest => crate::contract::transient::SimulateParams,
+    crate::contract::transient::FrequencyResponseRequest => crate::contract::transient::FrequencyResponseParams,
+);
+
 // ------------------------------------------------------------------ GE
 
 fn check_ge_system(

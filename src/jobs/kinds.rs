@@ -15,7 +15,7 @@ use serde_json::Value;
 use serde_json::value::RawValue;
 use utoipa::ToSchema;
 
-use crate::config::Limits;
+use crate::limits::Limits;
 use crate::contract::dto::*;
 use crate::contract::ge_charts::{self, AnyChartRequest, AnyFrequencyResponseRequest};
 use crate::contract::ge_critical::{self, AnyCriticalRequest, AnyStabilityRequest};

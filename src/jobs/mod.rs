@@ -32,7 +32,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 
-use crate::config::Limits;
+use crate::limits::Limits;
 use crate::contract::dto::ErrorBody;
 use crate::contract::{Progress, RequestError};
 use kinds::JobSubmission;

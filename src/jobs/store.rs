@@ -14,6 +14,7 @@
 //! Jobs carry an owner (the hash of the API token that submitted them, or
 //! none without tokens) and optionally an idempotency key, unique per owner.
 
+use std::path::PathBuf;
 use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
@@ -327,4 +328,38 @@ pub enum PutSystem {
     Full {
         max: usize,
     },
+}
+
+/// The job store a process opens: SQLite at a path, or PostgreSQL.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum StoreConfig {
+    Sqlite(PathBuf),
+    Postgres(String),
+}
+
+impl StoreConfig {
+    pub fn new(db: PathBuf, database_url: Option<String>) -> Self {
+        match database_url.filter(|u| !u.trim().is_empty()) {
+            Some(url) => Self::Postgres(url),
+            None => Self::Sqlite(db),
+        }
+    }
+
+    /// Where the jobs are, for logs (no password).
+    pub fn describe(&self) -> String {
+        match self {
+            Self::Sqlite(p) => format!("sqlite:{}", p.display()),
+            Self::Postgres(u) => super::postgres::redact(u),
+        }
+    }
+
+    /// Opens (and migrates) the store.
+    pub fn open(
+        &self,
+    ) -> Result<Box<dyn JobBackend>, StoreError> {
+        Ok(match self {
+            Self::Sqlite(p) => Box::new(JobStore::open(p)?),
+            Self::Postgres(u) => Box::new(super::postgres::PgStore::open(u)?),
+        })
+    }
 }

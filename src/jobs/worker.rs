@@ -9,7 +9,16 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use super::JobQueue;
-use crate::config::WorkerConfig;
+use super::store::StoreConfig;
+use crate::limits::Limits;
+
+/// Everything `worker` needs.
+#[derive(Clone, Debug)]
+pub struct WorkerConfig {
+    pub store: StoreConfig,
+    pub job_threads: usize,
+    pub limits: Limits,
+}
 
 /// Longest wait for the running work to stop after a signal.
 pub const STOP_GRACE: Duration = Duration::from_secs(20);

@@ -11,11 +11,15 @@ use utoipa::ToSchema;
 use crate::contract::bands::dto::{
     PercentileBand, RejectedSamplesOutput, UncertainInput, UncertaintyInput,
 };
-use crate::contract::bands::run::{MAX_OUT_OF_RANGE, MAX_SEED, distribution};
 use crate::contract::{Progress, RequestError};
 use crate::numerics::chart::Parallelism;
 use crate::numerics::params::{InvalidInput, Range, compact};
 use crate::numerics::uncertainty::{self, Distribution, Ensemble};
+
+/// Largest fraction of a distribution allowed outside its field's range.
+pub const MAX_OUT_OF_RANGE: f64 = 0.01;
+/// Largest seed (2^53 − 1: exact in every JSON reader).
+pub const MAX_SEED: u64 = (1 << 53) - 1;
 
 /// The `uncertainty` parameter of a plan or envelope bands request.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
@@ -370,7 +374,7 @@ pub fn rejected_output<F: UncertainField>(
 
 /// The 5/50/95 % band of `values` (sorted in place).
 pub fn band_of(values: &mut [f64]) -> PercentileBand {
-    crate::contract::bands::run::percentile_band(
+    percentile_band(
         uncertainty::Summariser::new(values.len()).band(values),
     )
 }
@@ -397,5 +401,37 @@ impl Progress for Silent<'_> {
     fn report(&self, _: usize, _: usize) {}
     fn cancelled(&self) -> bool {
         self.0.cancelled()
+    }
+}
+
+/// The sampling distribution of an uncertain input.
+pub(crate) fn distribution(input: &UncertainInput) -> Distribution {
+    match *input {
+        UncertainInput::Normal { mean, std_dev, .. } => Distribution::Normal { mean, std_dev },
+        UncertainInput::Uniform { low, high, .. } => Distribution::Uniform { low, high },
+        UncertainInput::Lognormal { mean, std_dev, .. } => {
+            Distribution::Lognormal { mean, std_dev }
+        }
+    }
+}
+
+/// The 5/50/95 % band of a quantity with each percentile's sampling error.
+pub(crate) fn percentile_band(b: uncertainty::Band) -> PercentileBand {
+    let [q05, q50, q95] = b.quantiles;
+    PercentileBand {
+        p05: q05.value,
+        p50: q50.value,
+        p95: q95.value,
+        p05_error: q05.error(),
+        p50_error: q50.error(),
+        p95_error: q95.error(),
+        p05_low: q05.low,
+        p05_high: q05.high,
+        p50_low: q50.low,
+        p50_high: q50.high,
+        p95_low: q95.low,
+        p95_high: q95.high,
+        mean: b.mean,
+        std_dev: b.std_dev,
     }
 }

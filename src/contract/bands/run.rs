@@ -18,7 +18,10 @@ use std::sync::Arc;
 
 use serde_json::{Map, Value};
 
-use crate::contract::bands::common::{FieldRange, UncertainField, check_distribution, culprit};
+use crate::contract::bands::common::{
+    FieldRange, UncertainField, check_distribution, culprit, distribution, percentile_band,
+};
+pub use crate::contract::bands::common::{MAX_OUT_OF_RANGE, MAX_SEED};
 use crate::contract::bands::dto::*;
 use crate::contract::dto::SystemInput;
 use crate::contract::{Progress, RequestError, parse_value};
@@ -27,17 +30,12 @@ use crate::numerics::params::{AerostatSystem, InvalidInput, ranges, require_posi
 use crate::numerics::string::StringModel;
 use crate::numerics::string::critical::Onset;
 use crate::numerics::string::operators::StringOperators;
-use crate::numerics::uncertainty::{self, Distribution, Ensemble, Summariser};
+use crate::numerics::uncertainty::{self, Ensemble, Summariser};
 
 /// Most rates of one banded chart.
 pub const MAX_BAND_RATES: usize = 1000;
 /// Most chart points (samples × rates) of one bands request (a job).
 pub const MAX_BAND_EVALUATIONS: usize = 2_000_000;
-/// Largest fraction of a distribution allowed outside its field's range.
-pub const MAX_OUT_OF_RANGE: f64 = 0.01;
-/// Largest seed (2^53 − 1: exact in every JSON reader).
-pub const MAX_SEED: u64 = (1 << 53) - 1;
-
 /// The keys of the parameters; every other top-level key belongs to the
 /// system.
 const PARAM_KEYS: [&str; 3] = ["rates_m_s", "uncertainty", "target_elevation_m"];
@@ -192,16 +190,6 @@ pub fn evaluations(req: &BandsRequest) -> usize {
         RatesInput::Grid(g) => g.count,
     };
     rates.saturating_mul(req.params.uncertainty.samples)
-}
-
-pub(crate) fn distribution(input: &UncertainInput) -> Distribution {
-    match *input {
-        UncertainInput::Normal { mean, std_dev, .. } => Distribution::Normal { mean, std_dev },
-        UncertainInput::Uniform { low, high, .. } => Distribution::Uniform { low, high },
-        UncertainInput::Lognormal { mean, std_dev, .. } => {
-            Distribution::Lognormal { mean, std_dev }
-        }
-    }
 }
 
 /// Every check that needs no solve.
@@ -599,26 +587,6 @@ fn summarise(
         elements: crate::contract::run::chart_elements(prep.discretisation),
         converged,
     })
-}
-
-pub(crate) fn percentile_band(b: uncertainty::Band) -> PercentileBand {
-    let [q05, q50, q95] = b.quantiles;
-    PercentileBand {
-        p05: q05.value,
-        p50: q50.value,
-        p95: q95.value,
-        p05_error: q05.error(),
-        p50_error: q50.error(),
-        p95_error: q95.error(),
-        p05_low: q05.low,
-        p05_high: q05.high,
-        p50_low: q50.low,
-        p50_high: q50.high,
-        p95_low: q95.low,
-        p95_high: q95.high,
-        mean: b.mean,
-        std_dev: b.std_dev,
-    }
 }
 
 /// Parses a bands body: the system part and the parameters separately (so

@@ -1,11 +1,14 @@
-//! The geometrically exact (GE) model's requests: the transient run, the
-//! critical time and stability, and the deployment chart.
+//! The geometrically exact (GE) model's requests: the transient run and
+//! the model inputs every GE request shares ([`simulate`]), the critical
+//! time ([`critical`], both methods), the stability query ([`stability`]),
+//! the deployment chart and the base-excitation frequency response
+//! ([`charts`]), and the numerics settings they share ([`numerics`]).
 
 pub mod charts;
 pub mod critical;
 pub mod numerics;
-pub mod quasi_static;
 pub mod simulate;
+pub mod stability;
 
 pub use simulate::{
     GeAerostatInput, GeModelInput, GeModelKind, GeSimulateRequest, GeSimulateResponse,

@@ -6,9 +6,10 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::numerics::ge::critical::{MAX_STEP_CUTS, StartState};
-use crate::numerics::ge::solver::Scheme;
-use crate::numerics::params::InvalidInput;
+use crate::contract::ge::simulate::NewtonInput;
+use crate::numerics::ge::critical::{CriticalConfig, MAX_STEP_CUTS, StartState};
+use crate::numerics::ge::solver::{NewtonConfig, Scheme};
+use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 
 /// The time-stepping scheme of a GE march.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
@@ -160,4 +161,100 @@ impl From<StartStateInput> for StartState {
             StartStateInput::SteadyPayout => StartState::SteadyPayout,
         }
     }
+}
+
+/// Settings of each critical-time search.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GeChartNumericsInput {
+    /// Newmark step (s).
+    #[serde(default = "default_dt")]
+    #[schema(example = 0.02, minimum = 1e-9, maximum = 1000.0)]
+    pub time_step_s: f64,
+    /// Local QEP every this many steps (the bracket is then retraced step by step).
+    #[serde(default = "default_check")]
+    #[schema(example = 25, minimum = 1, maximum = 100000)]
+    pub check_every_steps: usize,
+    /// Stop searching (stable) after this long (s).
+    #[serde(default = "default_horizon")]
+    #[schema(example = 2000.0, minimum = 1e-6, maximum = 1e7)]
+    pub horizon_s: f64,
+    /// Floor of the growth-rate tolerance on Re λ (1/s).
+    #[serde(default = "default_growth")]
+    #[schema(example = 1e-6, minimum = 0.0, maximum = 1e6)]
+    pub growth_tolerance_1_s: f64,
+    /// Time-stepping scheme; default: generalized-α, which dissipates the
+    /// unresolved axial modes a start from rest sets ringing (they
+    /// otherwise show as a false early onset).
+    #[serde(default = "default_scheme")]
+    pub scheme: SchemeInput,
+    /// Spectral radius ρ∞ of the scheme as ωΔt → ∞ (default: 0 for generalized-α, 0.5 for HHT-α;
+    /// generalized-α: 0–1, HHT-α: 0.5–1, average acceleration: 1).
+    #[serde(default)]
+    #[schema(example = 0.0, minimum = 0.0, maximum = 1.0)]
+    pub rho_infinity_nondim: Option<f64>,
+    /// When Newton fails, halve the step and retry, at most this many
+    /// levels deep.
+    #[serde(default = "default_max_step_cuts")]
+    #[schema(example = 8, minimum = 0, maximum = 12)]
+    pub max_step_cuts: u32,
+}
+
+pub(crate) fn default_dt() -> f64 {
+    CriticalConfig::default().time_step_s
+}
+pub(crate) fn default_check() -> usize {
+    CriticalConfig::default().check_every
+}
+pub(crate) fn default_horizon() -> f64 {
+    CriticalConfig::default().horizon_s
+}
+pub(crate) fn default_growth() -> f64 {
+    CriticalConfig::default().growth_tolerance_1_s
+}
+
+/// How a point's search ended.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum GeOnsetKind {
+    /// Unstable at t = 0.
+    Immediate,
+    /// First unstable at `critical_time_s`.
+    During,
+    /// Stable over the search horizon.
+    Never,
+    /// Newton–Raphson failed before any instability.
+    NewtonFailed,
+    /// The eigenvalue iteration failed.
+    SpectrumFailed,
+    /// Stopped by the caller.
+    Cancelled,
+}
+
+/// The Newton settings of a request (defaults when absent), checked.
+pub(crate) fn newton_config(input: &Option<NewtonInput>) -> Result<NewtonConfig, InvalidInput> {
+    let Some(n) = input else {
+        return Ok(NewtonConfig::default());
+    };
+    let rtol = require_positive("newton.relative_tolerance", n.relative_tolerance)?;
+    if rtol > 0.1 {
+        return Err(InvalidInput::new(
+            "newton.relative_tolerance",
+            "must not exceed 0.1",
+        ));
+    }
+    if !(1..=200).contains(&n.max_iterations) {
+        return Err(InvalidInput::new(
+            "newton.max_iterations",
+            format!("must be between 1 and 200, got {}", n.max_iterations),
+        ));
+    }
+    Ok(NewtonConfig {
+        relative_tolerance: rtol,
+        absolute_tolerance_n: require_non_negative(
+            "newton.absolute_tolerance_n",
+            n.absolute_tolerance_n,
+        )?,
+        max_iterations: n.max_iterations,
+    })
 }

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+pub use crate::contract::error::{ErrorBody, ErrorDetail};
 pub use crate::contract::system::{AerostatInput, CableInput, WinchInput, WindInput};
 
 /// Which cable model, and its discretisation.
@@ -486,36 +487,6 @@ pub struct ChartResponse {
     pub converged: bool,
 }
 
-/// The one error body of the CLI and the API.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
-pub struct ErrorBody {
-    pub error: ErrorDetail,
-}
-
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
-pub struct ErrorDetail {
-    /// Machine-readable kind: `invalid_input`, `malformed_json`,
-    /// `payload_too_large`, `queue_full`, `overloaded`, `not_found`,
-    /// `cancelled`, `internal`.
-    pub code: String,
-    /// The offending field as a JSON path (`cable.mass_per_length_kg_m`), when one is to blame.
-    pub field: Option<String>,
-    /// What is wrong, in words.
-    pub message: String,
-}
-
-impl ErrorBody {
-    pub fn new(code: &str, field: Option<String>, message: impl Into<String>) -> Self {
-        Self {
-            error: ErrorDetail {
-                code: code.into(),
-                field,
-                message: message.into(),
-            },
-        }
-    }
-}
-
 /// A request made of the common system part and its own parameters;
 /// the two are parsed separately so that every error names its field
 /// (serde loses the path inside `#[serde(flatten)]`).
@@ -527,30 +498,3 @@ pub trait SystemRequest: Sized {
         Ok(())
     }
 }
-
-macro_rules! system_request {
-    ($($req:ty => $params:ty),* $(,)?) => {$(
-        impl SystemRequest for $req {
-            type Params = $params;
-            fn from_parts(system: SystemInput, params: $params) -> Self {
-                Self { system, params }
-            }
-            fn check_ranges(&self) -> Result<(), crate::numerics::params::InvalidInput> {
-                crate::contract::ranges::check_system(&self.system)?;
-                crate::contract::ranges::CheckRanges::check_ranges(
-                    &self.params,
-                    self.system.initial_length_m,
-                )
-            }
-        }
-    )*};
-}
-
-system_request!(
-    StabilityRequest => StabilityParams,
-    CriticalRequest => CriticalParams,
-    SafeRateRequest => SafeRateParams,
-    ChartRequest => ChartParams,
-    crate::contract::transient::SimulateRequest => crate::contract::transient::SimulateParams,
-    crate::contract::transient::FrequencyResponseRequest => crate::contract::transient::FrequencyResponseParams,
-);

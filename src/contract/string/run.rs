@@ -2,60 +2,17 @@
 //! SI input, calls the core, and converts the outcome back to SI output.
 
 use crate::contract::dto::*;
+pub use crate::contract::error::{NoProgress, Progress, RequestError};
 use crate::numerics::chart::{self, Parallelism};
 use crate::numerics::params::{
     AerostatSystem, InvalidInput, Kinematics, require_finite, require_positive,
 };
 use crate::numerics::profile::Profile;
-use crate::numerics::qep::QepError;
 use crate::numerics::string::StringModel;
 use crate::numerics::string::converged::{self, ConvergedConfig, ConvergedSafeRate};
 use crate::numerics::string::critical::{
     self, ImmediateCause, Onset, SafeRate, SearchConfig, SearchMethod,
 };
-
-/// Why a request was not answered.
-#[derive(Debug, thiserror::Error)]
-pub enum RequestError {
-    /// The body is not JSON (HTTP 400).
-    #[error("malformed JSON: {0}")]
-    Malformed(String),
-    /// Bad input: the field and the reason (HTTP 422/400).
-    #[error(transparent)]
-    Invalid(#[from] InvalidInput),
-    /// The numerics failed on valid input (HTTP 500; should not happen).
-    #[error("numerical failure: {0}")]
-    Numerical(QepError),
-    /// The work was cancelled through its progress handle.
-    #[error("cancelled")]
-    Cancelled,
-}
-
-impl From<QepError> for RequestError {
-    fn from(e: QepError) -> Self {
-        match e {
-            QepError::Cancelled => Self::Cancelled,
-            e => Self::Numerical(e),
-        }
-    }
-}
-
-/// Progress reporting and cancellation for long requests.
-pub trait Progress: Sync {
-    /// `done` of `total` units finished.
-    fn report(&self, done: usize, total: usize);
-    /// Should the work stop?
-    fn cancelled(&self) -> bool {
-        false
-    }
-}
-
-/// Progress that goes nowhere.
-pub struct NoProgress;
-
-impl Progress for NoProgress {
-    fn report(&self, _: usize, _: usize) {}
-}
 
 impl SystemInput {
     pub fn system(&self) -> Result<AerostatSystem, InvalidInput> {
@@ -668,25 +625,5 @@ pub fn chart_elements(discretisation: chart::Discretisation) -> usize {
     match discretisation {
         chart::Discretisation::Elements(n) => n,
         chart::Discretisation::Converged { .. } => converged::graded_operators(0).dim(),
-    }
-}
-
-impl RequestError {
-    /// The error body the CLI prints and the API returns.
-    pub fn body(&self) -> ErrorBody {
-        match self {
-            Self::Malformed(m) => ErrorBody::new(
-                "malformed_json",
-                Some("body".into()),
-                format!("malformed JSON: {m}"),
-            ),
-            Self::Invalid(e) => ErrorBody::new(
-                "invalid_input",
-                Some(e.field.clone()),
-                format!("{}: {}", e.field, e.reason),
-            ),
-            Self::Numerical(e) => ErrorBody::new("internal", None, e.to_string()),
-            Self::Cancelled => ErrorBody::new("cancelled", None, "the work was cancelled"),
-        }
     }
 }

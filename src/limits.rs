@@ -1,0 +1,59 @@
+//! The limits that keep the service responsive: the HTTP service's
+//! (body size, requests in flight, synchronous work) and the job queue's
+//! (pending jobs, leases, attempts, run time, answer size, retention).
+//! A plain struct below both: `config` fills it from the flags, the job
+//! queue carries it, and the HTTP state reads it from the queue.
+
+use std::time::Duration;
+
+/// Limits of the HTTP service and its job queue.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Limits {
+    pub max_body_bytes: usize,
+    pub max_in_flight: usize,
+    pub solve_timeout: Duration,
+    pub max_pending_jobs: usize,
+    /// Largest chart answered synchronously (points = rates × buoyancies).
+    pub max_sync_chart_points: usize,
+    /// Largest synchronous chart work, points × elements.
+    pub max_sync_chart_work: usize,
+    /// Largest model answered synchronously when the answer needs a dense
+    /// QEP solve (stability; critical time with QEP confirmation or an
+    /// accelerating profile). 400 elements ≈ 0.4 s per solve.
+    pub max_sync_qep_elements: usize,
+    /// Largest number of requests in one batch job.
+    pub max_batch_items: usize,
+    /// Jobs queued or running at once for one API token.
+    pub max_pending_jobs_per_token: usize,
+    /// How long a job claim lasts unless renewed (heartbeat every third of it).
+    pub job_lease: Duration,
+    /// Claims of one job whose process died before it is failed.
+    pub max_job_attempts: u32,
+    /// Longest run of one job.
+    pub max_job_run_time: Duration,
+    /// Largest estimated answer of one job, bytes of JSON.
+    pub max_job_result_bytes: u64,
+    /// How long a finished job is kept before it is deleted.
+    pub job_retention: Duration,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self {
+            max_body_bytes: 1 << 20,
+            max_in_flight: 64,
+            solve_timeout: Duration::from_secs(30),
+            max_pending_jobs: 1000,
+            max_sync_chart_points: 20_000,
+            max_sync_chart_work: 2_000_000,
+            max_sync_qep_elements: 400,
+            max_batch_items: 1000,
+            max_pending_jobs_per_token: 100,
+            job_lease: Duration::from_secs(30),
+            max_job_attempts: 3,
+            max_job_run_time: Duration::from_secs(3600),
+            max_job_result_bytes: 64 << 20,
+            job_retention: Duration::from_secs(7 * 24 * 3600),
+        }
+    }
+}
