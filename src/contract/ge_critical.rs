@@ -193,6 +193,35 @@ pub struct GeCriticalResponse {
     /// Quasi-static only: equilibria solved.
     #[serde(default)]
     pub quasi_static_equilibrium_solves: Option<usize>,
+    /// Quasi-static without `model.elements`: the critical length is
+    /// converged (nested meshes from `elements`, Richardson) and
+    /// `max_elevation_m` / `critical_time_s` are its safe side (best
+    /// estimate minus the error estimate); null otherwise.
+    #[serde(default)]
+    pub converged: Option<bool>,
+    /// Converged only: the relative tolerance of the search.
+    #[serde(default)]
+    pub relative_tolerance_nondim: Option<f64>,
+    /// Converged only: the best estimate of the continuum h* (m).
+    #[serde(default)]
+    pub max_elevation_estimate_m: Option<f64>,
+    /// Converged only: the estimated discretisation error of that estimate (m).
+    #[serde(default)]
+    pub max_elevation_error_m: Option<f64>,
+    /// Converged only: the same error in t* (s), `max_elevation_error_m / v`.
+    #[serde(default)]
+    pub critical_time_error_s: Option<f64>,
+    /// Converged only: `(elements, divergence root h* in m)` of each mesh.
+    #[serde(default)]
+    pub mesh_levels: Option<Vec<GeMeshLevelOutput>>,
+}
+
+/// One mesh of a converged quasi-static search.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct GeMeshLevelOutput {
+    pub elements: usize,
+    /// The divergence root on this mesh (m).
+    pub max_elevation_m: f64,
 }
 
 /// The cable model of a GE request.
@@ -213,12 +242,12 @@ fn prepare(
     let l0 = require_positive("initial_length_m", initial_length_m)?;
     let g = require_non_negative("gravity_m_s2", gravity_m_s2)?;
     let buoyancy = aerostat.net_buoyancy("aerostat")?;
-    if !(1..=MAX_GE_QEP_ELEMENTS).contains(&model.elements) {
+    if !(1..=MAX_GE_QEP_ELEMENTS).contains(&model.elements()) {
         return Err(InvalidInput::new(
             "model.elements",
             format!(
                 "must be between 1 and {MAX_GE_QEP_ELEMENTS} for a GE stability or critical-time answer, got {}",
-                model.elements
+                model.elements()
             ),
         ));
     }
@@ -228,7 +257,7 @@ fn prepare(
         link_length_m: aerostat.link_length("aerostat")?,
     };
     Ok(Prepared {
-        model: GeModel::new(section, model.elements, tip, g)?,
+        model: GeModel::new(section, model.elements(), tip, g)?,
         initial_length_m: l0,
         net_buoyancy_n: buoyancy,
     })
@@ -461,6 +490,12 @@ pub fn ge_critical(
         method: GeCriticalMethod::Marching,
         quasi_static_bracket_m: None,
         quasi_static_equilibrium_solves: None,
+        converged: None,
+        relative_tolerance_nondim: None,
+        max_elevation_estimate_m: None,
+        max_elevation_error_m: None,
+        critical_time_error_s: None,
+        mesh_levels: None,
     })
 }
 
