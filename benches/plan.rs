@@ -42,16 +42,15 @@ fn bench(c: &mut Criterion) {
     // at 1000 m), equilibria at every node of the pass, with a jerk limit
     // and a tension rating.
     let windy: PlanRequest = serde_json::from_value(json!({
-        "cable": {"mass_per_length_kg_m": 0.078},
-        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0},
+        "cable": {"mass_per_length_kg_m": 0.078, "diameter_m": 0.006, "breaking_strength_n": 20000.0},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.47,
+                     "reference_area_m2": 3.0},
         "initial_length_m": 1.0,
         "target_elevation_m": 1000.0,
         "winch": {"max_rate_m_s": 40.0, "max_acceleration_m_s2": 2.0, "max_jerk_m_s3": 1.0},
         "lift_reserve_nondim": 0.05,
-        "tether": {"breaking_strength_n": 20000.0, "safety_factor_nondim": 5.0},
-        "wind": {"flow": {"kind": "log_law", "reference_speed_m_s": 3.0, "roughness_length_m": 0.03},
-                 "cable_diameter_m": 0.006, "aerostat_drag_coefficient_nondim": 0.47,
-                 "aerostat_reference_area_m2": 3.0},
+        "required_safety_factor_nondim": 5.0,
+        "wind": {"flow": {"kind": "log_law", "reference_speed_m_s": 3.0, "roughness_length_m": 0.03}},
         "haul_down": {"forecast": [{"time_s": 0.0, "wind_speed_m_s": 5.0}, {"time_s": 3600.0, "wind_speed_m_s": 15.0}],
                       "max_operating_wind_m_s": 12.0}
     }))
@@ -75,6 +74,18 @@ fn bench(c: &mut Criterion) {
     group.bench_function(
         "plan_request_1000m_log_law_wind_jerk_rated_quasi_static_ge",
         |b| b.iter(|| plan(std::hint::black_box(&ge), &NoProgress).unwrap()),
+    );
+    // Issue 21 (target ≤ 200 ms): the same plan with the GE table
+    // converged (no `elements`: nested meshes from 20, tolerance 1e-3,
+    // safe side) and EI from the tether (6 mm, full-slip bound).
+    let mut conv: serde_json::Value = serde_json::to_value(&windy).unwrap();
+    conv["stability"] = json!({"method": "quasi_static_ge"});
+    let conv: PlanRequest = serde_json::from_value(conv).unwrap();
+    let out = plan(&conv, &NoProgress).unwrap();
+    assert!(out.ge_stability.as_ref().is_some_and(|g| g.converged), "{out:?}");
+    group.bench_function(
+        "plan_request_1000m_log_law_wind_jerk_rated_quasi_static_ge_converged",
+        |b| b.iter(|| plan(std::hint::black_box(&conv), &NoProgress).unwrap()),
     );
     group.finish();
 }

@@ -81,3 +81,59 @@ async fn quasi_static_refuses_what_it_cannot_answer() {
     assert!(s.is_client_error(), "{v}");
     assert!(v.to_string().contains("method"), "{v}");
 }
+
+/// Issue 21: without `model.elements` the quasi-static h* is converged and
+/// given on the safe side with its error estimate. Checked against
+/// independent 20- and 40-element quasi-static answers of the same
+/// body (each with `elements`; 40 is the synchronous limit): the levels
+/// the answer states are those answers (to 1e-5 relative: the root widths
+/// differ) and the safe h* is below them (FE roots converge from above in
+/// calm air). With a nearly flexible tether
+/// (EI = 1e-2 N m², so E* = EA/EI with EA = 1e6 N) the converged h* is the
+/// string's closed form `(F/ρA − v²)/g` within 0.2 %.
+#[tokio::test]
+async fn quasi_static_without_elements_is_converged_with_its_error() {
+    let app = app();
+    let mut conv = body(Some("quasi_static"));
+    conv["model"].as_object_mut().unwrap().remove("elements");
+    conv["profile"]["rate_m_s"] = json!(10.0);
+    let (s, c) = post(&app, &conv).await;
+    assert_eq!(s, StatusCode::OK, "{c}");
+    assert_eq!(c["converged"], true, "{c}");
+    assert_eq!(c["relative_tolerance_nondim"], 1e-3);
+    let safe = c["max_elevation_m"].as_f64().unwrap();
+    let est = c["max_elevation_estimate_m"].as_f64().unwrap();
+    let err = c["max_elevation_error_m"].as_f64().unwrap();
+    println!("converged h* {est:.3} ± {err:.3} m, safe {safe:.3} m: {}", c["explanation"]);
+    assert!(err >= 0.0 && err <= 1e-3 * est, "{c}");
+    assert!((safe - (est - err)).abs() <= 1e-9 * est);
+    let t = c["critical_time_s"].as_f64().unwrap();
+    assert!((t - (safe - 1.0) / 10.0).abs() < 1e-9);
+    assert!((c["critical_time_error_s"].as_f64().unwrap() - err / 10.0).abs() < 1e-12);
+    let levels = c["mesh_levels"].as_array().unwrap();
+    assert!(levels.len() >= 3);
+    for (n, l) in [20, 40].into_iter().zip(levels) {
+        let mut one = conv.clone();
+        one["model"]["elements"] = json!(n);
+        let (s, o) = post(&app, &one).await;
+        assert_eq!(s, StatusCode::OK, "{o}");
+        assert!(o["converged"].is_null(), "{o}");
+        let h = o["max_elevation_m"].as_f64().unwrap();
+        assert_eq!(l["elements"], n);
+        let level = l["max_elevation_m"].as_f64().unwrap();
+        assert!((level - h).abs() <= 1e-5 * h, "{n}: level {level} vs answer {h}");
+        assert!(safe < h, "{n}: safe {safe} not below {h}");
+    }
+    // nearly flexible: the string's closed form
+    let mut flexible = conv.clone();
+    flexible["model"]["bending_stiffness_n_m2"] = json!(1e-2);
+    flexible["model"]["stiffness_ratio"] = json!(1e8);
+    flexible["model"]["inertia_ratio"] = json!(0.078 / (0.078 * 0.005 * 0.005 / 16.0));
+    let (s, f) = post(&app, &flexible).await;
+    assert_eq!(s, StatusCode::OK, "{f}");
+    let want = (1000.0 / 0.078 - 100.0) / 9.81;
+    let got = f["max_elevation_m"].as_f64().unwrap();
+    println!("EI = 0.01 N m²: converged safe h* {got:.3} m, closed form {want:.3} m, {}", f["explanation"]);
+    assert!((got / want - 1.0).abs() <= 2e-3, "{got} vs {want}");
+    assert!(got <= f["max_elevation_estimate_m"].as_f64().unwrap());
+}

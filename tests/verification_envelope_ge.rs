@@ -142,8 +142,11 @@ fn envelope_cells_are_single_point_answers() {
             }
             let g = p.max_growth_rate_1_s.unwrap();
             let chained = cell_stability(&sys, p.tether_length_m, RATE, start.as_deref()).unwrap();
+            // The solid section's slow spectrum inverts K, which magnifies
+            // the Newton tolerance's differences between two solves of one
+            // state (measured 5.6e-7 1/s of 1.3e-2 at 5 m/s, 1150 m).
             assert!(
-                (g - chained.spectrum.max_real).abs() < 1e-12,
+                (g - chained.spectrum.max_real).abs() < 1e-4 * g.abs() + 1e-9,
                 "{g} vs {}",
                 chained.spectrum.max_real
             );
@@ -271,9 +274,28 @@ fn critical_length_and_rate_in_wind_match_scans() {
         let (mut last_stable, mut first_unstable) = (None, None);
         for k in 0..=n {
             let r = 1e-3 * cap + (cap - 1e-3 * cap) * k as f64 / n as f64;
+            // Unstable also where det K < 0 on the continued branch: just
+            // past a divergence root the QEP's real eigenvalue grows more
+            // slowly than the tolerance, and further on the Newton may
+            // follow the stable buckled branch instead (with the solid
+            // section the rate search's 43 m/s at 1150 m in 5 m/s wind,
+            // about √(T_guide/ρA) of the string, was "stable" to the QEP
+            // alone up to 318 m/s).
             let stable = match cell_stability(&sys, 1150.0, r, start.as_deref()) {
                 Ok(s) => {
-                    let st = s.spectrum.is_stable();
+                    let kin = tetherplan::numerics::params::Kinematics {
+                        length_m: 1150.0,
+                        rate_m_s: r,
+                        acceleration_m_s2: 0.0,
+                    };
+                    let det = tetherplan::numerics::ge::quasi_static::stiffness_determinant_sign(
+                        &sys.model,
+                        kin,
+                        sys.tip_load,
+                        &sys.air,
+                        &s.state.q,
+                    );
+                    let st = s.spectrum.is_stable() && det > 0;
                     start = Some(s.state.q);
                     st
                 }
@@ -300,6 +322,56 @@ fn critical_length_and_rate_in_wind_match_scans() {
             "never" => assert!(first_unstable.is_none(), "{first_unstable:?}"),
             "immediate" => assert_eq!(last_stable, None),
             other => panic!("{u} m/s: {other}"),
+        }
+    }
+}
+
+/// Issue 21: without `stability.elements` (and without
+/// `bending_stiffness_n_m2`, which then defaults from the tether: the
+/// full-slip bound of a 12-strand braid of 3.6 mm with the aramid modulus,
+/// no EA given) each wind's critical length and rate are converged and
+/// given on the safe side with their error estimates. Calm air: the safe
+/// critical length is within 0.2 % of the string's `(F/ρA − v²)/g` (EI is
+/// tiny) and below it (safe side, plus the bending lift); the grid's cells
+/// past it are unstable and those below stable; the answer states the
+/// tolerance and the solid section's rotary inertia ρA d²/16.
+#[test]
+fn converged_without_elements() {
+    let mut v = request((0.0, 0.0, 1), (100.0, 1400.0, 14), 20);
+    let st = v["stability"].as_object_mut().unwrap();
+    st.remove("elements");
+    st.remove("bending_stiffness_n_m2");
+    let (_, out) = solve(&v);
+    let ge = out.quasi_static_ge.as_ref().unwrap();
+    assert!(ge.converged);
+    assert_eq!(ge.relative_tolerance_nondim, Some(1e-3));
+    let ei_default = 25e9 * std::f64::consts::PI * 0.0036f64.powi(4) / 64.0 / 12.0;
+    assert!((ge.bending_stiffness_n_m2 / ei_default - 1.0).abs() < 0.5, "{}", ge.bending_stiffness_n_m2);
+    assert!((ge.rotary_inertia_kg_m - 0.078 * 0.0036 * 0.0036 / 16.0).abs() < 1e-15);
+    let w = &ge.per_wind[0];
+    let (l, est, err) = (
+        w.critical_length_m.unwrap(),
+        w.critical_length_estimate_m.unwrap(),
+        w.critical_length_error_m.unwrap(),
+    );
+    println!(
+        "calm, converged: critical length {l:.3} m = {est:.3} − {err:.3} m ({:?}), string {:.3} m; \
+         rate at 1150 m {:?} ± {:?} m/s; finest mesh {:?}",
+        w.critical_length_converged,
+        string_h(RATE),
+        w.critical_rate_m_s,
+        w.critical_rate_error_m_s,
+        ge.finest_elements
+    );
+    assert!((l - (est - err)).abs() <= 1e-9 * l);
+    assert!(l <= string_h(RATE) * (1.0 + 1e-4));
+    assert!((l / string_h(RATE) - 1.0).abs() < 2e-3);
+    assert!(w.critical_rate_error_m_s.is_some());
+    for p in &out.points {
+        if p.tether_length_m < l {
+            assert_eq!(p.stable, Some(true), "{} m", p.tether_length_m);
+        } else {
+            assert_eq!(p.stable, Some(false), "{} m", p.tether_length_m);
         }
     }
 }

@@ -254,10 +254,78 @@ fn critical_rate_converges_from_above() {
     assert!(o.safe_value < o.levels.last().unwrap().1);
 }
 
-/// In a steady 8 m/s wind the safe side lies below every level's root
-/// and below the calm-air one. (Measured: the 20-element mesh finds a
-/// sign change of det K at 142 m that the 40-element mesh does not; the
-/// search then stops, not converged, on the coarse root's safe side.)
+/// The first sign change of `det K` along the length on one mesh, found
+/// independently of the search: a continuation in the length (steps of 1 %
+/// from 10 m, each Newton started from the previous equilibrium, so that
+/// it stays on the tensioned branch), then bisection on the sign.
+fn continued_det_root(
+    ei: f64,
+    elements: usize,
+    air: &AirLoads,
+    (lo, hi): (f64, f64),
+) -> Option<f64> {
+    use tetherplan::numerics::ge::element::TipLoad;
+    use tetherplan::numerics::ge::quasi_static::{
+        QsConfig, stiffness_determinant_sign, wind_equilibrium,
+    };
+    use tetherplan::numerics::params::Kinematics;
+    let m = model(ei, elements);
+    let load = TipLoad {
+        force_n: [F, 0.0],
+        moment_n_m: 0.0,
+    };
+    let kin = |l: f64| Kinematics {
+        length_m: l,
+        rate_m_s: V,
+        acceleration_m_s2: 0.0,
+    };
+    let sign = |l: f64, start: &[f64]| -> Option<(i8, Vec<f64>)> {
+        let eq = wind_equilibrium(&m, kin(l), load, air, &QsConfig::default(), Some(start)).ok()?;
+        Some((stiffness_determinant_sign(&m, kin(l), load, air, &eq.q), eq.q))
+    };
+    let first = wind_equilibrium(&m, kin(lo), load, air, &QsConfig::default(), None).unwrap();
+    let s0 = stiffness_determinant_sign(&m, kin(lo), load, air, &first.q);
+    assert_eq!(s0, 1, "{elements} elements: det K not positive at {lo} m");
+    let (mut a, mut qa) = (lo, first.q);
+    while a < hi {
+        let b = (a * 1.01).min(hi);
+        match sign(b, &qa) {
+            Some((1, q)) => (a, qa) = (b, q),
+            _ => {
+                // bisect (a, b] from a's equilibrium
+                let (mut x, mut y) = (a, b);
+                while y - x > 1e-9 * y {
+                    let mid = 0.5 * (x + y);
+                    match sign(mid, &qa) {
+                        Some((1, q)) => (x, qa) = (mid, q),
+                        _ => y = mid,
+                    }
+                }
+                return Some(0.5 * (x + y));
+            }
+        }
+    }
+    None
+}
+
+/// In a steady 8 m/s wind (EI = 1 N m²). Cause of issue 21's open
+/// question: the 20-element search found a sign change of `det K` at
+/// 142 m that no finer mesh reproduced because its Newton at a scan point
+/// (~120 m from the previous one) started from that far state and landed
+/// on a spurious branch; a continuation in the length (1 % steps) finds
+/// `det K > 0` from 10 m to well past 142 m on 20, 40 and 80 elements
+/// (`scan` below). A search in wind now starts a Newton only from an
+/// equilibrium within 5 % of the parameter, and the 142 m root is gone.
+///
+/// **Still open (measured, printed):** in wind the levels' roots do not
+/// converge — 1134 / 1226 / 1156 / 1238 / 1231 / 1316 / 1293 m at 20 …
+/// 1280 elements — and the continuation in the length finds its first
+/// sign change elsewhere (751 / 714 / 838 m at 20 / 40 / 80): the blown-down
+/// GE tether has several equilibria at one length, and which one a Newton
+/// reaches depends on its start. The search says so (`converged: false`)
+/// and its safe side lies below every level's root and below the calm
+/// answer; that is what is asserted. It is *not* below the continuation's
+/// roots, so in wind the converged GE onset is not yet an answer to act on.
 #[test]
 fn wind_keeps_the_safe_side() {
     let air = AirLoads {
@@ -279,9 +347,20 @@ fn wind_keeps_the_safe_side() {
     )
     .unwrap();
     eprintln!("wind: {:?}", c.outcome);
+    let reference: Vec<Option<f64>> = [20, 40, 80]
+        .iter()
+        .map(|&n| continued_det_root(1.0, n, &air, (10.0, range().1)))
+        .collect();
+    eprintln!("continuation roots at 20/40/80 elements: {reference:?}");
+    // the cause of the 142 m root: det K stays positive past it on the
+    // continued branch of every mesh
+    for (n, r) in [20, 40, 80].iter().zip(&reference) {
+        assert!(r.is_none_or(|r| r > 300.0), "{n} elements: {r:?}");
+    }
     let ConvergedOutcome::During(o) = c.outcome else {
         panic!("{:?}", c.outcome)
     };
+    assert!(o.levels[0].1 > 300.0, "the spurious 142 m root is back: {:?}", o.levels);
     if o.converged {
         let k = o.levels.len();
         let (d1, d2) = (
@@ -291,7 +370,7 @@ fn wind_keeps_the_safe_side() {
         assert!(d2 < d1, "levels do not converge: {:?}", o.levels);
     }
     let lowest = o.levels.iter().map(|l| l.1).fold(f64::INFINITY, f64::min);
-    assert!(o.safe_value <= lowest);
+    assert!(o.safe_value <= lowest, "{} above {lowest}", o.safe_value);
     // blown down: shorter than in calm air
     assert!(o.safe_value < converged(1.0, &AirLoads::calm(), 1e-3).safe_value);
 }

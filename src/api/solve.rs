@@ -273,7 +273,7 @@ solve_path!(
             to_json(&run::stability(req)?)
         }
         AnyStabilityRequest::GeometricallyExact(r) => {
-            limit_ge_elements(r.model.elements, MAX_SYNC_GE_STABILITY_ELEMENTS, "a GE stability analysis")?;
+            limit_ge_elements(r.model.elements(), MAX_SYNC_GE_STABILITY_ELEMENTS, "a GE stability analysis")?;
             to_json(&ge_critical::ge_stability(r)?)
         }
     }
@@ -301,7 +301,7 @@ solve_path!(
             to_json(&run::critical_with(req, &Deadline::after(limits))?)
         }
         AnyCriticalRequest::GeometricallyExact(r) => {
-            limit_ge_elements(r.model.elements, MAX_SYNC_GE_CRITICAL_ELEMENTS, "a GE critical-time search")?;
+            limit_ge_elements(r.model.elements(), MAX_SYNC_GE_CRITICAL_ELEMENTS, "a GE critical-time search")?;
             to_json(&ge_critical::ge_critical(r, &Deadline::after(limits))?)
         }
     }

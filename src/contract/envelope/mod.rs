@@ -214,6 +214,7 @@ impl EnvelopeRequest {
                 self.aerostat.mass("aerostat")?,
                 longest,
                 self.payout_rate_m_s,
+                self.cable.bending_stiffness("cable")?,
             )?,
             None => None,
         };

@@ -8,15 +8,15 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::equilibrium::require_range;
+use crate::numerics::ge::qs_converged::{
+    ConvergedOutcome, ConvergedSearch, ConvergenceConfig, DEFAULT_RELATIVE_TOLERANCE,
+    MAX_RELATIVE_TOLERANCE, MIN_RELATIVE_TOLERANCE,
+};
 use crate::numerics::ge::qs_critical::{QsOnset, QsSearch};
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::envelope_ge::{
     DEFAULT_ELEMENTS, GeEnvelope, GeStabilitySpec, MAX_ELEMENTS,
 };
-
-fn default_ge_elements() -> usize {
-    DEFAULT_ELEMENTS
-}
 
 /// How stability is judged (needs `payout_rate_m_s`).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
@@ -29,14 +29,26 @@ pub enum EnvelopeStabilityInput {
     /// rate: stable iff max Re λ of its local QEP ≤ the spectrum tolerance.
     /// Adds per wind speed the critical length and the critical payout rate.
     QuasiStaticGe {
-        /// Bending stiffness EI of the tether (N m²); a braided tether is
-        /// nearly flexible (≈ 0.01–10 N m²).
+        /// Bending stiffness EI of the tether (N m²); default the tether's
+        /// (`cable.bending_stiffness_n_m2`, else the full-slip bound of its
+        /// preset or of a 12-strand braid of its diameter: ≈ 0.16 N m² for
+        /// a 6 mm Dyneema braid). A braided tether is nearly flexible.
+        #[serde(default)]
         #[schema(example = 1.0, exclusive_minimum = 0.0, maximum = 1e9)]
-        bending_stiffness_n_m2: f64,
-        /// Finite elements of the GE model (default 20).
-        #[serde(default = "default_ge_elements")]
+        bending_stiffness_n_m2: Option<f64>,
+        /// Finite elements of one GE mesh. Omitted (the default): the
+        /// critical length and rate of each wind are converged (nested
+        /// meshes from 20 elements, Richardson, to
+        /// `relative_tolerance_nondim`) and given on the safe side, with
+        /// their error estimates; the cells are judged against them.
+        #[serde(default)]
         #[schema(example = 20, minimum = 2, maximum = 80)]
-        elements: usize,
+        elements: Option<usize>,
+        /// Relative tolerance of the converged limits (default 1e-3);
+        /// only without `elements`.
+        #[serde(default)]
+        #[schema(example = 0.001, minimum = 1e-6, maximum = 0.05)]
+        relative_tolerance_nondim: Option<f64>,
         /// Length (m) at which the critical payout rate is searched;
         /// default the longest grid length.
         #[serde(default)]
@@ -47,15 +59,18 @@ pub enum EnvelopeStabilityInput {
 
 impl EnvelopeStabilityInput {
     /// The GE settings, validated (`None` for the string criterion).
+    /// `tether_bending_stiffness_n_m2`: the tether's own EI (the default).
     pub fn spec(
         &self,
         aerostat_mass_kg: f64,
         longest_length_m: f64,
         payout_rate_m_s: Option<f64>,
+        tether_bending_stiffness_n_m2: Option<f64>,
     ) -> Result<Option<GeStabilitySpec>, InvalidInput> {
         let Self::QuasiStaticGe {
             bending_stiffness_n_m2,
             elements,
+            relative_tolerance_nondim,
             critical_rate_length_m,
         } = *self
         else {
@@ -67,19 +82,46 @@ impl EnvelopeStabilityInput {
                 "is required with stability.method = quasi_static_ge (the rate the stability is judged at)",
             ));
         }
-        let ei = require_range(
-            "stability.bending_stiffness_n_m2",
-            bending_stiffness_n_m2,
-            0.0,
-            true,
-            1e9,
-        )?;
-        if !(2..=MAX_ELEMENTS).contains(&elements) {
+        let ei = match bending_stiffness_n_m2.or(tether_bending_stiffness_n_m2) {
+            Some(ei) => require_range("stability.bending_stiffness_n_m2", ei, 0.0, true, 1e9)?,
+            None => {
+                return Err(InvalidInput::new(
+                    "stability.bending_stiffness_n_m2",
+                    "is needed: give the tether's bending stiffness EI in N m² (or the tether's diameter, from which it defaults)",
+                ));
+            }
+        };
+        if let Some(n) = elements
+            && !(2..=MAX_ELEMENTS).contains(&n)
+        {
             return Err(InvalidInput::new(
                 "stability.elements",
-                format!("must be between 2 and {MAX_ELEMENTS}, got {elements}"),
+                format!("must be between 2 and {MAX_ELEMENTS}, got {n}"),
             ));
         }
+        let converge = match (elements, relative_tolerance_nondim) {
+            (Some(_), Some(_)) => {
+                return Err(InvalidInput::new(
+                    "stability.relative_tolerance_nondim",
+                    "applies to the converged limits only: omit stability.elements to converge them",
+                ));
+            }
+            (Some(_), None) => None,
+            (None, tol) => {
+                let tol = tol.unwrap_or(DEFAULT_RELATIVE_TOLERANCE);
+                require_range(
+                    "stability.relative_tolerance_nondim",
+                    tol,
+                    MIN_RELATIVE_TOLERANCE,
+                    false,
+                    MAX_RELATIVE_TOLERANCE,
+                )?;
+                Some(ConvergenceConfig {
+                    relative_tolerance: tol,
+                    ..ConvergenceConfig::default()
+                })
+            }
+        };
         let at = match critical_rate_length_m {
             Some(l) => require_range("stability.critical_rate_length_m", l, 0.0, true, 1e5)?,
             None => longest_length_m,
@@ -87,9 +129,9 @@ impl EnvelopeStabilityInput {
         Ok(Some(GeStabilitySpec {
             bending_stiffness_n_m2: ei,
             aerostat_mass_kg,
-            elements,
+            elements: elements.unwrap_or(DEFAULT_ELEMENTS),
             critical_rate_length_m: at,
-            converge: None,
+            converge,
         }))
     }
 }
@@ -102,9 +144,21 @@ pub struct GeWindLimitOutput {
     /// `length_search_max_m`), `immediate` (unstable at the shortest grid
     /// length), `equilibrium_failed`, `spectrum_failed`.
     pub critical_length_outcome: String,
-    /// Maximum safe tether length at the payout rate (m): the onset.
+    /// Maximum safe tether length at the payout rate (m): the onset;
+    /// converged (no `elements`): the safe side, best estimate minus its
+    /// error estimate.
     pub critical_length_m: Option<f64>,
-    /// Altitude of the blown-down aerostat at the onset (m): the maximum safe altitude.
+    /// Converged only: the best estimate of the continuum critical length (m).
+    pub critical_length_estimate_m: Option<f64>,
+    /// Converged only: the estimated discretisation error of
+    /// `critical_length_estimate_m` (m); `critical_length_m` is below the
+    /// estimate by this much.
+    pub critical_length_error_m: Option<f64>,
+    /// Converged only: whether the error estimate met the tolerance
+    /// (else the finest mesh was reached and the answer is still on the safe side).
+    pub critical_length_converged: Option<bool>,
+    /// Altitude of the blown-down aerostat at the onset (m): the maximum
+    /// safe altitude (converged: at the safe length, on the finest mesh).
     pub critical_altitude_m: Option<f64>,
     /// Its downwind distance at the onset (m).
     pub critical_downwind_m: Option<f64>,
@@ -117,8 +171,15 @@ pub struct GeWindLimitOutput {
     pub critical_rate_length_m: f64,
     /// As `critical_length_outcome`, along the payout rate.
     pub critical_rate_outcome: String,
-    /// Smallest unstable payout rate at `critical_rate_length_m` (m/s).
+    /// Smallest unstable payout rate at `critical_rate_length_m` (m/s);
+    /// converged: the safe side.
     pub critical_rate_m_s: Option<f64>,
+    /// Converged only: the best estimate of the continuum critical rate (m/s).
+    pub critical_rate_estimate_m_s: Option<f64>,
+    /// Converged only: its estimated discretisation error (m/s).
+    pub critical_rate_error_m_s: Option<f64>,
+    /// Converged only: whether the error estimate met the tolerance.
+    pub critical_rate_converged: Option<bool>,
     /// Upper end of the rate search (m/s); it starts at 10⁻³ of it.
     pub rate_search_max_m_s: f64,
 }
@@ -126,13 +187,36 @@ pub struct GeWindLimitOutput {
 /// The quasi-static GE part of the envelope answer.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
 pub struct GeStabilityOutput {
+    /// EI used (N m²): as given, else the tether's default.
     pub bending_stiffness_n_m2: f64,
     pub aerostat_mass_kg: f64,
+    /// Elements of the mesh (converged: of the base mesh; the finest mesh
+    /// of each search is in `finest_elements`).
     pub elements: usize,
-    /// Rotary inertia per length used by the model (kg m): ρA · (0.1 m)².
+    /// Whether the critical lengths and rates are converged (`elements` omitted).
+    pub converged: bool,
+    /// Converged only: the relative tolerance asked.
+    pub relative_tolerance_nondim: Option<f64>,
+    /// Converged only: the finest mesh any search of the answer reached.
+    pub finest_elements: Option<usize>,
+    /// Rotary inertia per length used by the model (kg m): the solid
+    /// section's ρA d²/16.
     pub rotary_inertia_kg_m: f64,
     /// Per grid wind speed.
     pub per_wind: Vec<GeWindLimitOutput>,
+}
+
+/// `(estimate, error, converged, finest elements)` of a converged search.
+fn converged_fields(c: Option<&ConvergedSearch>) -> (Option<f64>, Option<f64>, Option<bool>, usize) {
+    match c.map(|c| (&c.outcome, c.flutter.is_some())) {
+        Some((ConvergedOutcome::During(o), false)) => (
+            Some(o.value),
+            Some(o.error_estimate),
+            Some(o.converged),
+            o.levels.last().map_or(0, |l| l.0),
+        ),
+        _ => (None, None, None, 0),
+    }
 }
 
 fn outcome(s: &QsSearch) -> (&'static str, Option<f64>) {
@@ -154,6 +238,7 @@ pub fn ge_output(
     winds: &[f64],
     ge: &GeEnvelope,
 ) -> GeStabilityOutput {
+    let mut finest = 0;
     let per_wind = winds
         .iter()
         .zip(&ge.wind_limits)
@@ -161,10 +246,17 @@ pub fn ge_output(
             let (lo, at) = outcome(&w.critical_length);
             let (ro, rate) = outcome(&w.critical_rate);
             let state = at.and(w.critical_length.at_onset);
+            let c = w.converged.as_ref();
+            let (l_est, l_err, l_conv, l_n) = converged_fields(c.map(|c| &c.critical_length));
+            let (r_est, r_err, r_conv, r_n) = converged_fields(c.map(|c| &c.critical_rate));
+            finest = finest.max(l_n).max(r_n);
             GeWindLimitOutput {
                 wind_speed_m_s: u,
                 critical_length_outcome: lo.into(),
                 critical_length_m: at,
+                critical_length_estimate_m: l_est,
+                critical_length_error_m: l_err,
+                critical_length_converged: l_conv,
                 critical_altitude_m: state.map(|s| s.tip_altitude_m),
                 critical_downwind_m: state.map(|s| s.tip_downwind_m),
                 length_search_max_m: w.length_search_max_m,
@@ -175,6 +267,9 @@ pub fn ge_output(
                 critical_rate_length_m: spec.critical_rate_length_m,
                 critical_rate_outcome: ro.into(),
                 critical_rate_m_s: rate,
+                critical_rate_estimate_m_s: r_est,
+                critical_rate_error_m_s: r_err,
+                critical_rate_converged: r_conv,
                 rate_search_max_m_s: w.rate_search_max_m_s,
             }
         })
@@ -183,16 +278,13 @@ pub fn ge_output(
         bending_stiffness_n_m2: spec.bending_stiffness_n_m2,
         aerostat_mass_kg: spec.aerostat_mass_kg,
         elements: spec.elements,
-        rotary_inertia_kg_m: if spec.converge.is_some() {
-            crate::numerics::ge::tether_system::solid_rotary_inertia_kg_m(
-                mass_per_length_kg_m,
-                diameter_m,
-            )
-        } else {
-            mass_per_length_kg_m
-                * crate::numerics::tether::envelope_ge::ROTARY_INERTIA_RADIUS_M
-                * crate::numerics::tether::envelope_ge::ROTARY_INERTIA_RADIUS_M
-        },
+        converged: spec.converge.is_some(),
+        relative_tolerance_nondim: spec.converge.map(|c| c.relative_tolerance),
+        finest_elements: spec.converge.map(|_| finest.max(spec.elements)),
+        rotary_inertia_kg_m: crate::numerics::ge::tether_system::solid_rotary_inertia_kg_m(
+            mass_per_length_kg_m,
+            diameter_m,
+        ),
         per_wind,
     }
 }

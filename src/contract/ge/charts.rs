@@ -687,7 +687,7 @@ pub fn ge_base_frequency_response(
             },
         ),
     };
-    let model = GeModel::new(section, m.elements, tip, g)?;
+    let model = GeModel::new(section, m.elements(), tip, g)?;
     let scale = section.time_scale_s(l0);
     let grid = &req.frequencies_rad_s;
     let omegas = rate_grid(grid.min, grid.max, grid.count).map_err(|e| {
@@ -709,13 +709,13 @@ pub fn ge_base_frequency_response(
     if steps < 1.0 {
         return Err(InvalidInput::new("time_step_s", "must not exceed duration_s").into());
     }
-    let work = steps * (omegas.len() + 1) as f64 * m.elements as f64;
-    if steps * m.elements as f64 > MAX_RESPONSE_WORK {
+    let work = steps * (omegas.len() + 1) as f64 * m.elements() as f64;
+    if steps * m.elements() as f64 > MAX_RESPONSE_WORK {
         return Err(InvalidInput::new(
             "time_step_s",
             format!(
                 "one run alone needs {steps:.0} steps × {} elements, beyond the work limit {MAX_RESPONSE_WORK:.0e}: take a longer step or a shorter duration_s",
-                m.elements
+                m.elements()
             ),
         )
         .into());
@@ -726,7 +726,7 @@ pub fn ge_base_frequency_response(
             format!(
                 "{} runs × {steps:.0} steps × {} elements exceeds the work limit {MAX_RESPONSE_WORK:.0e}",
                 omegas.len() + 1,
-                m.elements
+                m.elements()
             ),
         )
         .into());
@@ -810,7 +810,7 @@ pub fn ge_base_frequency_response(
         time_scale_s: scale,
         stiffness_ratio: m.stiffness_ratio,
         rate_nondim,
-        elements: m.elements,
+        elements: m.elements(),
     })
 }
 

@@ -13,6 +13,12 @@
 //! * `quasi_static` (constant-rate profiles): the quasi-static GE critical
 //!   length in calm air ([`crate::numerics::ge::qs_critical`]), served in
 //!   the shape of the marching answer, with `t* = (h* − L0)/v`.
+//!
+//! Without `model.elements` (issue 21, SPEC §5) the critical length is
+//! the converged one of [`crate::numerics::ge::qs_converged`] (nested
+//! meshes from 20 elements, first-order Richardson, to the default
+//! relative tolerance) and `max_elevation_m` and `critical_time_s` are its
+//! safe side, best estimate minus the error estimate, with both stated.
 
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
@@ -32,8 +38,12 @@ use crate::numerics::ge::critical::{
     CriticalConfig, CriticalProblem, GeOnset, TipPerturbation, critical_time,
 };
 use crate::numerics::ge::extensible::ExtensibleString;
+use crate::numerics::ge::qs_converged::{
+    ConvergedOnset, ConvergedOutcome, ConvergedSearch, ConvergenceConfig,
+    converged_critical_length,
+};
 use crate::numerics::ge::qs_critical::{
-    QsOnset, QsSearchConfig, critical_length, lift_limit_length_m,
+    QsOnset, QsSearch, QsSearchConfig, critical_length, lift_limit_length_m,
 };
 use crate::numerics::ge::{GeModel, TipBody};
 use crate::numerics::params::{
@@ -204,6 +214,35 @@ pub struct GeCriticalResponse {
     /// Quasi-static only: equilibria solved.
     #[serde(default)]
     pub quasi_static_equilibrium_solves: Option<usize>,
+    /// Quasi-static without `model.elements`: the critical length is
+    /// converged (nested meshes from `elements`, Richardson) and
+    /// `max_elevation_m` / `critical_time_s` are its safe side (best
+    /// estimate minus the error estimate); null otherwise.
+    #[serde(default)]
+    pub converged: Option<bool>,
+    /// Converged only: the relative tolerance of the search.
+    #[serde(default)]
+    pub relative_tolerance_nondim: Option<f64>,
+    /// Converged only: the best estimate of the continuum h* (m).
+    #[serde(default)]
+    pub max_elevation_estimate_m: Option<f64>,
+    /// Converged only: the estimated discretisation error of that estimate (m).
+    #[serde(default)]
+    pub max_elevation_error_m: Option<f64>,
+    /// Converged only: the same error in t* (s), `max_elevation_error_m / v`.
+    #[serde(default)]
+    pub critical_time_error_s: Option<f64>,
+    /// Converged only: `(elements, divergence root h* in m)` of each mesh.
+    #[serde(default)]
+    pub mesh_levels: Option<Vec<GeMeshLevelOutput>>,
+}
+
+/// One mesh of a converged quasi-static search.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct GeMeshLevelOutput {
+    pub elements: usize,
+    /// The divergence root on this mesh (m).
+    pub max_elevation_m: f64,
 }
 
 /// The cable model of a GE request.
@@ -224,12 +263,12 @@ pub(super) fn prepare(
     let l0 = require_positive("initial_length_m", initial_length_m)?;
     let g = require_non_negative("gravity_m_s2", gravity_m_s2)?;
     let buoyancy = aerostat.net_buoyancy("aerostat")?;
-    if !(1..=MAX_GE_QEP_ELEMENTS).contains(&model.elements) {
+    if !(1..=MAX_GE_QEP_ELEMENTS).contains(&model.elements()) {
         return Err(InvalidInput::new(
             "model.elements",
             format!(
                 "must be between 1 and {MAX_GE_QEP_ELEMENTS} for a GE stability or critical-time answer, got {}",
-                model.elements
+                model.elements()
             ),
         ));
     }
@@ -239,7 +278,7 @@ pub(super) fn prepare(
         link_length_m: aerostat.link_length("aerostat")?,
     };
     Ok(Prepared {
-        model: GeModel::new(section, model.elements, tip, g)?,
+        model: GeModel::new(section, model.elements(), tip, g)?,
         initial_length_m: l0,
         net_buoyancy_n: buoyancy,
     })
@@ -472,6 +511,12 @@ pub fn ge_critical(
         method: GeCriticalMethod::Marching,
         quasi_static_bracket_m: None,
         quasi_static_equilibrium_solves: None,
+        converged: None,
+        relative_tolerance_nondim: None,
+        max_elevation_estimate_m: None,
+        max_elevation_error_m: None,
+        critical_time_error_s: None,
+        mesh_levels: None,
     })
 }
 
@@ -546,6 +591,37 @@ pub(crate) fn finite(x: f64) -> Option<f64> {
 
 // ---------------------------------------------------------------- quasi-static method
 
+/// A converged search as the onset of a search on one mesh (its safe side).
+fn as_search(c: &ConvergedSearch) -> QsSearch {
+    let onset = match &c.outcome {
+        ConvergedOutcome::During(o) => QsOnset::During { at: o.safe_value },
+        ConvergedOutcome::Immediate => QsOnset::Immediate {
+            max_real_1_s: f64::NAN,
+        },
+        ConvergedOutcome::Never { up_to } => QsOnset::Never { up_to: *up_to },
+        ConvergedOutcome::Failed { at } => QsOnset::EquilibriumFailed {
+            at: *at,
+            failure: crate::numerics::ge::solver::NewtonFailure {
+                time_s: 0.0,
+                iterations: 0,
+                residual_norm: f64::NAN,
+            },
+        },
+        ConvergedOutcome::Cancelled => QsOnset::Cancelled,
+    };
+    QsSearch {
+        onset,
+        bracket: None,
+        divergence: true,
+        qep_solves: 0,
+        equilibria: c.equilibria,
+        at_onset: match &c.outcome {
+            ConvergedOutcome::During(o) => Some(o.at_safe),
+            _ => None,
+        },
+    }
+}
+
 /// The quasi-static answer of a GE critical-time request (already checked by `prepare_critical`).
 pub fn quasi_static_critical(
     req: &GeCriticalRequest,
@@ -571,17 +647,39 @@ pub fn quasi_static_critical(
         ..QsSearchConfig::default()
     };
     let cancel = || progress.cancelled();
-    let r = critical_length(
-        model,
-        f,
-        &air,
-        v,
-        0.0,
-        req.start_state.into(),
-        &config,
-        (l0, upper.max(l0)),
-        &cancel,
-    )?;
+    // Converged without `model.elements` (module docs); paying out only
+    // (a retrieval's onset is not a divergence).
+    let converged: Option<ConvergedOnset>;
+    let r = if req.model.elements.is_none() && v > 0.0 {
+        let c = converged_critical_length(
+            model,
+            f,
+            &air,
+            v,
+            &ConvergenceConfig::default(),
+            (l0, upper.max(l0)),
+            &cancel,
+        )?;
+        converged = match &c.outcome {
+            ConvergedOutcome::During(o) => Some(o.clone()),
+            _ => None,
+        };
+        as_search(&c)
+    } else {
+        converged = None;
+        critical_length(
+            model,
+            f,
+            &air,
+            v,
+            0.0,
+            req.start_state.into(),
+            &config,
+            (l0, upper.max(l0)),
+            &cancel,
+        )?
+    };
+    let is_converged = req.model.elements.is_none() && v > 0.0;
     let time_at = |l: f64| {
         if v != 0.0 {
             ((l - l0) / v).max(0.0)
@@ -605,15 +703,28 @@ pub fn quasi_static_critical(
             Some(time_at(at)),
             Some(at),
             None,
-            format!(
-                "quasi-static: stable until the cable is {at:.2} m long (t* = {:.3} s at {v} m/s){}",
-                time_at(at),
-                if r.divergence {
-                    "; a real eigenvalue crosses zero there (divergence)"
-                } else {
-                    ""
-                }
-            ),
+            match &converged {
+                Some(c) => format!(
+                    "quasi-static, converged: stable until the cable is {at:.2} m long (t* = {:.3} s at {v} m/s), \
+                     the safe side of the continuum estimate {:.2} ± {:.2} m (meshes of {} to {} elements{}); \
+                     a real eigenvalue crosses zero there (divergence)",
+                    time_at(at),
+                    c.value,
+                    c.error_estimate,
+                    c.levels.first().map_or(0, |l| l.0),
+                    c.levels.last().map_or(0, |l| l.0),
+                    if c.converged { "" } else { ", tolerance not met: the finest mesh was reached" }
+                ),
+                None => format!(
+                    "quasi-static: stable until the cable is {at:.2} m long (t* = {:.3} s at {v} m/s){}",
+                    time_at(at),
+                    if r.divergence {
+                        "; a real eigenvalue crosses zero there (divergence)"
+                    } else {
+                        ""
+                    }
+                ),
+            },
         ),
         QsOnset::Never { up_to } => (
             GeOnsetKind::Never,
@@ -685,5 +796,20 @@ pub fn quasi_static_critical(
         method: GeCriticalMethod::QuasiStatic,
         quasi_static_bracket_m: r.bracket.map(|(a, b)| [a, b]),
         quasi_static_equilibrium_solves: Some(r.equilibria),
+        converged: is_converged.then(|| converged.as_ref().is_some_and(|c| c.converged)),
+        relative_tolerance_nondim: is_converged
+            .then_some(ConvergenceConfig::default().relative_tolerance),
+        max_elevation_estimate_m: converged.as_ref().map(|c| c.value),
+        max_elevation_error_m: converged.as_ref().map(|c| c.error_estimate),
+        critical_time_error_s: converged.as_ref().map(|c| c.error_estimate / v),
+        mesh_levels: converged.as_ref().map(|c| {
+            c.levels
+                .iter()
+                .map(|&(elements, h)| GeMeshLevelOutput {
+                    elements,
+                    max_elevation_m: h,
+                })
+                .collect()
+        }),
     })
 }

@@ -47,10 +47,13 @@ pub enum GeModelKind {
 #[serde(deny_unknown_fields)]
 pub struct GeModelInput {
     pub kind: GeModelKind,
-    /// Number of 2-node elements (1..=2000).
-    #[serde(default = "default_elements")]
+    /// Number of 2-node elements (1..=2000), default 20. `/critical`
+    /// with `method: quasi_static`: omitted, the critical length is
+    /// converged (nested meshes from 20 elements, Richardson) and given
+    /// on the safe side with its error estimate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(example = 20, minimum = 1, maximum = 2000)]
-    pub elements: usize,
+    pub elements: Option<usize>,
     /// Bending stiffness EI (N m²).
     #[schema(example = 1000.0, minimum = 1e-6, maximum = 1e12)]
     pub bending_stiffness_n_m2: f64,
@@ -66,8 +69,15 @@ pub struct GeModelInput {
     pub inertia_ratio: f64,
 }
 
-fn default_elements() -> usize {
-    20
+/// Elements of a GE mesh when `model.elements` is omitted (the base mesh
+/// of a converged quasi-static search).
+pub const DEFAULT_GE_ELEMENTS: usize = 20;
+
+impl GeModelInput {
+    /// `model.elements`, or [`DEFAULT_GE_ELEMENTS`].
+    pub fn elements(&self) -> usize {
+        self.elements.unwrap_or(DEFAULT_GE_ELEMENTS)
+    }
 }
 
 /// Time shape of the end load.
@@ -365,7 +375,7 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
         mass_kg: req.aerostat.mass("aerostat")?,
         link_length_m: req.aerostat.link_length("aerostat")?,
     };
-    let model = GeModel::new(section, m.elements, tip, g)?;
+    let model = GeModel::new(section, m.elements(), tip, g)?;
 
     let dt = require_positive("time_step_s", req.time_step_s)?;
     let duration = require_positive("duration_s", req.duration_s)?;
@@ -382,12 +392,12 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
             format!("needs {steps:.0} steps of time_step_s; at most {MAX_STEPS} are allowed"),
         ));
     }
-    if steps * m.elements as f64 > MAX_WORK {
+    if steps * m.elements() as f64 > MAX_WORK {
         return Err(InvalidInput::new(
             "duration_s",
             format!(
                 "{steps:.0} steps × {} elements exceeds the work limit {MAX_WORK:.0e}",
-                m.elements
+                m.elements()
             ),
         ));
     }
@@ -404,12 +414,12 @@ fn prepare(req: &GeSimulateRequest) -> Result<Prepared, InvalidInput> {
         ));
     }
     if req.eigenvalues_every_steps > 0 {
-        if m.elements > MAX_EIGEN_ELEMENTS {
+        if m.elements() > MAX_EIGEN_ELEMENTS {
             return Err(InvalidInput::new(
                 "eigenvalues_every_steps",
                 format!(
                     "eigenvalues need elements ≤ {MAX_EIGEN_ELEMENTS}, got {}",
-                    m.elements
+                    m.elements()
                 ),
             ));
         }

@@ -53,15 +53,23 @@ pub enum PlanStabilityMethod {
 pub struct PlanStabilityInput {
     #[serde(default)]
     pub method: PlanStabilityMethod,
-    /// `quasi_static_ge`: bending stiffness EI of the tether (N m²); default 1000 (thesis Table 7.1).
-    #[serde(default = "default_bending_stiffness")]
+    /// `quasi_static_ge`: bending stiffness EI of the tether (N m²); default the tether's
+    /// (`cable.bending_stiffness_n_m2`, else the full-slip bound of its preset or of a 12-strand braid of
+    /// its diameter; in calm air without a diameter, of the diameter of a 1000 kg/m³ fibre of its ρA).
+    #[serde(default)]
     #[schema(example = 1000.0, minimum = 1e-6, maximum = 1e12)]
-    pub bending_stiffness_n_m2: f64,
-    /// `quasi_static_ge`: finite elements of the GE tether for the critical-rate table and the divergence
-    /// check (the inertia of the stiffness, O(elements) per state).
-    #[serde(default = "default_ge_elements")]
+    pub bending_stiffness_n_m2: Option<f64>,
+    /// `quasi_static_ge`: finite elements of one GE mesh for the critical-rate table and the divergence
+    /// check. Omitted (the default): the table's maximum safe length and critical rates are converged
+    /// (nested meshes from 20 elements, Richardson, to `relative_tolerance_nondim`) and taken on the safe
+    /// side, with their error estimates.
+    #[serde(default)]
     #[schema(example = 40, minimum = 4, maximum = 2000)]
-    pub elements: usize,
+    pub elements: Option<usize>,
+    /// `quasi_static_ge`: relative tolerance of the converged table (default 1e-3); only without `elements`.
+    #[serde(default)]
+    #[schema(example = 0.001, minimum = 1e-6, maximum = 0.05)]
+    pub relative_tolerance_nondim: Option<f64>,
     /// `quasi_static_ge`: finite elements of the QEP (flutter) check of the schedule's samples.
     #[serde(default = "default_ge_check_elements")]
     #[schema(example = 16, minimum = 4, maximum = 100)]
@@ -76,12 +84,6 @@ pub struct PlanStabilityInput {
     pub check_samples: usize,
 }
 
-fn default_bending_stiffness() -> f64 {
-    1000.0
-}
-fn default_ge_elements() -> usize {
-    40
-}
 fn default_ge_check_elements() -> usize {
     16
 }
@@ -373,6 +375,9 @@ pub struct PlanGeTableRowOutput {
     pub capped: bool,
     /// Not even the slowest rate was stable.
     pub unstable: bool,
+    /// Converged table only: the estimated discretisation error of the critical rate (m/s); the rate
+    /// is the safe side (best estimate minus this).
+    pub critical_rate_error_m_s: Option<f64>,
     /// The pass's rate ceiling at rest at this length, √((S − ε(1−r)F)/ρA) (m/s).
     pub plan_rate_ceiling_m_s: f64,
 }
@@ -396,10 +401,19 @@ pub struct PlanGeCheckOutput {
 /// The quasi-static GE stability of the plan.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
 pub struct PlanGeStabilityOutput {
+    /// EI used (N m²): as given, else the tether's default.
     pub bending_stiffness_n_m2: f64,
+    /// Elements of the mesh (converged: the base mesh of the nested ones).
     pub elements: usize,
-    /// QS GE maximum safe length with the reserve, at a vanishing payout rate (m).
+    /// Whether the table is converged (`elements` omitted).
+    pub converged: bool,
+    /// Converged only: the relative tolerance asked.
+    pub relative_tolerance_nondim: Option<f64>,
+    /// QS GE maximum safe length with the reserve, at a vanishing payout rate (m); converged: the safe
+    /// side (best estimate minus its error estimate).
     pub max_safe_length_m: f64,
+    /// Converged only: the estimated discretisation error of the maximum safe length (m).
+    pub max_safe_length_error_m: Option<f64>,
     /// Cap of the critical-rate searches (m/s).
     pub rate_cap_m_s: f64,
     /// Largest change of S − S₀ between table rows (N): the most the lower-neighbour interpolation takes off.

@@ -4,6 +4,7 @@
 //! [`crate::numerics::plan::ge_stability`].
 
 use crate::contract::plan::dto::*;
+use crate::numerics::ge::qs_converged::{BASE_ELEMENTS, ConvergenceConfig, DEFAULT_RELATIVE_TOLERANCE};
 use crate::numerics::params::InvalidInput;
 use crate::numerics::plan::air::{Air, SteadyWind};
 use crate::numerics::plan::ge_stability::{self as ge_plan, GeStabilityOptions};
@@ -40,22 +41,64 @@ pub(super) fn calm_wind(mass_per_length_kg_m: f64) -> SteadyWind {
     )
 }
 
+/// The tether's own EI (N m²): the cable's ([`crate::contract::system::CableInput::bending_stiffness`]),
+/// in calm air without a diameter that of the diameter of [`calm_wind`].
+fn tether_bending_stiffness(req: &PlanRequest) -> Result<f64, InvalidInput> {
+    if let Some(ei) = req.cable.bending_stiffness("cable")? {
+        return Ok(ei);
+    }
+    let rho_a = req.cable.mass_per_length()?;
+    let d = calm_wind(rho_a).cable.diameter_m;
+    crate::numerics::tether::presets::default_bending_stiffness_n_m2(
+        None,
+        d,
+        req.cable.axial_stiffness("cable")?,
+    )
+    .map(|e| e.max(1e-6))
+    .ok_or_else(|| {
+        InvalidInput::new(
+            "stability.bending_stiffness_n_m2",
+            "is needed: give the tether's bending stiffness EI in N m² (or its diameter)",
+        )
+    })
+}
+
 /// The GE options of the request, if it asks for the GE criterion.
 pub(super) fn ge_options(req: &PlanRequest) -> Result<Option<GeStabilityOptions>, InvalidInput> {
     let Some(st) = &req.stability else {
         return Ok(None);
     };
-    crate::numerics::params::ranges::BENDING_STIFFNESS_N_M2.check(
-        "stability.bending_stiffness_n_m2",
-        st.bending_stiffness_n_m2,
-    )?;
+    let ei = match (st.bending_stiffness_n_m2, st.method) {
+        (Some(ei), _) => ei,
+        (None, PlanStabilityMethod::QuasiStaticGe) => tether_bending_stiffness(req)?,
+        (None, _) => 1.0,
+    };
+    crate::numerics::params::ranges::BENDING_STIFFNESS_N_M2
+        .check("stability.bending_stiffness_n_m2", ei)?;
+    let converge = match (st.elements, st.relative_tolerance_nondim) {
+        (Some(_), Some(_)) => {
+            return Err(InvalidInput::new(
+                "stability.relative_tolerance_nondim",
+                "applies to the converged table only: omit stability.elements to converge it",
+            ));
+        }
+        (Some(_), None) => None,
+        (None, tol) => {
+            let c = ConvergenceConfig {
+                relative_tolerance: tol.unwrap_or(DEFAULT_RELATIVE_TOLERANCE),
+                ..ConvergenceConfig::default()
+            };
+            c.validate()?;
+            Some(c)
+        }
+    };
     let o = GeStabilityOptions {
-        bending_stiffness_n_m2: st.bending_stiffness_n_m2,
-        elements: st.elements,
+        bending_stiffness_n_m2: ei,
+        elements: st.elements.unwrap_or(BASE_ELEMENTS),
         check_elements: st.check_elements,
         table_lengths: st.table_samples,
         min_length_m: req.initial_length_m.min(req.target_elevation_m),
-        converge: None,
+        converge,
     };
     o.validate()?;
     if !(2..=MAX_GE_CHECK_SAMPLES).contains(&st.check_samples) {
@@ -127,18 +170,23 @@ pub(super) fn ge_output(
     Some(PlanGeStabilityOutput {
         bending_stiffness_n_m2: ge.options.bending_stiffness_n_m2,
         elements: ge.options.elements,
+        converged: ge.options.converge.is_some(),
+        relative_tolerance_nondim: ge.options.converge.map(|c| c.relative_tolerance),
         max_safe_length_m: t.max_safe_length_m,
+        max_safe_length_error_m: t.max_safe_length_error_m,
         rate_cap_m_s: t.rate_cap_m_s,
         interpolation_error_n: t.interpolation_error_n,
         interpolation_error_length_m: t.interpolation_error_n / (rho_a * p.system.gravity_m_s2),
         table: t
             .rows
             .iter()
-            .map(|r| PlanGeTableRowOutput {
+            .enumerate()
+            .map(|(i, r)| PlanGeTableRowOutput {
                 length_m: r.length_m,
                 critical_rate_m_s: r.critical_rate_m_s,
                 capped: r.capped,
                 unstable: r.unstable,
+                critical_rate_error_m_s: t.rate_error_m_s.get(i).copied(),
                 plan_rate_ceiling_m_s: ((ge.stability_tension_n(w, p, r.length_m) - margin)
                     / rho_a)
                     .max(0.0)

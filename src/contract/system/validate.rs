@@ -163,6 +163,31 @@ impl CableInput {
             .transpose()
     }
 
+    /// The tether's bending stiffness EI (N m²): as given, else the
+    /// full-slip bound of its preset or of a 12-strand braid of its
+    /// diameter and axial stiffness
+    /// ([`crate::numerics::tether::presets::default_bending_stiffness_n_m2`],
+    /// issue 21: never the thesis table's 1000 N m²); `None` without
+    /// either a value or a diameter.
+    pub fn bending_stiffness(&self, at: &str) -> Result<Option<f64>, InvalidInput> {
+        if let Some(e) = self.bending_stiffness_n_m2 {
+            return require_range(&Self::field(at, "bending_stiffness_n_m2"), e, 1e-6, false, 1e12)
+                .map(Some);
+        }
+        let Some(d) = self.diameter_m else {
+            return Ok(None);
+        };
+        let d = require_range(&Self::field(at, "diameter_m"), d, 0.0, true, 1.0)?;
+        Ok(
+            crate::numerics::tether::presets::default_bending_stiffness_n_m2(
+                self.preset.map(preset_cable),
+                d,
+                self.axial_stiffness(at)?,
+            )
+            .map(|e| e.max(1e-6)),
+        )
+    }
+
     /// Checks the fields that are given but not used by a calm-air analysis
     /// (so that a whole system is refused for the same values everywhere).
     pub fn check_given(&self, at: &str) -> Result<(), InvalidInput> {

@@ -16,17 +16,31 @@
 //!
 //! **Method.** Uniform nested meshes `n_k = n₀ 2^k` (`n₀ =`
 //! [`BASE_ELEMENTS`]); on each the divergence root (the parameter where the
-//! inertia of the symmetric part of `K` changes, bisected to
-//! [`ROOT_RTOL`]; the Newton of each equilibrium starts from the nearest
-//! one already found (regula falsi on the determinant, safeguarded by the
-//! inertia count), on the first level from the scan, on finer levels
-//! from the coarser level's equilibria prolonged onto the finer mesh, and
-//! the bracket of each level is searched just below the coarser root).
-//! Richardson removes the first order, `R_k = 2 q_k − q_{k−1}`, and the
-//! error of `R_k` is estimated by `|R_k − R_{k−1}|` (three times the true
-//! error when the remainder is second order). Levels are added until the
-//! estimate is below the tolerance (relative, default
-//! [`DEFAULT_RELATIVE_TOLERANCE`]) or [`MAX_CONVERGED_ELEMENTS`] is reached.
+//! divergence count of [`divergence_indicator`] changes), refined by the
+//! safeguarded Illinois regula falsi of [`super::qs_critical`] on
+//! `det K` to [`level_rtol`] (`10⁻⁴` of the tolerance: the roots' own error
+//! stays out of the estimate). The base level scans the range; a finer
+//! level looks first just below the coarser root, by the step the levels'
+//! ratio predicts, and keeps the base level's lower-end count; each state
+//! is solved once per level, and its Newton starts from the nearest
+//! equilibrium already found (on finer levels the coarser ones prolonged
+//! onto the mesh; in wind only one within [`NEAR`] of it: see
+//! `Level::equilibrium`). Richardson removes the first order,
+//! `R_k = 2 q_k − q_{k−1}`, and the error of `R_k` is estimated by
+//! `|R_k − R_{k−1}|` (three times the true error when the remainder is
+//! second order). Levels are added until the estimate is below the
+//! tolerance (relative, default [`DEFAULT_RELATIVE_TOLERANCE`]) or
+//! [`MAX_CONVERGED_ELEMENTS`] is reached.
+//!
+//! **Cost.** A state is an equilibrium (banded Newton, O(n)) and a band
+//! `LDLᵀ`/LU; a level costs about ten states, so a search costs about
+//! ten states on each mesh, dominated by the finest. Measured (thesis
+//! tether, calm air, 10 m/s): EI = 10⁻² N m² stops at 80 elements, 1 and
+//! 1000 N m² at 320 (the levels turn from first to second order as the
+//! elements resolve the bending layer). A graded mesh (elements shrinking
+//! toward the guide, where the divergence mode and the bending layer live)
+//! would need fewer unknowns for the same error; the element operators
+//! assume a uniform mesh (`GeModel::ops.h`), so it is not done.
 //!
 //! **Conservative.** The answer handed out ([`ConvergedOnset::safe_value`])
 //! is the best estimate minus its error, and never above the finest mesh's
@@ -55,7 +69,10 @@
 use super::GeModel;
 use super::air_load::AirLoads;
 use super::element::{TipLoad, node};
-use super::qs_critical::{OnsetState, QsOnset, QsSearchConfig, search_onset_from};
+use super::qs_critical::{
+    OnsetState, QsOnset, QsSearchConfig, Scan, along_length, along_rate, nearest, onset_state,
+    refine_root, scan_change, search_onset_from,
+};
 use super::quasi_static::{QsConfig, divergence_indicator, wind_equilibrium, wind_stability};
 use super::stability::StateMotion;
 use crate::numerics::params::{InvalidInput, Kinematics, require_finite, require_positive};
@@ -69,12 +86,13 @@ pub const MAX_RELATIVE_TOLERANCE: f64 = 0.05;
 pub const BASE_ELEMENTS: usize = 20;
 /// Finest mesh of a converged search.
 pub const MAX_CONVERGED_ELEMENTS: usize = 1280;
-/// Relative width of each level's bisection.
-pub const ROOT_RTOL: f64 = 1e-8;
+/// How near (relative) a known equilibrium must be to start a Newton from
+/// it in wind (see `Level::equilibrium`).
+pub const NEAR: f64 = 0.05;
+/// Loosest relative width of a level's root ([`level_rtol`]).
+pub const ROOT_RTOL: f64 = 1e-7;
 /// Scan points of the first level.
 const SCAN_POINTS: usize = 16;
-/// Cap on bisection steps per level.
-const MAX_BISECTIONS: usize = 120;
 
 /// Settings of a converged search.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -131,7 +149,7 @@ pub struct ConvergedOnset {
     pub value: f64,
     /// Estimated bound on `|value − continuum value|` (≥ 0).
     pub error_estimate: f64,
-    /// The safe side: `value − error_estimate`, and at most the finest root.
+    /// The safe side: `value − error_estimate`, and at most the lowest root.
     pub safe_value: f64,
     /// Whether the tolerance was met within the finest mesh.
     pub converged: bool,
@@ -183,11 +201,22 @@ enum LevelRoot {
         at: f64,
         /// Equilibria found on this level, by parameter.
         known: Vec<(f64, Vec<f64>)>,
+        /// The lower end's count.
+        c_lo: usize,
     },
     Immediate,
     Never,
     Failed,
     Cancelled,
+}
+
+/// Where a finer level's root is looked for first: just below the coarser
+/// root `prev`, by about `expected_move` (the next step of the levels'
+/// sequence, from the ratio of the last two).
+#[derive(Clone, Copy)]
+struct Hint {
+    prev: f64,
+    expected_move: f64,
 }
 
 struct Level<'a, K: Fn(f64) -> Kinematics> {
@@ -196,16 +225,24 @@ struct Level<'a, K: Fn(f64) -> Kinematics> {
     air: &'a AirLoads,
     kin: &'a K,
     known: Vec<(f64, Vec<f64>)>,
+    /// Indicators already evaluated on this level, by parameter.
+    seen: Vec<(f64, Option<(usize, f64)>)>,
     equilibria: usize,
 }
 
 impl<K: Fn(f64) -> Kinematics> Level<'_, K> {
     fn equilibrium(&mut self, p: f64) -> Option<Vec<f64>> {
         self.equilibria += 1;
-        let start = self
-            .known
-            .iter()
-            .min_by(|a, b| (a.0 - p).abs().total_cmp(&(b.0 - p).abs()))
+        // In wind a Newton started from a state far along the parameter
+        // (the scan's previous point, ~100 m shorter) can land on a
+        // spurious compressed branch whose `det K` is negative: the
+        // 20-element "divergence" at 142 m in an 8 m/s wind that no finer
+        // mesh reproduced (issue 21) was one. There the state is solved
+        // afresh (straight, then continued in the dynamic pressure) unless
+        // a known one lies within `NEAR` of it.
+        let calm = self.air.is_calm();
+        let start = nearest(&self.known, p)
+            .filter(|k| calm || (k.0 - p).abs() <= NEAR * p.abs().max(k.0.abs()))
             .map(|k| k.1.clone());
         let eq = wind_equilibrium(
             &self.model,
@@ -224,143 +261,154 @@ impl<K: Fn(f64) -> Kinematics> Level<'_, K> {
         self.inertia(p).map(|x| x.0)
     }
 
-    /// Negative count and `ln |det|` of the symmetric part of `K` at `p`.
+    /// The divergence count and `ln |det|` at `p` ([`divergence_indicator`]),
+    /// each state solved once.
     fn inertia(&mut self, p: f64) -> Option<(usize, f64)> {
-        let q = self.equilibrium(p)?;
-        divergence_indicator(&self.model, (self.kin)(p), self.load, self.air, &q)
+        if let Some(x) = self.seen.iter().find(|x| x.0 == p) {
+            return x.1;
+        }
+        let x = self
+            .equilibrium(p)
+            .and_then(|q| divergence_indicator(&self.model, (self.kin)(p), self.load, self.air, &q));
+        self.seen.push((p, x));
+        x
     }
 
     fn state(&mut self, p: f64) -> OnsetState {
-        let Some(q) = self.equilibrium(p) else {
-            return OnsetState::default();
-        };
-        let kin = (self.kin)(p);
-        let top = node(&q, self.model.elements);
-        OnsetState {
-            root_axial_force_n: super::critical::root_axial_force_n(&self.model, kin.length_m, &q),
-            tip_altitude_m: kin.length_m + top[0],
-            tip_downwind_m: top[1],
+        match self.equilibrium(p) {
+            Some(q) => onset_state(&self.model, (self.kin)(p), &q),
+            None => OnsetState::default(),
         }
     }
 
-    /// The divergence root in `[lo, hi]`; `hint` is the coarser level's root
-    /// and its last step (the root is searched just below it first).
+    /// The divergence root in `[lo, hi]` to relative width `rtol`;
+    /// `c_lo`: the lower end's count when known (a finer level keeps the
+    /// base level's), `hint`: where a finer level looks first.
     fn root(
         mut self,
         (lo, hi): (f64, f64),
-        hint: Option<(f64, f64)>,
+        c_lo: Option<usize>,
+        hint: Option<Hint>,
+        rtol: f64,
         cancel: &dyn Fn() -> bool,
     ) -> (LevelRoot, usize) {
-        let Some(c_lo) = self.count(lo) else {
-            return (LevelRoot::Failed, self.equilibria);
+        let c_lo = match c_lo {
+            Some(c) => c,
+            None => {
+                let Some(c) = self.count(lo) else {
+                    return (LevelRoot::Failed, self.equilibria);
+                };
+                if c > 0 && self.air.is_calm() {
+                    return (LevelRoot::Immediate, self.equilibria);
+                }
+                c
+            }
         };
-        if c_lo > 0 && self.air.is_calm() {
-            return (LevelRoot::Immediate, self.equilibria);
-        }
-        let same = |c: Option<usize>| c == Some(c_lo);
         let mut bracket = None;
-        if let Some((prev, step)) = hint {
-            let b = prev.min(hi);
-            if !same(self.count(b)) {
-                let mut d = step.abs().max(1e-4 * prev.abs()).max(1e-12);
+        if let Some(Hint {
+            prev,
+            expected_move,
+        }) = hint
+        {
+            // FE roots converge from above: the finer root is expected at
+            // `prev − m`; bracket it by `[prev − 1.5 m, prev − 0.5 m]`,
+            // widened by 4× steps where it is not.
+            let m = expected_move.abs().max(1e-4 * prev.abs()).max(1e-12);
+            let mut b = (prev - 0.5 * m).clamp(lo, hi);
+            if self.count(b) == Some(c_lo) {
+                // above the guess: up to the coarser root, then the scan
+                let top = prev.min(hi);
+                if top > b && self.count(top) != Some(c_lo) {
+                    bracket = Some((b, top));
+                }
+            } else {
+                let mut d = m;
                 loop {
                     if cancel() {
                         return (LevelRoot::Cancelled, self.equilibria);
                     }
                     let a = (b - d).max(lo);
-                    if a <= lo || same(self.count(a)) {
+                    if self.count(a) == Some(c_lo) {
                         bracket = Some((a, b));
                         break;
                     }
+                    if a <= lo {
+                        // unstable down to the lower end on this mesh
+                        return (LevelRoot::Immediate, self.equilibria);
+                    }
+                    b = a;
                     d *= 4.0;
                 }
             }
         }
         if bracket.is_none() {
-            let mut prev = lo;
-            for k in 1..=SCAN_POINTS {
-                if cancel() {
-                    return (LevelRoot::Cancelled, self.equilibria);
-                }
-                let p = lo + (hi - lo) * k as f64 / SCAN_POINTS as f64;
-                if same(self.count(p)) {
-                    prev = p;
-                } else {
-                    bracket = Some((prev, p));
-                    break;
-                }
+            self.count(lo);
+            match scan_change(
+                (lo, hi),
+                SCAN_POINTS,
+                |p| Some(self.count(p) == Some(c_lo)),
+                cancel,
+            ) {
+                Scan::Bracket { a, b, .. } => bracket = Some((a, b)),
+                Scan::Unchanged => return (LevelRoot::Never, self.equilibria),
+                Scan::Cancelled => return (LevelRoot::Cancelled, self.equilibria),
             }
         }
-        let Some((mut a, mut b)) = bracket else {
+        let Some((a, b)) = bracket else {
             return (LevelRoot::Never, self.equilibria);
         };
-        // Illinois regula falsi on det of the symmetric part of K (its sign
-        // is (−1)^count, smooth through a simple root), safeguarded by the
-        // count: the bracket always has the lower-end count at `a` only.
-        let tol = ROOT_RTOL * b.abs().max(1e-300);
-        let signed = |x: Option<(usize, f64)>, reference: f64| -> f64 {
-            match x {
-                Some((c, ld)) => {
-                    let mag = (ld - reference).clamp(-700.0, 700.0).exp();
-                    if c % 2 == 0 { mag } else { -mag }
-                }
-                None => f64::NAN,
-            }
+        let ends = (self.inertia(a), self.inertia(b));
+        let Some((a, b)) = refine_root((a, b), ends, rtol, |p| self.inertia(p), cancel) else {
+            return (LevelRoot::Cancelled, self.equilibria);
         };
-        let ia = self.inertia(a);
-        let reference = ia.map_or(0.0, |x| x.1);
-        let mut fa = signed(ia, reference);
-        let mut fb = signed(self.inertia(b), reference);
-        let mut side = 0i8;
-        for _ in 0..MAX_BISECTIONS {
-            let w = b - a;
-            if w <= tol {
-                break;
-            }
-            if cancel() {
-                return (LevelRoot::Cancelled, self.equilibria);
-            }
-            let mut m = if fa * fb < 0.0 && fa.is_finite() && fb.is_finite() {
-                (a * fb - b * fa) / (fb - fa)
-            } else {
-                0.5 * (a + b)
-            };
-            if !(m > a && m < b) {
-                m = 0.5 * (a + b);
-            }
-            // keep off the ends so that the bracket closes
-            let eps = 0.5 * tol;
-            if m - a < eps {
-                m = a + eps.min(0.5 * w);
-            } else if b - m < eps {
-                m = b - eps.min(0.5 * w);
-            }
-            let im = self.inertia(m);
-            let fm = signed(im, reference);
-            if same(im.map(|x| x.0)) {
-                a = m;
-                fa = fm;
-                if side == -1 {
-                    fb *= 0.5;
-                }
-                side = -1;
-            } else {
-                b = m;
-                fb = fm;
-                if side == 1 {
-                    fa *= 0.5;
-                }
-                side = 1;
-            }
-        }
         let e = self.equilibria;
         (
             LevelRoot::Root {
                 at: 0.5 * (a + b),
                 known: self.known,
+                c_lo,
             },
             e,
         )
+    }
+}
+
+/// Relative width of each level's root at a relative tolerance `tol`:
+/// Richardson weighs the roots by at most 6 in its error estimate, so
+/// `10⁻⁴ tol` keeps the roots' own error out of it (at most
+/// [`ROOT_RTOL`], at least `10⁻¹²`).
+pub fn level_rtol(tol: f64) -> f64 {
+    (1e-4 * tol).clamp(1e-12, ROOT_RTOL)
+}
+
+/// Where the next level looks for its root: below the last by the last
+/// step times the ratio of the last two (first order: a half), 1 % on
+/// the first refinement.
+fn hint(roots: &[(usize, f64)]) -> Option<Hint> {
+    let k = roots.len();
+    let q = |i: usize| roots[i].1;
+    match k {
+        0 => None,
+        1 => Some(Hint {
+            prev: q(0),
+            expected_move: 1e-2 * q(0),
+        }),
+        2 => Some(Hint {
+            prev: q(1),
+            expected_move: 0.5 * (q(0) - q(1)),
+        }),
+        _ => {
+            let (d1, d2) = (q(k - 3) - q(k - 2), q(k - 2) - q(k - 1));
+            let ratio = if d1 != 0.0 {
+                (d2 / d1).clamp(0.1, 1.0)
+            } else {
+                0.5
+            };
+            Some(Hint {
+                prev: q(k - 1),
+                expected_move: ratio * d2,
+            })
+        }
     }
 }
 
@@ -448,6 +496,8 @@ pub fn converged_onset(
     let mut n = config.base_elements;
     let mut finest: Option<GeModel> = None;
     let mut finest_known = Vec::new();
+    let mut c_base = None;
+    let rtol = level_rtol(config.relative_tolerance);
     let outcome = loop {
         let m = with_elements(model, n)?;
         let level = Level {
@@ -456,17 +506,18 @@ pub fn converged_onset(
             air,
             kin: &kin,
             known: std::mem::take(&mut known),
+            seen: Vec::new(),
             equilibria: 0,
         };
-        let hint = match roots.len() {
-            0 => None,
-            1 => Some((roots[0].1, 0.5 * roots[0].1 * 1e-2)),
-            k => Some((roots[k - 1].1, roots[k - 2].1 - roots[k - 1].1)),
-        };
-        let (r, e) = level.root((lo, hi), hint, cancel);
+        let (r, e) = level.root((lo, hi), c_base, hint(&roots), rtol, cancel);
         equilibria += e;
         match r {
-            LevelRoot::Root { at, known: k } => {
+            LevelRoot::Root {
+                at,
+                known: k,
+                c_lo,
+            } => {
+                c_base = Some(c_lo);
                 roots.push((n, at));
                 known = k.iter().map(|(p, q)| (*p, prolong(q, n))).collect();
                 finest = Some(m);
@@ -552,6 +603,7 @@ pub fn converged_onset(
                     air,
                     kin: &kin,
                     known: finest_known,
+                    seen: Vec::new(),
                     equilibria: 0,
                 };
                 c.at_safe = level.state(c.safe_value.max(lo));
@@ -578,10 +630,12 @@ fn summarise(roots: &[(usize, f64)], config: &ConvergenceConfig, met: bool) -> C
     } else {
         finest.abs() * config.relative_tolerance.max(0.05)
     };
+    // At most the lowest root (the finest, when the levels fall as in calm air).
+    let lowest = values.iter().copied().fold(finest, f64::min);
     ConvergedOnset {
         value,
         error_estimate: err,
-        safe_value: (value - err).min(finest),
+        safe_value: (value - err).min(lowest),
         converged: met,
         order,
         levels: roots.to_vec(),
@@ -609,11 +663,7 @@ pub fn converged_critical_length(
         air,
         config,
         (min_length_m, max_length_m),
-        |l| Kinematics {
-            length_m: l,
-            rate_m_s,
-            acceleration_m_s2: 0.0,
-        },
+        along_length(rate_m_s, 0.0),
         cancel,
         None,
     )
@@ -640,11 +690,7 @@ pub fn converged_critical_rate(
         air,
         config,
         (1e-3 * max_rate_m_s, max_rate_m_s),
-        |v| Kinematics {
-            length_m,
-            rate_m_s: v,
-            acceleration_m_s2: 0.0,
-        },
+        along_rate(length_m),
         cancel,
         start,
     )

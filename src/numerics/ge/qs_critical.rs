@@ -43,19 +43,6 @@ use super::quasi_static::{
     QsConfig, divergence_indicator, state_at, wind_equilibrium, wind_matrices,
 };
 
-/// The divergence count of a state ([`divergence_indicator`]): the inertia
-/// of `K` in calm air, the parity of `det K` in wind (issue 21: the
-/// inertia of the symmetric part of the non-symmetric `K` changes where no
-/// real eigenvalue crosses zero).
-fn stiffness_negative_count(
-    model: &GeModel,
-    kin: Kinematics,
-    load: TipLoad,
-    air: &AirLoads,
-    q: &[f64],
-) -> Option<usize> {
-    divergence_indicator(model, kin, load, air, q).map(|x| x.0)
-}
 use super::solver::NewtonFailure;
 use super::stability::{StateMotion, spectrum_of};
 use crate::numerics::params::{InvalidInput, Kinematics, require_finite, require_positive};
@@ -185,10 +172,7 @@ impl<K: Fn(f64) -> Kinematics> Searcher<'_, K> {
     fn equilibrium(&mut self, p: f64) -> Result<Vec<f64>, NewtonFailure> {
         self.equilibria += 1;
         let kin = (self.kin)(p);
-        let start = self
-            .known
-            .iter()
-            .min_by(|a, b| (a.0 - p).abs().total_cmp(&(b.0 - p).abs()))
+        let start = nearest(&self.known, p)
             .map(|k| k.1.as_slice())
             .or(self.last.as_deref());
         let eq = wind_equilibrium(
@@ -204,11 +188,12 @@ impl<K: Fn(f64) -> Kinematics> Searcher<'_, K> {
         Ok(eq.q)
     }
 
-    /// Negative eigenvalues of the (symmetric part of the) stiffness at `p`;
-    /// `None` without an equilibrium or with a zero pivot.
-    fn negative_count(&mut self, p: f64) -> Option<usize> {
+    /// The divergence indicator at `p` ([`divergence_indicator`]: the
+    /// inertia of `K` in calm air, the parity of `det K` in wind, and
+    /// `ln |det|`); `None` without an equilibrium or with a zero pivot.
+    fn indicator(&mut self, p: f64) -> Option<(usize, f64)> {
         let q = self.equilibrium(p).ok()?;
-        stiffness_negative_count(self.model, (self.kin)(p), self.load, self.air, &q)
+        divergence_indicator(self.model, (self.kin)(p), self.load, self.air, &q)
     }
 
     /// The QEP verdict at `p`. With `divergence`, a real eigenvalue above
@@ -224,16 +209,7 @@ impl<K: Fn(f64) -> Kinematics> Searcher<'_, K> {
             return (Verdict::SpectrumFailed, None);
         };
         self.qep_solves += 1;
-        let top = node(&state.q, self.model.elements);
-        let at = OnsetState {
-            root_axial_force_n: super::critical::root_axial_force_n(
-                self.model,
-                kin.length_m,
-                &state.q,
-            ),
-            tip_altitude_m: kin.length_m + top[0],
-            tip_downwind_m: top[1],
-        };
+        let at = onset_state(self.model, kin, &state.q);
         match spectrum_of(
             self.model,
             wind_matrices(self.model, kin, self.load, self.air, &state),
@@ -257,6 +233,154 @@ fn interpolate(a: OnsetState, b: OnsetState, f: f64) -> OnsetState {
         tip_altitude_m: a.tip_altitude_m + f * (b.tip_altitude_m - a.tip_altitude_m),
         tip_downwind_m: a.tip_downwind_m + f * (b.tip_downwind_m - a.tip_downwind_m),
     }
+}
+
+/// The equilibrium already found nearest to `p` along the parameter (a
+/// start far along it can converge in wind to a spurious buckled
+/// equilibrium with almost no tension).
+pub(super) fn nearest(known: &[(f64, Vec<f64>)], p: f64) -> Option<&(f64, Vec<f64>)> {
+    known
+        .iter()
+        .min_by(|a, b| (a.0 - p).abs().total_cmp(&(b.0 - p).abs()))
+}
+
+/// The state of the equilibrium `q` at `kin`: root force, top of the cable.
+pub(super) fn onset_state(model: &GeModel, kin: Kinematics, q: &[f64]) -> OnsetState {
+    let top = node(q, model.elements);
+    OnsetState {
+        root_axial_force_n: super::critical::root_axial_force_n(model, kin.length_m, q),
+        tip_altitude_m: kin.length_m + top[0],
+        tip_downwind_m: top[1],
+    }
+}
+
+/// The states along the length at a constant rate and acceleration.
+pub fn along_length(rate_m_s: f64, acceleration_m_s2: f64) -> impl Fn(f64) -> Kinematics {
+    move |length_m| Kinematics {
+        length_m,
+        rate_m_s,
+        acceleration_m_s2,
+    }
+}
+
+/// The constant-rate states at one length, along the rate.
+pub fn along_rate(length_m: f64) -> impl Fn(f64) -> Kinematics {
+    move |rate_m_s| Kinematics {
+        length_m,
+        rate_m_s,
+        acceleration_m_s2: 0.0,
+    }
+}
+
+/// The end of an even scan of `(lo, hi]`.
+pub(super) enum Scan {
+    /// `(last point like the lower end, first point not like it)`;
+    /// `failed`: the second point had no state at all.
+    Bracket { a: f64, b: f64, failed: bool },
+    /// Like the lower end up to `hi`.
+    Unchanged,
+    Cancelled,
+}
+
+/// Scans `(lo, hi]` at `n` even steps for the first point where `like`
+/// (like the lower end: `Some(true)`, not: `Some(false)`, no state: `None`)
+/// is not `Some(true)`.
+pub(super) fn scan_change(
+    (lo, hi): (f64, f64),
+    n: usize,
+    mut like: impl FnMut(f64) -> Option<bool>,
+    cancel: &dyn Fn() -> bool,
+) -> Scan {
+    let mut prev = lo;
+    for k in 1..=n {
+        if cancel() {
+            return Scan::Cancelled;
+        }
+        let p = lo + (hi - lo) * k as f64 / n as f64;
+        match like(p) {
+            Some(true) => prev = p,
+            other => {
+                return Scan::Bracket {
+                    a: prev,
+                    b: p,
+                    failed: other.is_none(),
+                };
+            }
+        }
+    }
+    Scan::Unchanged
+}
+
+/// The divergence root between `a` (the lower-end count, `fa = (count,
+/// ln |det|)`) and `b` (another count, `fb`) to relative width `rtol`:
+/// Illinois regula falsi on the determinant `(−1)^count exp(ln |det|)`
+/// (smooth through a simple root), safeguarded by the count (the bracket
+/// keeps the lower-end count at `a` only) and by bisection when the
+/// determinant does not change sign. `eval` gives the indicator of a
+/// state; the final bracket, `None` when cancelled.
+pub(super) fn refine_root(
+    (mut a, mut b): (f64, f64),
+    (ia, ib): (Option<(usize, f64)>, Option<(usize, f64)>),
+    rtol: f64,
+    mut eval: impl FnMut(f64) -> Option<(usize, f64)>,
+    cancel: &dyn Fn() -> bool,
+) -> Option<(f64, f64)> {
+    let c_a = ia.map(|x| x.0);
+    let reference = ia.map_or(0.0, |x| x.1);
+    let signed = |x: Option<(usize, f64)>| -> f64 {
+        match x {
+            Some((c, ld)) => {
+                let mag = (ld - reference).clamp(-700.0, 700.0).exp();
+                if c % 2 == 0 { mag } else { -mag }
+            }
+            None => f64::NAN,
+        }
+    };
+    let tol = rtol * b.abs().max(a.abs()).max(1e-300);
+    let (mut fa, mut fb) = (signed(ia), signed(ib));
+    let mut side = 0i8;
+    for _ in 0..MAX_BISECTIONS {
+        let w = b - a;
+        if w <= tol {
+            break;
+        }
+        if cancel() {
+            return None;
+        }
+        let mut m = if fa * fb < 0.0 && fa.is_finite() && fb.is_finite() {
+            (a * fb - b * fa) / (fb - fa)
+        } else {
+            0.5 * (a + b)
+        };
+        if !(m > a && m < b) {
+            m = 0.5 * (a + b);
+        }
+        // keep off the ends so that the bracket closes
+        let eps = 0.5 * tol;
+        if m - a < eps {
+            m = a + eps.min(0.5 * w);
+        } else if b - m < eps {
+            m = b - eps.min(0.5 * w);
+        }
+        let im = eval(m);
+        let fm = signed(im);
+        if c_a.is_some() && im.map(|x| x.0) == c_a {
+            a = m;
+            fa = fm;
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        } else {
+            b = m;
+            fb = fm;
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    Some((a, b))
 }
 
 /// The first loss of stability along `p ∈ [lo, hi]` with the state
@@ -371,45 +495,41 @@ pub fn search_onset_from(
     let mut stable = (lo, st0.unwrap_or_default());
     let delta = config.relative_tolerance;
     // 1. scan the inertia of K
-    let c_lo = q_lo
+    let i_lo = q_lo
         .as_ref()
-        .and_then(|q| stiffness_negative_count(model, (s.kin)(lo), s.load, air, q));
+        .and_then(|q| divergence_indicator(model, (s.kin)(lo), s.load, air, q));
     let n = config.scan_points;
-    let mut prev = lo;
     let mut det_bracket = None;
     let mut no_eq_at = None;
-    for k in 1..=n {
-        if cancel() {
-            return Ok(finish(out, &s));
-        }
-        let p = lo + (hi - lo) * k as f64 / n as f64;
-        let Some(c_lo) = c_lo else { break };
-        let Ok(q) = s.equilibrium(p) else {
-            no_eq_at = Some((prev, p));
-            break;
-        };
-        match stiffness_negative_count(model, (s.kin)(p), s.load, air, &q) {
-            Some(c) if c == c_lo => prev = p,
-            _ => {
-                det_bracket = Some((prev, p));
-                break;
-            }
+    if let Some((c_lo, _)) = i_lo {
+        let mut last = None;
+        match scan_change(
+            (lo, hi),
+            n,
+            |p| match s.equilibrium(p) {
+                Err(_) => None,
+                Ok(q) => {
+                    last = divergence_indicator(model, (s.kin)(p), s.load, air, &q);
+                    Some(last.map(|x| x.0) == Some(c_lo))
+                }
+            },
+            cancel,
+        ) {
+            Scan::Cancelled => return Ok(finish(out, &s)),
+            Scan::Unchanged => {}
+            Scan::Bracket { a, b, failed: true } => no_eq_at = Some((a, b)),
+            Scan::Bracket { a, b, .. } => det_bracket = Some((a, b, last)),
         }
     }
-    // 2. bisect the divergence root
+    // 2. the divergence root
     let mut unstable: Option<(f64, Option<OnsetState>)> = None;
-    if let Some((mut a, mut b)) = det_bracket {
+    if let Some((a, b, i_b)) = det_bracket {
         s.last = q_lo.clone();
-        for _ in 0..MAX_BISECTIONS {
-            if b - a <= 1e-12 * b.abs().max(1e-300) {
-                break;
-            }
-            let m = 0.5 * (a + b);
-            match s.negative_count(m) {
-                Some(c) if Some(c) == c_lo => a = m,
-                _ => b = m,
-            }
-        }
+        let i_a = if a == lo { i_lo } else { s.indicator(a) };
+        let Some((a, b)) = refine_root((a, b), (i_a, i_b), 1e-12, |p| s.indicator(p), cancel)
+        else {
+            return Ok(finish(out, &s));
+        };
         let root = 0.5 * (a + b);
         // 3. confirm with the QEP on either side
         let (below, above) = (root - delta * root.abs(), root + delta * root.abs());
@@ -509,19 +629,11 @@ fn inertia_only<K: Fn(f64) -> Kinematics>(
     hi: f64,
     mut out: QsSearch,
 ) -> QsSearch {
-    let state = |s: &mut Searcher<'_, K>, p: f64| -> Option<(usize, OnsetState)> {
+    let state = |s: &mut Searcher<'_, K>, p: f64| -> Option<((usize, f64), OnsetState)> {
         let q = s.equilibrium(p).ok()?;
         let kin = (s.kin)(p);
-        let c = stiffness_negative_count(s.model, kin, s.load, s.air, &q)?;
-        let top = node(&q, s.model.elements);
-        Some((
-            c,
-            OnsetState {
-                root_axial_force_n: super::critical::root_axial_force_n(s.model, kin.length_m, &q),
-                tip_altitude_m: kin.length_m + top[0],
-                tip_downwind_m: top[1],
-            },
-        ))
+        let c = divergence_indicator(s.model, kin, s.load, s.air, &q)?;
+        Some((c, onset_state(s.model, kin, &q)))
     };
     let finish = |mut out: QsSearch, s: &Searcher<'_, K>| {
         out.equilibria = s.equilibria;
@@ -538,7 +650,7 @@ fn inertia_only<K: Fn(f64) -> Kinematics>(
         };
         return finish(out, s);
     };
-    if c0 > 0 {
+    if c0.0 > 0 {
         out.onset = QsOnset::Immediate {
             max_real_1_s: f64::NAN,
         };
@@ -546,33 +658,35 @@ fn inertia_only<K: Fn(f64) -> Kinematics>(
         return finish(out, s);
     }
     let n = s.config.scan_points;
-    let (mut a, mut sa) = (lo, st0);
-    let mut b = None;
-    for k in 1..=n {
-        let p = lo + (hi - lo) * k as f64 / n as f64;
-        match state(s, p) {
-            Some((0, st)) => (a, sa) = (p, st),
-            other => {
-                b = Some((p, other.map(|x| x.1)));
-                break;
-            }
+    let mut last = None;
+    let (a, b) = match scan_change(
+        (lo, hi),
+        n,
+        |p| {
+            last = state(s, p);
+            Some(last.is_some_and(|x| x.0.0 == 0))
+        },
+        &|| false,
+    ) {
+        Scan::Bracket { a, b, .. } => (a, b),
+        _ => {
+            out.onset = QsOnset::Never { up_to: hi };
+            out.at_onset = state(s, hi).map(|x| x.1).or(Some(st0));
+            return finish(out, s);
         }
-    }
-    let Some((mut b, mut sb)) = b else {
-        out.onset = QsOnset::Never { up_to: hi };
-        out.at_onset = Some(sa);
-        return finish(out, s);
     };
-    for _ in 0..MAX_BISECTIONS {
-        if b - a <= 1e-12 * b.abs() {
-            break;
-        }
-        let m = 0.5 * (a + b);
-        match state(s, m) {
-            Some((0, st)) => (a, sa) = (m, st),
-            other => (b, sb) = (m, other.map(|x| x.1)),
-        }
-    }
+    let i_a = if a == lo { Some(c0) } else { state(s, a).map(|x| x.0) };
+    let i_b = last.map(|x| x.0);
+    let (a, b) = refine_root(
+        (a, b),
+        (i_a, i_b),
+        1e-12,
+        |p| state(s, p).map(|x| x.0),
+        &|| false,
+    )
+    .unwrap_or((a, b));
+    let sa = state(s, a).map_or(st0, |x| x.1);
+    let sb = state(s, b).map(|x| x.1);
     out.onset = QsOnset::During { at: 0.5 * (a + b) };
     out.bracket = Some((a, b));
     out.divergence = true;
@@ -608,11 +722,7 @@ pub fn critical_length(
         motion,
         config,
         (min_length_m, max_length_m),
-        |l| Kinematics {
-            length_m: l,
-            rate_m_s,
-            acceleration_m_s2,
-        },
+        along_length(rate_m_s, acceleration_m_s2),
         cancel,
     )
 }
@@ -669,11 +779,7 @@ pub fn critical_rate_from(
         motion,
         config,
         (1e-3 * max_rate_m_s, max_rate_m_s),
-        |v| Kinematics {
-            length_m,
-            rate_m_s: v,
-            acceleration_m_s2: 0.0,
-        },
+        along_rate(length_m),
         cancel,
         start,
     )

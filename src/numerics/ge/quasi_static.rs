@@ -280,6 +280,26 @@ pub fn wind_stability(
     })
 }
 
+/// `K` of the state at rest at the equilibrium `q` (the air stiffness
+/// included in wind).
+pub fn static_stiffness(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    q: &[f64],
+) -> Band {
+    let zero = vec![0.0; q.len()];
+    let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
+    if !air.is_calm() {
+        k.add_scaled(
+            1.0,
+            &air.terms(model, kin.length_m, q, &zero, true).stiffness,
+        );
+    }
+    k
+}
+
 /// Sign of `det K` of the quasi-static state (`K` with the air stiffness):
 /// `+1`, `−1`, or 0 when singular. A real eigenvalue of the QEP crosses
 /// zero exactly where it changes sign (divergence).
@@ -290,15 +310,7 @@ pub fn stiffness_determinant_sign(
     air: &AirLoads,
     q: &[f64],
 ) -> i8 {
-    let zero = vec![0.0; q.len()];
-    let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
-    if !air.is_calm() {
-        k.add_scaled(
-            1.0,
-            &air.terms(model, kin.length_m, q, &zero, true).stiffness,
-        );
-    }
-    band_determinant_sign(&k)
+    band_determinant_sign(&static_stiffness(model, kin, load, air, q))
 }
 
 /// Number of negative eigenvalues of the symmetric part of `K` (with the
@@ -312,15 +324,7 @@ pub fn stiffness_negative_count(
     air: &AirLoads,
     q: &[f64],
 ) -> Option<usize> {
-    let zero = vec![0.0; q.len()];
-    let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
-    if !air.is_calm() {
-        k.add_scaled(
-            1.0,
-            &air.terms(model, kin.length_m, q, &zero, true).stiffness,
-        );
-    }
-    symmetric_negative_count(&k)
+    symmetric_negative_count(&static_stiffness(model, kin, load, air, q))
 }
 
 /// As [`stiffness_negative_count`], with `ln |det|` of the symmetric part.
@@ -331,15 +335,7 @@ pub fn stiffness_inertia(
     air: &AirLoads,
     q: &[f64],
 ) -> Option<(usize, f64)> {
-    let zero = vec![0.0; q.len()];
-    let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
-    if !air.is_calm() {
-        k.add_scaled(
-            1.0,
-            &air.terms(model, kin.length_m, q, &zero, true).stiffness,
-        );
-    }
-    symmetric_inertia(&k)
+    symmetric_inertia(&static_stiffness(model, kin, load, air, q))
 }
 
 /// Negative pivots of `LDLᵀ` of `(A + Aᵀ)/2` for a band `A` (no pivoting).
@@ -406,13 +402,8 @@ pub fn divergence_indicator(
     if air.is_calm() {
         return stiffness_inertia(model, kin, load, air, q);
     }
-    let zero = vec![0.0; q.len()];
-    let mut k = solver::system_matrices(model, kin, load, 0.0, q, &zero, &zero).stiffness;
-    k.add_scaled(
-        1.0,
-        &air.terms(model, kin.length_m, q, &zero, true).stiffness,
-    );
-    band_determinant(&k).map(|(sign, ld)| (usize::from(sign < 0), ld))
+    band_determinant(&static_stiffness(model, kin, load, air, q))
+        .map(|(sign, ld)| (usize::from(sign < 0), ld))
 }
 
 /// Sign and `ln |det|` of a band matrix (LU with partial pivoting on a

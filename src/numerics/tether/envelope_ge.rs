@@ -28,14 +28,8 @@
 //! 0.1 m was used. The tether's model now solves the slow modes by the
 //! inverted problem ([`crate::numerics::ge::stability::slow_spectrum_of`],
 //! a shift-invert about `λ = 0`): the spectrum is that of the solid
-//! section itself, no stand-in (issue 21), in the converged mode. *Not
-//! yet* when the mesh is given (no [`GeStabilitySpec::converge`]): that
-//! path keeps the stand-in `I_ρ = ρA (0.1 m)²`
-//! ([`ROTARY_INERTIA_RADIUS_M`]) and the full spectrum, because with the
-//! solid section its rate search reaches rates (47 m/s at 1150 m in a
-//! 5 m/s wind) where `det K` changes sign while the scan's QEP growth
-//! stays below the tolerance (measured, `tests/verification_envelope_ge.rs`),
-//! a disagreement not yet resolved. The rotation wave speed
+//! section itself, no stand-in (issue 21), converged or on a given mesh.
+//! The rotation wave speed
 //! `c_r = √(EI/I_ρ)` still bounds the payout rate (a sliding beam paid out
 //! near it is unstable for that reason alone: its effective bending
 //! stiffness is `EI − I_ρ L̇²`); with the solid section `c_r = (4/d)√(EI/ρA)`
@@ -80,10 +74,6 @@ use crate::numerics::tether::equilibrium::EquilibriumConfig;
 /// Fastest payout (and top of the rate search) as a fraction of the rotation
 /// wave speed `√(EI/I_ρ)` (see the module docs).
 pub const ROTATION_WAVE_FRACTION: f64 = 0.5;
-/// Radius of gyration (m) of the stand-in rotary inertia `I_ρ = ρA r²`
-/// that the envelope keeps **when `elements` is given** (no `converge`):
-/// its cells are judged by the full QEP of that mesh, as in issue 12.
-pub const ROTARY_INERTIA_RADIUS_M: f64 = 0.1;
 
 /// The rotation wave speed `√(EI/I_ρ)` of a GE model (m/s).
 pub fn rotation_wave_speed_m_s(model: &GeModel) -> f64 {
@@ -245,7 +235,7 @@ pub fn ge_system(
         .iter()
         .copied()
         .fold(problem.base.tether_length_m, f64::max);
-    let mut sys = ge_tether_system(
+    let sys = ge_tether_system(
         &problem.point_problem(wind_speed_m_s, longest),
         &GeTetherOptions {
             bending_stiffness_n_m2: spec.bending_stiffness_n_m2,
@@ -253,13 +243,6 @@ pub fn ge_system(
             elements: spec.elements,
         },
     )?;
-    if spec.converge.is_none() {
-        // The mesh as given keeps issue 12's stand-in (module docs).
-        sys.model.section.rotary_inertia_kg_m = problem.base.cable.mass_per_length_kg_m
-            * ROTARY_INERTIA_RADIUS_M
-            * ROTARY_INERTIA_RADIUS_M;
-        sys.model.slow_spectrum = false;
-    }
     Ok(sys)
 }
 
