@@ -8,10 +8,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::equilibrium::require_range;
-use crate::numerics::ge::qs_converged::{
-    ConvergedOutcome, ConvergedSearch, ConvergenceConfig, DEFAULT_RELATIVE_TOLERANCE,
-    MAX_RELATIVE_TOLERANCE, MIN_RELATIVE_TOLERANCE,
-};
+use crate::numerics::ge::qs_converged::{ConvergedOutcome, ConvergedSearch, ConvergenceConfig};
 use crate::numerics::ge::qs_critical::{QsOnset, QsSearch};
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::envelope_ge::{
@@ -99,29 +96,8 @@ impl EnvelopeStabilityInput {
                 format!("must be between 2 and {MAX_ELEMENTS}, got {n}"),
             ));
         }
-        let converge = match (elements, relative_tolerance_nondim) {
-            (Some(_), Some(_)) => {
-                return Err(InvalidInput::new(
-                    "stability.relative_tolerance_nondim",
-                    "applies to the converged limits only: omit stability.elements to converge them",
-                ));
-            }
-            (Some(_), None) => None,
-            (None, tol) => {
-                let tol = tol.unwrap_or(DEFAULT_RELATIVE_TOLERANCE);
-                require_range(
-                    "stability.relative_tolerance_nondim",
-                    tol,
-                    MIN_RELATIVE_TOLERANCE,
-                    false,
-                    MAX_RELATIVE_TOLERANCE,
-                )?;
-                Some(ConvergenceConfig {
-                    relative_tolerance: tol,
-                    ..ConvergenceConfig::default()
-                })
-            }
-        };
+        let converge =
+            ConvergenceConfig::requested(elements.is_some(), relative_tolerance_nondim)?;
         let at = match critical_rate_length_m {
             Some(l) => require_range("stability.critical_rate_length_m", l, 0.0, true, 1e5)?,
             None => longest_length_m,

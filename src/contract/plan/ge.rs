@@ -4,7 +4,7 @@
 //! [`crate::numerics::plan::ge_stability`].
 
 use crate::contract::plan::dto::*;
-use crate::numerics::ge::qs_converged::{BASE_ELEMENTS, ConvergenceConfig, DEFAULT_RELATIVE_TOLERANCE};
+use crate::numerics::ge::qs_converged::{BASE_ELEMENTS, ConvergenceConfig};
 use crate::numerics::params::InvalidInput;
 use crate::numerics::plan::air::{Air, SteadyWind};
 use crate::numerics::plan::ge_stability::{self as ge_plan, GeStabilityOptions};
@@ -75,23 +75,8 @@ pub(super) fn ge_options(req: &PlanRequest) -> Result<Option<GeStabilityOptions>
     };
     crate::numerics::params::ranges::BENDING_STIFFNESS_N_M2
         .check("stability.bending_stiffness_n_m2", ei)?;
-    let converge = match (st.elements, st.relative_tolerance_nondim) {
-        (Some(_), Some(_)) => {
-            return Err(InvalidInput::new(
-                "stability.relative_tolerance_nondim",
-                "applies to the converged table only: omit stability.elements to converge it",
-            ));
-        }
-        (Some(_), None) => None,
-        (None, tol) => {
-            let c = ConvergenceConfig {
-                relative_tolerance: tol.unwrap_or(DEFAULT_RELATIVE_TOLERANCE),
-                ..ConvergenceConfig::default()
-            };
-            c.validate()?;
-            Some(c)
-        }
-    };
+    let converge =
+        ConvergenceConfig::requested(st.elements.is_some(), st.relative_tolerance_nondim)?;
     let o = GeStabilityOptions {
         bending_stiffness_n_m2: ei,
         elements: st.elements.unwrap_or(BASE_ELEMENTS),

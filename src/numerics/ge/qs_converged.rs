@@ -142,6 +142,34 @@ impl ConvergenceConfig {
     }
 }
 
+impl ConvergenceConfig {
+    /// The converged search a request asks for: none when it gives a mesh
+    /// (`elements_given`), else one to `relative_tolerance` (default
+    /// [`DEFAULT_RELATIVE_TOLERANCE`]); a tolerance beside a mesh is
+    /// refused (the fields are `stability.elements` and
+    /// `stability.relative_tolerance_nondim`).
+    pub fn requested(
+        elements_given: bool,
+        relative_tolerance: Option<f64>,
+    ) -> Result<Option<Self>, InvalidInput> {
+        match (elements_given, relative_tolerance) {
+            (true, Some(_)) => Err(InvalidInput::new(
+                "stability.relative_tolerance_nondim",
+                "applies to converged answers only: omit stability.elements to converge them",
+            )),
+            (true, None) => Ok(None),
+            (false, tol) => {
+                let c = Self {
+                    relative_tolerance: tol.unwrap_or(DEFAULT_RELATIVE_TOLERANCE),
+                    ..Self::default()
+                };
+                c.validate()?;
+                Ok(Some(c))
+            }
+        }
+    }
+}
+
 /// A converged onset (length in m, or rate in m/s).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConvergedOnset {

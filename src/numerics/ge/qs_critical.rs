@@ -14,8 +14,10 @@
 //!    of a band `LDLᵀ`, O(n)), in wind the sign of `det K` (band LU);
 //! 2. **divergence root** — where that count first grows, an eigenvalue
 //!    of `K` passes through zero, and with it a real eigenvalue of the
-//!    QEP; the root is bisected on the count to `1e-12` relative
-//!    (equilibrium + band `LDLᵀ` per step, no eigenvalues);
+//!    QEP; the root is refined to `1e-12` relative by [`refine_root`]
+//!    (Illinois regula falsi on `det K`, safeguarded by the count;
+//!    equilibrium + band `LDLᵀ` per step, no eigenvalues), shared with
+//!    the converged search of [`super::qs_converged`];
 //! 3. **confirmation** — the QEP is solved at `p*(1 ∓ δ)`: stable below,
 //!    and above either unstable or with a real eigenvalue above zero
 //!    (just past the root it grows more slowly than the roundoff
