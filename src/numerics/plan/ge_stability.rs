@@ -451,9 +451,18 @@ fn build(
         .0
     };
     let never = || false;
+    // In wind the levels' divergence roots do not converge (issue 21:
+    // several blown-down equilibria, `wind_keeps_the_safe_side` in
+    // tests/verification_ge_converged.rs) and a search ran to 1280
+    // elements per row (minutes per plan): three levels there, the safe
+    // side below each.
     let conv = options.converge.map(|c| ConvergenceConfig {
         base_elements: options.elements,
-        max_elements: c.max_elements.max(4 * options.elements),
+        max_elements: if gm.air.is_calm() {
+            c.max_elements.max(4 * options.elements)
+        } else {
+            4 * options.elements
+        },
         qep_in_wind: false,
         ..c
     });

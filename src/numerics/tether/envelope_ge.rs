@@ -311,6 +311,16 @@ pub fn wind_limits(
         spec.critical_rate_length_m,
     );
     if let Some(cfg) = &spec.converge {
+        // In wind the levels do not converge (issue 21, see
+        // `ge_stability`'s plan table): three levels, the safe side below each.
+        let cfg = &if sys.air.is_calm() {
+            *cfg
+        } else {
+            ConvergenceConfig {
+                max_elements: 4 * cfg.base_elements,
+                ..*cfg
+            }
+        };
         let cl = converged_critical_length(
             &sys.model,
             sys.net_buoyancy_n,
