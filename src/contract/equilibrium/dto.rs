@@ -212,3 +212,13 @@ pub struct EquilibriumResponse {
     pub aerostat: ResolvedAerostatOutput,
     pub numerics: EquilibriumNumerics,
 }
+
+/// The mean state's fields read as the answer's own (`answer.winch_tension_n`),
+/// as they are in its JSON.
+impl std::ops::Deref for EquilibriumResponse {
+    type Target = EquilibriumStateOutput;
+
+    fn deref(&self) -> &EquilibriumStateOutput {
+        &self.state
+    }
+}
