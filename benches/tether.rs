@@ -58,6 +58,7 @@ fn benches(c: &mut Criterion) {
         limits: Limits {
             required_safety_factor: 5.0,
             ceiling_m: None,
+            min_altitude_m: None,
             payout_rate_m_s: None,
         },
     };

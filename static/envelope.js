@@ -81,6 +81,7 @@
     stability: "stability limit",
     slack: "slack tether",
     ceiling: "above ceiling",
+    min_altitude: "below the floor",
     not_converged: "not converged",
   };
 
@@ -448,7 +449,10 @@
     out.textContent =
       `U = ${fmt(p.wind_speed_m_s)} m/s, L = ${fmt(p.tether_length_m, 4)} m: altitude ${fmt(p.aerostat_altitude_m, 4)} m, ` +
       `downwind ${fmt(p.aerostat_downwind_m, 4)} m, winch ${fmt(p.winch_tension_n, 4)} N, top ${fmt(p.top_tension_n, 4)} N, ` +
-      `safety factor ${fmt(p.safety_factor_nondim)} — ${p.feasible ? "feasible" : REGION_NAMES[p.binding_limit] || p.binding_limit}`;
+      `safety factor ${fmt(p.safety_factor_nondim)}` +
+      (p.gust ? `; in the gust (${fmt(p.gust.wind_speed_m_s)} m/s): altitude ${fmt(p.gust.aerostat_altitude_m, 4)} m, winch ${fmt(p.gust.winch_tension_n, 4)} N, ` +
+        `safety factor ${fmt(p.gust.safety_factor_nondim)}` : "") +
+      ` — ${p.feasible ? "feasible" : `${REGION_NAMES[p.binding_limit] || p.binding_limit}${p.gust?.binds ? " in the gust" : ""}`}`;
   }
 
   // ---------- tables ----------
@@ -604,6 +608,8 @@
 
   const CSV_COLUMNS = ["wind_speed_m_s", "tether_length_m", "aerostat_altitude_m", "aerostat_downwind_m", "blowdown_angle_deg", "winch_tension_n",
     "top_tension_n", "max_tension_n", "min_tension_n", "safety_factor_nondim", "slack", "stability_margin_n", "stable", "feasible", "binding_limit"];
+  const GUST_COLUMNS = ["wind_speed_m_s", "aerostat_altitude_m", "aerostat_downwind_m", "blowdown_angle_deg", "winch_tension_n", "max_tension_n",
+    "safety_factor_nondim", "binding_limit", "binds"];
 
   // The inputs as sent (`# input`), the resolved tether and aerostat the server
   // used (`# resolved`, preset values filled in), then one row per grid point.
@@ -619,8 +625,10 @@
     for (const r of res.max_altitude_per_wind) {
       lines.push(`# max_altitude_per_wind wind_speed_m_s=${sig(r.wind_speed_m_s)} max_altitude_m=${sig(r.max_altitude_m) || "none"} tether_length_m=${sig(r.tether_length_m) || "none"}`);
     }
-    lines.push(CSV_COLUMNS.join(","));
-    for (const p of res.points) lines.push(CSV_COLUMNS.map((c) => sig(p[c])).join(","));
+    // With gusts (SPEC §10) each row carries the cell's gust figures too.
+    const gust = res.points.some((p) => p.gust) ? GUST_COLUMNS : [];
+    lines.push([...CSV_COLUMNS, ...gust.map((c) => `gust_${c}`)].join(","));
+    for (const p of res.points) lines.push([...CSV_COLUMNS.map((c) => sig(p[c])), ...gust.map((c) => sig(p.gust?.[c]))].join(","));
     return lines.join("\n") + "\n";
   }
 

@@ -4,7 +4,9 @@
 // /api/v1/plan in today's wind, and shows the verdict card (#verdict,
 // data-state go | no-go | stale | pending | error; aria-live), the tether
 // length the altitude needs, the blow-down angle, the peak tension and the
-// safety factor, the haul-down deadline, the operator's table and the plots.
+// safety factor (with gusts the gust's beside each, and the altitude in the
+// gust), the haul-down deadline (the wind's or the gust's limit, whichever
+// is passed first), the operator's table and the plots.
 // Any input event clears the verdict to "inputs changed: plan again" and
 // disables Print and the downloads until a plan is current again.
 "use strict";
@@ -88,16 +90,17 @@
 
   // ---------- the request ----------
 
-  // "0:5, 60:14" (minutes from now : m/s) → [{time_s, wind_speed_m_s}, …].
+  // "0:5, 60:14:20" (minutes from now : m/s [: gust m/s]) → [{time_s, wind_speed_m_s, gust_m_s?}, …].
   function parseForecast(text, errors) {
     const out = [];
     text.split(",").map((s) => s.trim()).filter(Boolean).forEach((pair, i) => {
-      const [t, u] = pair.split(":").map((x) => Number(x.trim()));
-      if (!Number.isFinite(t) || !Number.isFinite(u) || pair.split(":").length !== 2) {
-        errors.push({ field: `haul_down.forecast[${i}]`, message: `write minutes:m/s, like 60:9 (not “${pair}”)` });
+      const parts = pair.split(":").map((x) => Number(x.trim()));
+      const [t, u, g] = parts;
+      if (!(parts.length === 2 || parts.length === 3) || !parts.every(Number.isFinite)) {
+        errors.push({ field: `haul_down.forecast[${i}]`, message: `write minutes:m/s or minutes:m/s:gust, like 60:9 or 60:9:14 (not “${pair}”)` });
         return;
       }
-      out.push({ time_s: 60 * t, wind_speed_m_s: u });
+      out.push(parts.length === 3 ? { time_s: 60 * t, wind_speed_m_s: u, gust_m_s: g } : { time_s: 60 * t, wind_speed_m_s: u });
     });
     return out;
   }
@@ -105,13 +108,16 @@
   function readRequest(errors) {
     const body = S.readSystem(errors, "plan");
     body.target_elevation_m = S.readNumber(roots, "target_elevation_m", errors);
+    const floor = S.readNumber(roots, "min_altitude_m", errors, { optional: true, fallback: undefined });
+    if (floor != null) body.min_altitude_m = floor;
     body.samples = 61;
     const forecast = form.elements["haul_down.forecast"].value.trim();
     if (forecast) {
-      body.haul_down = {
+      body.haul_down = S.compact({
         forecast: parseForecast(forecast, errors),
         max_operating_wind_m_s: S.readNumber(roots, "haul_down.max_operating_wind_m_s", errors),
-      };
+        max_gust_m_s: S.readNumber(roots, "haul_down.max_gust_m_s", errors, { optional: true, fallback: undefined }) ?? undefined,
+      });
     }
     return body;
   }
@@ -163,6 +169,10 @@
         return `Not enough lift: ${fmt(H, 0)} m is above the highest altitude the lift holds with its reserve (${fmt(r.limits?.lift_limit_m, 0)} m).`;
       case "tension_limit":
         return "The tether would be overloaded: its tension exceeds the breaking strength divided by the safety factor.";
+      case "gust_tension_limit":
+        return `The gust of ${fmt(w?.gust?.reference_speed_m_s, 1)} m/s would overload the tether: ${fmt(r.limits?.gust_peak_tension_n, 0)} N in the gust, above the breaking strength divided by the safety factor (${fmt(r.limits?.allowable_tension_n, 0)} N).`;
+      case "min_altitude":
+        return `${w?.gust ? `The gust of ${fmt(w.gust.reference_speed_m_s, 1)} m/s blows` : "The wind blows"} the aerostat down to ${fmt(w?.gust?.target_altitude_m ?? req.target_elevation_m, 0)} m, below the lowest altitude allowed (${fmt(req.min_altitude_m, 0)} m).`;
       case "amplification_limit":
         return "Hauling in lets a swing of the tether grow beyond the limit, even at the slowest rate.";
       case "jerk_limit":
@@ -189,7 +199,9 @@
       return;
     }
     const sf = r.limits.min_safety_factor_nondim;
-    el.textContent = `Tension checked: peak ${fmt(r.limits.peak_tension_n, 0)} N, safety factor ${sf == null ? "–" : fmt(sf, 1)} (required ${fmt(req.required_safety_factor_nondim, 1)}).`;
+    const gsf = r.limits.gust_min_safety_factor_nondim;
+    const gust = r.limits.gust_peak_tension_n == null ? "" : `; in the gust peak ${fmt(r.limits.gust_peak_tension_n, 0)} N, safety factor ${gsf == null ? "–" : fmt(gsf, 1)}`;
+    el.textContent = `Tension checked: peak ${fmt(r.limits.peak_tension_n, 0)} N, safety factor ${sf == null ? "–" : fmt(sf, 1)}${gust} (required ${fmt(req.required_safety_factor_nondim, 1)}).`;
   }
 
   function deadlineLine(r, req) {
@@ -203,34 +215,50 @@
     } else if (h.wind_exceeds_limit_at_s == null) {
       el.textContent = `Haul-down deadline: none — the forecast stays below ${fmt(req.haul_down.max_operating_wind_m_s, 1)} m/s.`;
     } else if (h.latest_start_s != null && h.latest_start_s >= 0) {
-      el.textContent = `Haul-down deadline: start hauling down by ${clock(h.latest_start_s)} (in ${duration(h.latest_start_s)}); the wind passes ${fmt(req.haul_down.max_operating_wind_m_s, 1)} m/s at ${clock(h.wind_exceeds_limit_at_s)}.`;
+      const what = h.exceeded_by === "gust" ? `the gust passes ${fmt(req.haul_down.max_gust_m_s, 1)} m/s` : `the wind passes ${fmt(req.haul_down.max_operating_wind_m_s, 1)} m/s`;
+      el.textContent = `Haul-down deadline: start hauling down by ${clock(h.latest_start_s)} (in ${duration(h.latest_start_s)}); ${what} at ${clock(h.wind_exceeds_limit_at_s)}.`;
     } else {
       el.textContent = `Haul-down deadline: already passed — ${h.reason}`;
     }
   }
 
+  // The key figures; with gusts each figure of the mean wind has the gust's
+  // beside it (a `.gust-figure` span), and the altitude in the gust its own row.
   function keyFigures(r, req) {
     const dl = verdict.querySelector(".key-figures");
     const w = r.wind;
-    const sf = r.limits?.min_safety_factor_nondim;
+    const g = w?.gust;
+    const lim = r.limits ?? {};
+    const sf = lim.min_safety_factor_nondim;
+    const deg = (x) => (x == null ? "–" : `${fmt(x, 1)}°`);
     const rows = [
       ["Tether needed", w ? (w.target_length_m == null ? `out of reach (at most ${fmt(w.reachable_altitude_m, 0)} m up)` : `${fmt(w.target_length_m, 1)} m`) : `${fmt(req.target_elevation_m, 1)} m`],
-      ["Blow-down angle", w?.blowdown_angle_deg == null ? "–" : `${fmt(w.blowdown_angle_deg, 1)}°`],
-      ["Downwind of the winch", w?.target_downwind_m == null ? null : `${fmt(w.target_downwind_m, 0)} m`],
-      ["Peak tension", r.limits?.peak_tension_n == null ? "–" : `${fmt(r.limits.peak_tension_n, 0)} N`],
-      ["Safety factor", sf == null ? "not checked" : fmt(sf, 1)],
+      ["Altitude in the gust", g ? (g.target_altitude_m == null ? "–" : `${fmt(g.target_altitude_m, 0)} m`) : null],
+      ["Blow-down angle", w?.blowdown_angle_deg == null ? "–" : deg(w.blowdown_angle_deg), g && deg(g.blowdown_angle_deg)],
+      ["Downwind of the winch", w?.target_downwind_m == null ? null : `${fmt(w.target_downwind_m, 0)} m`, g?.target_downwind_m == null ? null : `${fmt(g.target_downwind_m, 0)} m`],
+      ["Peak tension", lim.peak_tension_n == null ? "–" : `${fmt(lim.peak_tension_n, 0)} N`, g && lim.gust_peak_tension_n != null ? `${fmt(lim.gust_peak_tension_n, 0)} N` : null],
+      ["Safety factor", sf == null ? "not checked" : fmt(sf, 1), g && lim.gust_min_safety_factor_nondim != null ? fmt(lim.gust_min_safety_factor_nondim, 1) : null],
       ["Time at the winch", duration(r.duration_s)],
     ];
-    dl.replaceChildren(...rows.filter(([, v]) => v != null).map(([k, v]) => {
+    dl.replaceChildren(...rows.filter(([, v]) => v != null).map(([k, v, gust]) => {
       const div = document.createElement("div");
       const dt = document.createElement("dt");
       dt.textContent = k;
       const dd = document.createElement("dd");
       dd.textContent = v;
       dd.dataset.figure = k;
+      if (gust != null) {
+        const span = document.createElement("span");
+        span.className = "gust-figure";
+        span.dataset.gust = gust;
+        span.textContent = ` · gust ${gust}`;
+        dd.append(span);
+      }
       div.append(dt, dd);
       return div;
     }));
+    if (g) dl.dataset.gust = `${fmt(g.reference_speed_m_s, 1)} m/s`;
+    else delete dl.dataset.gust;
     dl.hidden = false;
   }
 
@@ -259,6 +287,10 @@
     ], [t, s.map((x) => Math.abs(x.rate_m_s)), col("rate_ceiling_m_s")]);
     const tension = [{ label: "winch (N)", stroke: "#0b5cad", width: 2, value: lv(1) }, { label: "peak, at the aerostat (N)", stroke: "#7a4a00", width: 1.5, value: lv(1) }];
     const tdata = [t, col("winch_tension_n"), col("max_tension_n")];
+    if (s.length && s[0].gust_max_tension_n != null) {
+      tension.push({ label: "peak in the gust (N)", stroke: "#8a2be2", width: 1.5, dash: [2, 3], value: lv(1) });
+      tdata.push(col("gust_max_tension_n"));
+    }
     if (r.limits.allowable_tension_n) {
       tension.push({ label: "allowable (N)", stroke: "#b00020", width: 1.5, dash: [6, 4], value: lv(1) });
       tdata.push(s.map(() => r.limits.allowable_tension_n));
@@ -330,6 +362,7 @@
       ["Minimum-time bound", r.bound ? `${fmt(r.bound.duration_s, 1)} s: ${r.bound.explanation}` : null],
       ["Lift limit with the reserve (calm air)", r.limits ? `${fmt(r.limits.lift_limit_m, 1)} m` : null],
       ["Reachable altitude in this wind", r.wind ? `${fmt(r.wind.reachable_altitude_m, 1)} m` : null],
+      ["Gust", r.wind?.gust ? `${fmt(r.wind.gust.reference_speed_m_s, 1)} m/s at ${fmt(r.wind.gust.reference_height_m, 0)} m (${fmt(r.wind.gust.gust_factor_nondim, 2)} × the mean); reachable altitude in the gust ${fmt(r.wind.gust.reachable_altitude_m, 1)} m` : null],
       ["Stability criterion", r.wind?.stability_criterion ?? null],
       ["Smallest stability margin", r.limits?.min_stability_margin_m_s == null ? null : `${fmt(r.limits.min_stability_margin_m_s, 2)} m/s`],
       ["Allowable tension", r.limits?.allowable_tension_n ? `${fmt(r.limits.allowable_tension_n, 0)} N` : null],

@@ -337,6 +337,15 @@ fn cases() -> Vec<Case> {
     env_log["wind"]["flow"] = json!({"kind": "log_law", "speed_m_s": 0.0, "roughness_length_m": 0.03,
                                      "reference_height_m": 10.0});
     let pl = plan(json!({}));
+    let eq_gust = equilibrium(
+        json!({"wind": {"gust": {"turbulence_intensity_nondim": 0.1, "peak_factor_nondim": 3.0}}}),
+    );
+    let eq_gust_speed = equilibrium(json!({"wind": {"gust": {"gust_m_s": 12.0}}}));
+    let env_floor = envelope(json!({"min_altitude_m": 100.0}));
+    let pl_gust = plan(json!({"min_altitude_m": 100.0, "haul_down": {
+        "forecast": [{"time_s": 0.0, "wind_speed_m_s": 0.0, "gust_m_s": 1.0},
+                     {"time_s": 3600.0, "wind_speed_m_s": 15.0, "gust_m_s": 20.0}],
+        "max_operating_wind_m_s": 12.0, "max_gust_m_s": 18.0}}));
     let bands = bands_request(json!({}));
     let plan_ge = json!({
         "cable": {"mass_per_length_kg_m": 0.078},
@@ -670,6 +679,38 @@ fn cases() -> Vec<Case> {
             0.0,
             200.0,
         )),
+        // gusts (SPEC §10): the system's `wind.gust`, the floor, the forecast's gusts
+        lit(
+            "equilibrium",
+            &eq_gust,
+            "wind.gust.turbulence_intensity_nondim",
+            0.0,
+            1.0,
+        ),
+        lit(
+            "equilibrium",
+            &eq_gust,
+            "wind.gust.peak_factor_nondim",
+            0.0,
+            10.0,
+        ),
+        lit(
+            "equilibrium",
+            &eq_gust_speed,
+            "wind.gust.gust_m_s",
+            0.0,
+            150.0,
+        ),
+        lit("envelope", &env_floor, "min_altitude_m", 0.0, 1e5),
+        lit("plan", &pl_gust, "min_altitude_m", 0.0, 1e6),
+        exclusive(lit("plan", &pl_gust, "haul_down.max_gust_m_s", 0.0, 200.0)),
+        lit(
+            "plan",
+            &pl_gust,
+            "haul_down.forecast[0].gust_m_s",
+            0.0,
+            200.0,
+        ),
         // bands (the system's ranges, the ensemble and the grid)
         case(
             "bands",

@@ -82,6 +82,8 @@ window.tetherplanShared = window.tetherplanShared || {};
     }
     sys.required_safety_factor_nondim = n("required_safety_factor_nondim");
     sys.wind = { air_density_kg_m3: n("wind.air_density_kg_m3"), flow: readFlow(roots, errors) };
+    const gust = readGust(roots, errors);
+    if (gust) sys.wind.gust = gust;
     if (use === "wind") return sys;
     sys.winch = compact({
       max_rate_m_s: n("winch.max_rate_m_s"),
@@ -103,6 +105,17 @@ window.tetherplanShared = window.tetherplanShared || {};
       flow.roughness_length_m = n("wind.flow.roughness_length_m");
     }
     return flow;
+  }
+
+  // The gusts (SPEC §10): a turbulence intensity (with its peak factor) or a
+  // gust speed; both blank: none. Both given go to the API, which says which to drop.
+  function readGust(roots, errors) {
+    const n = (name) => readNumber(roots, name, errors, { optional: true, fallback: undefined });
+    const intensity = n("wind.gust.turbulence_intensity_nondim");
+    const speed = n("wind.gust.gust_m_s");
+    if (intensity == null && speed == null) return null;
+    const peak = intensity == null ? undefined : n("wind.gust.peak_factor_nondim");
+    return compact({ turbulence_intensity_nondim: intensity ?? undefined, peak_factor_nondim: peak ?? undefined, gust_m_s: speed ?? undefined });
   }
 
   // ---------- errors beside their fields, in plain words ----------

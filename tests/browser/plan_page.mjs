@@ -12,7 +12,10 @@
 // the downloads; a negative buoyancy turns it to `error` with the message in
 // plain words beside aerostat.net_buoyancy_n. A shared URL (and one written
 // by hand with the request paths) plans at once with the same verdict. The
-// card's values reach the envelope panel's request. A forecast gives the
+// card's values reach the envelope panel's request. A turbulence intensity
+// (wind.gust.turbulence_intensity_nondim) puts the gust's figures beside the
+// mean's in the key figures, and a rating between the mean's and the gust's
+// tension turns the verdict NO-GO naming the gust. A forecast gives the
 // haul-down deadline on its own line (none by default). Print: the verdict,
 // date and time, version, inputs with units, legends. The verdict's box is
 // inside the first screen at 1440×900, 390×844 and in print; the phone's
@@ -154,6 +157,30 @@ try {
   check(rated.state === "go" && /Tension checked/.test(rated.tension) && sf > 5 && rated.figures["Safety factor"] === sf.toFixed(1),
     `with 20 kN: tension checked, safety factor ${sf?.toFixed(2)} (${rated.tension})`);
   check(Math.abs(sf - 20000 / rated.plan.limits.peak_tension_n) < 1e-9 * sf, "safety factor = breaking strength / peak tension");
+
+  phase = "gust";
+  await page.fill(field("wind.gust.turbulence_intensity_nondim"), "0.15");
+  await page.click("#plan-button");
+  const gusty = await verdictOf(page);
+  const gw = gusty.plan?.wind?.gust;
+  check(gusty.request?.wind?.gust?.turbulence_intensity_nondim === 0.15, `the request carries wind.gust (${JSON.stringify(gusty.request?.wind?.gust)})`);
+  check(gusty.state === "go" && gw && Math.abs(gw.reference_speed_m_s - 6 * 1.45) < 1e-9, `a 15 % turbulence: GO, the gust at 6 × 1.45 m/s (${gw?.reference_speed_m_s})`);
+  const gustFigures = await page.evaluate(() => Object.fromEntries([...document.querySelectorAll("#verdict .key-figures .gust-figure")].map((s) => [s.closest("dd").dataset.figure, s.dataset.gust])));
+  check(gustFigures["Peak tension"] === `${gusty.plan.limits.gust_peak_tension_n.toFixed(0)} N` && gustFigures["Blow-down angle"] === `${gw.blowdown_angle_deg.toFixed(1)}°` &&
+    gustFigures["Safety factor"] === gusty.plan.limits.gust_min_safety_factor_nondim.toFixed(1),
+    `the gust's figures beside the mean's: ${JSON.stringify(gustFigures)}`);
+  check(gusty.figures["Altitude in the gust"] === `${gw.target_altitude_m.toFixed(0)} m` && gw.target_altitude_m < 900,
+    `the altitude in the gust is shown (${gusty.figures["Altitude in the gust"]})`);
+  check(gusty.figures["Peak tension"].startsWith(`${gusty.plan.limits.peak_tension_n.toFixed(0)} N`), `the mean's peak tension first (${gusty.figures["Peak tension"]})`);
+  // A rating between the mean's and the gust's tension at rest: NO-GO naming the gust.
+  const between = 5 * 0.5 * (gusty.plan.wind.target_max_tension_n + gw.target_max_tension_n);
+  await page.fill(field("cable.breaking_strength_n"), between.toFixed(0));
+  await page.click("#plan-button");
+  const broken = await verdictOf(page);
+  check(broken.state === "no-go" && broken.word === "NO-GO" && broken.plan?.binding_limit === "gust_tension_limit",
+    `a gust that breaks the tension limit: NO-GO (${broken.state}, ${broken.plan?.binding_limit})`);
+  check(/gust/i.test(broken.why) && !/_/.test(broken.why), `the headline names the gust (“${broken.why}”)`);
+  await page.fill(field("wind.gust.turbulence_intensity_nondim"), "");
   await page.fill(field("cable.breaking_strength_n"), "");
 
   phase = "error";

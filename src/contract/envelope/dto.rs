@@ -51,6 +51,11 @@ pub struct EnvelopeRequest {
     #[serde(default)]
     #[schema(example = 2500.0, exclusive_minimum = 0.0, maximum = 100000.0)]
     pub ceiling_m: Option<f64>,
+    /// Lowest allowed altitude (m): terrain or an airspace floor; with
+    /// `wind.gust` the altitude in the gust must clear it. Absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 150.0, minimum = 0.0, maximum = 100000.0)]
+    pub min_altitude_m: Option<f64>,
     /// Payout rate (m/s) for the stability limit; absent: stability not judged.
     #[serde(default)]
     #[schema(example = 5.0, minimum = 0.0, maximum = 1000.0)]
@@ -97,10 +102,48 @@ pub struct EnvelopePointOutput {
     /// (slack, not converged) or whose GE equilibrium failed (unstable).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_growth_rate_1_s: Option<f64>,
-    /// Inside every limit.
+    /// Inside every limit (in the mean and, with `wind.gust`, in the gust).
     pub feasible: bool,
-    /// The first limit violated: `slack`, `tension`, `ceiling`, `stability`, `not_converged`.
+    /// The first limit violated, in the mean or in the gust: `slack`,
+    /// `tension`, `ceiling`, `min_altitude`, `stability`, `not_converged`.
     pub binding_limit: Option<String>,
+    /// With `wind.gust`: the same cell in the gust.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust: Option<EnvelopeGustPointOutput>,
+}
+
+/// One grid point in the gust: the equilibrium at the gust speed, judged
+/// against the same limits (with the quasi-static GE criterion the
+/// stability is judged in the mean wind only).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct EnvelopeGustPointOutput {
+    /// Gust at the reference height (m/s): the row's wind times the gust factor.
+    pub wind_speed_m_s: f64,
+    pub aerostat_altitude_m: f64,
+    pub aerostat_downwind_m: f64,
+    pub blowdown_angle_deg: f64,
+    pub winch_tension_n: f64,
+    pub top_tension_n: f64,
+    pub max_tension_n: f64,
+    pub min_tension_n: f64,
+    pub safety_factor_nondim: Option<f64>,
+    pub slack: bool,
+    /// With a payout rate (string criterion): `min T − ρA v²` in the gust (N).
+    pub stability_margin_n: Option<f64>,
+    pub stable: Option<bool>,
+    /// The first limit the gust alone violates; null: none.
+    pub binding_limit: Option<String>,
+    /// Whether the cell's binding limit is met in the gust (the mean is inside it, or meets a later one).
+    pub binds: bool,
+}
+
+/// The gust the envelope was judged in.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct EnvelopeGustOutput {
+    /// Gust over mean at every height: each row's gust is its wind times this.
+    pub gust_factor_nondim: f64,
+    /// How a cell is judged with gusts.
+    pub rule: String,
 }
 
 /// The largest operating wind at one length.
@@ -135,7 +178,12 @@ pub struct EnvelopeResponse {
     pub max_altitude_per_wind: Vec<WindLimitOutput>,
     pub required_safety_factor_nondim: f64,
     pub ceiling_m: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_altitude_m: Option<f64>,
     pub payout_rate_m_s: Option<f64>,
+    /// With `wind.gust`: the gust factor and the rule.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust: Option<EnvelopeGustOutput>,
     /// What "stable" means here.
     pub stability_criterion: String,
     pub cable: ResolvedCableOutput,

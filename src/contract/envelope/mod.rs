@@ -14,7 +14,9 @@ use crate::contract::system::grid::GridBounds;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::chart::Parallelism;
 use crate::numerics::params::InvalidInput;
-use crate::numerics::tether::envelope::{EnvelopeProblem, Limits, MAX_ENVELOPE_POINTS, WindShape};
+use crate::numerics::tether::envelope::{
+    EnvelopeProblem, Limit, Limits, MAX_ENVELOPE_POINTS, WindShape,
+};
 use crate::numerics::tether::{EquilibriumConfig, EquilibriumProblem, WindProfile};
 use dto::*;
 
@@ -166,6 +168,10 @@ impl EnvelopeRequest {
         if let Some(c) = self.ceiling_m {
             require_range("ceiling_m", c, 0.0, true, 1e5)?;
         }
+        if let Some(f) = self.min_altitude_m {
+            require_range("min_altitude_m", f, 0.0, false, 1e5)?;
+        }
+        self.gust_factor()?;
         if let Some(v) = self.payout_rate_m_s {
             require_range("payout_rate_m_s", v, 0.0, false, 1000.0)?;
         }
@@ -179,6 +185,7 @@ impl EnvelopeRequest {
                 limits: Limits {
                     required_safety_factor: required,
                     ceiling_m: self.ceiling_m,
+                    min_altitude_m: self.min_altitude_m,
                     payout_rate_m_s: self.payout_rate_m_s,
                 },
             },
@@ -224,6 +231,16 @@ impl EnvelopeRequest {
         Ok((problem, config, spec))
     }
 
+    /// With `wind.gust`: the gust factor `G` on the flow (each row's gust
+    /// is its wind times `G`).
+    pub fn gust_factor(&self) -> Result<Option<f64>, InvalidInput> {
+        if self.wind.gust.is_none() {
+            return Ok(None);
+        }
+        let mean = self.wind.flow.profile("wind.flow")?;
+        Ok(self.wind.gust_wind(&mean)?.map(|g| g.factor))
+    }
+
     /// Whether the quasi-static GE judges stability.
     pub fn uses_ge(&self) -> bool {
         matches!(
@@ -252,7 +269,10 @@ pub(crate) fn envelope_of(
     parallelism: Parallelism,
     progress: &dyn Progress,
 ) -> Result<EnvelopeResponse, RequestError> {
-    let report = |done: usize, total: usize| progress.report(done, total);
+    let gust_factor = req.gust_factor()?;
+    // With gusts the mean and the gust envelopes report half the progress each.
+    let passes = if gust_factor.is_some() { 2 } else { 1 };
+    let report = |done: usize, total: usize| progress.report(done, passes * total);
     let cancelled = || progress.cancelled();
     let (env, ge) = match spec {
         None => match problem.solve(config, parallelism, &report, &cancelled)? {
@@ -273,14 +293,26 @@ pub(crate) fn envelope_of(
             }
         }
     };
-    let name =
-        |l: Option<crate::numerics::tether::envelope::Limit>| l.map(|l| l.name().to_string());
+    let gust_env = match gust_factor {
+        Some(g) => {
+            let gust_problem = gust_problem(problem, g, spec.is_some());
+            let total = problem.wind_speeds_m_s.len();
+            let report = |done: usize, _: usize| progress.report(total + done, 2 * total);
+            match gust_problem.solve(config, parallelism, &report, &cancelled)? {
+                Some(env) => Some(env),
+                None => return Err(RequestError::Cancelled),
+            }
+        }
+        None => None,
+    };
     let points: Vec<EnvelopePointOutput> = env
         .points
         .iter()
         .enumerate()
         .map(|(k, p)| {
             let e = &p.equilibrium;
+            let gust = gust_env.as_ref().map(|g| &g.points[k]);
+            let (limit, in_gust) = worst_limit(p.verdict.limit, gust.and_then(|g| g.verdict.limit));
             EnvelopePointOutput {
                 wind_speed_m_s: p.wind_speed_m_s,
                 tether_length_m: p.tether_length_m,
@@ -295,18 +327,24 @@ pub(crate) fn envelope_of(
                 slack: e.slack,
                 stability_margin_n: p.verdict.stability_margin_n,
                 stable: p.verdict.stable,
-                feasible: p.verdict.limit.is_none(),
-                binding_limit: name(p.verdict.limit),
+                feasible: limit.is_none(),
+                binding_limit: limit.map(|l| l.name().to_string()),
                 max_growth_rate_1_s: ge.as_ref().and_then(|g| g.max_growth_rate_1_s[k]),
+                gust: gust.map(|g| gust_point_output(g, in_gust)),
             }
         })
         .collect();
     let max_wind_per_length =
         length_limits(&problem.wind_speeds_m_s, &problem.tether_lengths_m, &points);
+    let max_altitude = match gust_env {
+        // The cells' verdicts are the worst of mean and gust: from the points.
+        Some(_) => max_altitude_per_row(&points, problem.tether_lengths_m.len()),
+        None => env.max_altitude_per_wind.clone(),
+    };
     let max_altitude_per_wind = problem
         .wind_speeds_m_s
         .iter()
-        .zip(&env.max_altitude_per_wind)
+        .zip(&max_altitude)
         .map(|(&u, best)| WindLimitOutput {
             wind_speed_m_s: u,
             max_altitude_m: best.map(|b| b.0),
@@ -323,7 +361,17 @@ pub(crate) fn envelope_of(
         max_altitude_per_wind,
         required_safety_factor_nondim: req.required_safety_factor_nondim,
         ceiling_m: req.ceiling_m,
+        min_altitude_m: req.min_altitude_m,
         payout_rate_m_s: req.payout_rate_m_s,
+        gust: gust_factor.map(|g| EnvelopeGustOutput {
+            gust_factor_nondim: g,
+            rule: if spec.is_some() {
+                GUST_RULE_GE
+            } else {
+                GUST_RULE
+            }
+            .to_string(),
+        }),
         stability_criterion: if spec.is_some() {
             GE_STABILITY_CRITERION
         } else {
@@ -354,6 +402,83 @@ pub(crate) fn envelope_of(
             )
         }),
     })
+}
+
+/// How a cell is judged with gusts.
+pub const GUST_RULE: &str = "each cell is judged by the worst of the mean wind and the gust (the row's wind times the gust factor, the static equilibrium at that speed, SPEC §10): slack, tension, ceiling, min_altitude and stability in either put it outside; the first limit met in priority order names it (the mean's on a tie)";
+
+/// [`GUST_RULE`] with the quasi-static GE criterion.
+pub const GUST_RULE_GE: &str = "each cell is judged by the worst of the mean wind and the gust (the row's wind times the gust factor, the static equilibrium at that speed, SPEC §10): slack, tension, ceiling and min_altitude in either put it outside; the quasi-static GE stability is judged in the mean wind only";
+
+/// The envelope problem in the gust: each row's wind times `factor`; with
+/// the GE criterion stability is left to the mean (no payout rate).
+fn gust_problem(problem: &EnvelopeProblem, factor: f64, ge: bool) -> EnvelopeProblem {
+    let mut g = problem.clone();
+    g.wind_speeds_m_s = problem.wind_speeds_m_s.iter().map(|u| u * factor).collect();
+    if ge {
+        g.limits.payout_rate_m_s = None;
+    }
+    g
+}
+
+/// Rank of a limit in the order [`crate::numerics::tether::envelope::judge_with`] tests them.
+fn rank(l: Limit) -> u8 {
+    match l {
+        Limit::NotConverged => 0,
+        Limit::Slack => 1,
+        Limit::Tension => 2,
+        Limit::Ceiling => 3,
+        Limit::MinAltitude => 4,
+        Limit::Stability => 5,
+    }
+}
+
+/// The worst of the mean's and the gust's limits (the mean's on a tie),
+/// and whether it is the gust's.
+fn worst_limit(mean: Option<Limit>, gust: Option<Limit>) -> (Option<Limit>, bool) {
+    match (mean, gust) {
+        (Some(m), Some(g)) if rank(g) < rank(m) => (Some(g), true),
+        (Some(m), _) => (Some(m), false),
+        (None, Some(g)) => (Some(g), true),
+        (None, None) => (None, false),
+    }
+}
+
+fn gust_point_output(
+    p: &crate::numerics::tether::envelope::EnvelopePoint,
+    binds: bool,
+) -> EnvelopeGustPointOutput {
+    let e = &p.equilibrium;
+    EnvelopeGustPointOutput {
+        wind_speed_m_s: p.wind_speed_m_s,
+        aerostat_altitude_m: e.altitude_m,
+        aerostat_downwind_m: e.downwind_m,
+        blowdown_angle_deg: e.blowdown_angle_deg,
+        winch_tension_n: e.winch_tension_n,
+        top_tension_n: e.top_tension_n,
+        max_tension_n: e.max_tension_n,
+        min_tension_n: e.min_tension_n,
+        safety_factor_nondim: e.safety_factor,
+        slack: e.slack,
+        stability_margin_n: p.verdict.stability_margin_n,
+        stable: p.verdict.stable,
+        binding_limit: p.verdict.limit.map(|l| l.name().to_string()),
+        binds,
+    }
+}
+
+/// Per row (wind), the highest mean altitude of a feasible cell and its
+/// length (the rule of [`crate::numerics::tether::envelope::summarise`]).
+fn max_altitude_per_row(points: &[EnvelopePointOutput], lengths: usize) -> Vec<Option<(f64, f64)>> {
+    points
+        .chunks(lengths.max(1))
+        .map(|row| {
+            row.iter()
+                .filter(|p| p.feasible)
+                .map(|p| (p.aerostat_altitude_m, p.tether_length_m))
+                .max_by(|a, b| a.0.total_cmp(&b.0))
+        })
+        .collect()
 }
 
 /// The largest operating wind per length from the points (row by row, one

@@ -129,8 +129,9 @@ pub struct EquilibriumNumerics {
     pub converged: bool,
 }
 
+/// The state of the tether in one steady wind (the mean, or the gust).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
-pub struct EquilibriumResponse {
+pub struct EquilibriumStateOutput {
     /// Height of the aerostat above the winch (m).
     pub aerostat_altitude_m: f64,
     /// Downwind distance of the aerostat from the winch (m).
@@ -145,9 +146,6 @@ pub struct EquilibriumResponse {
     pub min_tension_n: f64,
     /// Breaking strength / largest tension; null without a breaking strength.
     pub safety_factor_nondim: Option<f64>,
-    pub required_safety_factor_nondim: f64,
-    /// Breaking strength / required factor (N); null without a breaking strength.
-    pub allowable_tension_n: Option<f64>,
     /// Whether the safety factor meets the required one; null without a breaking strength.
     pub meets_required_safety_factor: Option<bool>,
     /// Angle of the winch–aerostat line from the vertical (deg).
@@ -181,7 +179,46 @@ pub struct EquilibriumResponse {
     pub explanation: String,
     /// The shape from the winch up.
     pub shape: Vec<ShapePointOutput>,
+}
+
+/// The tether in the gust (SPEC §10): the static equilibrium at the gust
+/// speed, exactly the mean-wind answer for a mean wind of that speed.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct EquilibriumGustOutput {
+    /// Gust speed over the mean at every height, `1 + k I` or `gust_m_s / U(z_ref)`.
+    pub gust_factor_nondim: f64,
+    /// Height the gust speed refers to (m).
+    pub reference_height_m: f64,
+    /// Gust speed at the reference height (m/s).
+    pub reference_speed_m_s: f64,
+    #[serde(flatten)]
+    pub state: EquilibriumStateOutput,
+    pub numerics: EquilibriumNumerics,
+}
+
+/// The mean-wind state (its fields at the top level), the gust state
+/// beside it (with `wind.gust`), and the inputs as resolved.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct EquilibriumResponse {
+    #[serde(flatten)]
+    pub state: EquilibriumStateOutput,
+    pub required_safety_factor_nondim: f64,
+    /// Breaking strength / required factor (N); null without a breaking strength.
+    pub allowable_tension_n: Option<f64>,
+    /// With `wind.gust`: the same figures in the gust; absent without gusts.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust: Option<EquilibriumGustOutput>,
     pub cable: ResolvedCableOutput,
     pub aerostat: ResolvedAerostatOutput,
     pub numerics: EquilibriumNumerics,
+}
+
+/// The mean state's fields read as the answer's own (`answer.winch_tension_n`),
+/// as they are in its JSON.
+impl std::ops::Deref for EquilibriumResponse {
+    type Target = EquilibriumStateOutput;
+
+    fn deref(&self) -> &EquilibriumStateOutput {
+        &self.state
+    }
 }

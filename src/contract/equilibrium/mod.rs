@@ -47,6 +47,7 @@ impl EquilibriumRequest {
             self.initial_length_m,
             self.lift_reserve_nondim,
         )?;
+        self.wind.gust_wind(&problem.wind)?;
         Ok((
             problem,
             EquilibriumConfig {
@@ -121,20 +122,22 @@ pub(crate) fn explain(eq: &Equilibrium, limit: Option<&str>) -> String {
     s
 }
 
-/// Answers one equilibrium request.
-pub fn equilibrium(req: &EquilibriumRequest) -> Result<EquilibriumResponse, RequestError> {
-    let (problem, config) = req.problem()?;
-    let eq = problem.solve(&config)?;
+/// The state of one equilibrium judged against the limits.
+fn state_output(
+    eq: &Equilibrium,
+    problem: &EquilibriumProblem,
+    req: &EquilibriumRequest,
+) -> EquilibriumStateOutput {
     let limits = Limits {
         required_safety_factor: req.required_safety_factor_nondim,
         ceiling_m: None,
+        min_altitude_m: None,
         payout_rate_m_s: req.payout_rate_m_s,
     };
-    let verdict = judge(&eq, problem.cable.mass_per_length_kg_m, &limits);
+    let verdict = judge(eq, problem.cable.mass_per_length_kg_m, &limits);
     let limit = verdict.limit.map(|l| l.name().to_string());
     let (drag, vertical) = eq.top_force_n;
-    let strength = problem.cable.breaking_strength_n;
-    Ok(EquilibriumResponse {
+    EquilibriumStateOutput {
         aerostat_altitude_m: eq.altitude_m,
         aerostat_downwind_m: eq.downwind_m,
         winch_tension_n: eq.winch_tension_n,
@@ -142,8 +145,6 @@ pub fn equilibrium(req: &EquilibriumRequest) -> Result<EquilibriumResponse, Requ
         max_tension_n: eq.max_tension_n,
         min_tension_n: eq.min_tension_n,
         safety_factor_nondim: eq.safety_factor,
-        required_safety_factor_nondim: req.required_safety_factor_nondim,
-        allowable_tension_n: strength.map(|b| b / req.required_safety_factor_nondim),
         meets_required_safety_factor: eq
             .safety_factor
             .map(|f| f >= req.required_safety_factor_nondim),
@@ -160,9 +161,51 @@ pub fn equilibrium(req: &EquilibriumRequest) -> Result<EquilibriumResponse, Requ
         stretched_length_m: eq.stretched_length_m,
         stability_margin_n: verdict.stability_margin_n,
         stable: verdict.stable,
-        explanation: explain(&eq, limit.as_deref()),
+        explanation: explain(eq, limit.as_deref()),
         binding_limit: limit,
-        shape: sample_shape(&eq, req.shape_samples),
+        shape: sample_shape(eq, req.shape_samples),
+    }
+}
+
+fn numerics_output(eq: &Equilibrium, config: &EquilibriumConfig) -> EquilibriumNumerics {
+    EquilibriumNumerics {
+        integration_steps: config.steps,
+        order_nondim: 4,
+        shooting_iterations: eq.iterations,
+        residual_m: eq.residual_m,
+        converged: eq.converged,
+    }
+}
+
+/// Answers one equilibrium request: the mean wind, and with `wind.gust`
+/// the same problem at the gust speed beside it.
+pub fn equilibrium(req: &EquilibriumRequest) -> Result<EquilibriumResponse, RequestError> {
+    let (problem, config) = req.problem()?;
+    let gust = req.wind.gust_wind(&problem.wind)?;
+    let eq = problem.solve(&config)?;
+    let gust = match gust {
+        Some(g) => {
+            let gp = EquilibriumProblem {
+                wind: g.profile.clone(),
+                ..problem.clone()
+            };
+            let ge = gp.solve(&config)?;
+            Some(EquilibriumGustOutput {
+                gust_factor_nondim: g.factor,
+                reference_height_m: g.reference_height_m,
+                reference_speed_m_s: g.reference_speed_m_s,
+                state: state_output(&ge, &gp, req),
+                numerics: numerics_output(&ge, &config),
+            })
+        }
+        None => None,
+    };
+    let strength = problem.cable.breaking_strength_n;
+    Ok(EquilibriumResponse {
+        state: state_output(&eq, &problem, req),
+        required_safety_factor_nondim: req.required_safety_factor_nondim,
+        allowable_tension_n: strength.map(|b| b / req.required_safety_factor_nondim),
+        gust,
         cable: ResolvedCableOutput {
             mass_per_length_kg_m: problem.cable.mass_per_length_kg_m,
             diameter_m: problem.cable.diameter_m,
@@ -176,12 +219,6 @@ pub fn equilibrium(req: &EquilibriumRequest) -> Result<EquilibriumResponse, Requ
             lift_coefficient_nondim: problem.body.lift_coefficient,
             reference_area_m2: problem.body.reference_area_m2,
         },
-        numerics: EquilibriumNumerics {
-            integration_steps: config.steps,
-            order_nondim: 4,
-            shooting_iterations: eq.iterations,
-            residual_m: eq.residual_m,
-            converged: eq.converged,
-        },
+        numerics: numerics_output(&eq, &config),
     })
 }

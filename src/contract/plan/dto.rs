@@ -19,6 +19,11 @@ pub struct WindForecastPointInput {
     /// Forecast wind speed (m/s).
     #[schema(example = 8.0, minimum = 0.0, maximum = 200.0)]
     pub wind_speed_m_s: f64,
+    /// Forecast gust (m/s), at least the wind speed; absent: the wind speed
+    /// times `wind.gust`'s factor when the plan has one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 12.0, minimum = 0.0, maximum = 200.0)]
+    pub gust_m_s: Option<f64>,
 }
 
 /// Haul-down deadline: when must the retrieval start so the aerostat is
@@ -31,6 +36,13 @@ pub struct HaulDownInput {
     /// Largest wind in which the aerostat may stay aloft (m/s).
     #[schema(example = 12.0, exclusive_minimum = 0.0, maximum = 200.0)]
     pub max_operating_wind_m_s: f64,
+    /// Largest gust in which the aerostat may stay aloft (m/s); the
+    /// deadline is then the first forecast time at which the wind passes
+    /// `max_operating_wind_m_s` or the gust passes this. Needs the forecast's
+    /// gusts (`gust_m_s` on its points, or `wind.gust`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 18.0, exclusive_minimum = 0.0, maximum = 200.0)]
+    pub max_gust_m_s: Option<f64>,
 }
 
 /// How the plan judges stability.
@@ -157,6 +169,13 @@ pub struct PlanRequest {
     /// `cable.diameter_m` and the aerostat's drag data.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wind: Option<WindInput>,
+    /// Lowest altitude (m) the aerostat may be blown down to where the plan
+    /// leaves it (its end): terrain or an airspace floor; with `wind.gust`
+    /// the altitude in the gust must clear it. Leave it out for a haul-down
+    /// to the ground. Absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 150.0, minimum = 0.0, maximum = 1e6)]
+    pub min_altitude_m: Option<f64>,
     /// Stability criterion; absent: the string criterion.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stability: Option<PlanStabilityInput>,
@@ -206,6 +225,15 @@ pub struct PlanSampleOutput {
     /// Effective tension at the roller with the reserve (N):
     /// (1−r)F − mL̈ − ρA(g + L̈)L − ρA L̇² ≥ 0 is stable.
     pub effective_tension_margin_n: f64,
+    /// With `wind.gust`: the altitude in the gust (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust_altitude_m: Option<f64>,
+    /// With `wind.gust`: the winch tension in the gust, with the acceleration (N).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust_winch_tension_n: Option<f64>,
+    /// With `wind.gust`: the largest tension in the gust, with the acceleration (N).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust_max_tension_n: Option<f64>,
 }
 
 /// A stretch of the schedule under one limit: a line of the operator's table.
@@ -314,6 +342,11 @@ pub struct HaulDownOutput {
     pub latest_start_s: Option<f64>,
     pub go: bool,
     pub reason: String,
+    /// Which series passed its limit first: `mean` (the wind) or `gust`; null: neither.
+    pub exceeded_by: Option<String>,
+    /// With `max_gust_m_s`: the first time the forecast gust exceeds it (s); null: never.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust_exceeds_limit_at_s: Option<f64>,
 }
 
 /// Limits and margins of the plan.
@@ -335,6 +368,15 @@ pub struct PlanLimitsOutput {
     pub peak_tension_n: Option<f64>,
     /// Breaking strength / peak tension; null without a breaking strength.
     pub min_safety_factor_nondim: Option<f64>,
+    /// With `wind.gust`: the largest tension in the gust over the schedule (N).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust_peak_tension_n: Option<f64>,
+    /// With `wind.gust` and a breaking strength: breaking strength / gust peak tension.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust_min_safety_factor_nondim: Option<f64>,
+    /// The floor asked for (m), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_altitude_m: Option<f64>,
 }
 
 /// The plan in wind.
@@ -352,6 +394,39 @@ pub struct PlanWindOutput {
     pub reachable_altitude_m: f64,
     /// The stability criterion applied to the equilibrium.
     pub stability_criterion: String,
+    /// Winch tension at the target at rest, full buoyancy (N); null when unreachable.
+    pub target_winch_tension_n: Option<f64>,
+    /// Largest tension at the target at rest (N); null when unreachable.
+    pub target_max_tension_n: Option<f64>,
+    /// With `wind.gust`: the same figures in the gust, beside these.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust: Option<PlanGustOutput>,
+}
+
+/// The plan's figures in the gust (SPEC §10): the static equilibrium at the
+/// gust speed at the same tether lengths.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct PlanGustOutput {
+    /// Gust over mean at every height.
+    pub gust_factor_nondim: f64,
+    /// Height the gust speed refers to (m).
+    pub reference_height_m: f64,
+    /// Gust speed there (m/s).
+    pub reference_speed_m_s: f64,
+    /// Altitude of the aerostat at the target length in the gust (m): the lowest it is blown down to.
+    pub target_altitude_m: Option<f64>,
+    /// Its downwind distance (m).
+    pub target_downwind_m: Option<f64>,
+    /// Angle of the winch–aerostat line from the vertical in the gust (deg).
+    pub blowdown_angle_deg: Option<f64>,
+    /// Winch tension at the target at rest in the gust (N).
+    pub target_winch_tension_n: Option<f64>,
+    /// Largest tension at the target at rest in the gust (N).
+    pub target_max_tension_n: Option<f64>,
+    /// Breaking strength / that tension; null without a breaking strength.
+    pub target_safety_factor_nondim: Option<f64>,
+    /// Altitude in the gust at the lift limit (m).
+    pub reachable_altitude_m: f64,
 }
 
 /// The jerk limit.
@@ -440,7 +515,8 @@ pub struct PlanResponse {
     pub direction: String,
     /// Plan duration (s); null when infeasible.
     pub duration_s: Option<f64>,
-    /// When infeasible: `static_lift_limit`, `tension_limit`, `amplification_limit`, `jerk_limit`,
+    /// When infeasible: `static_lift_limit`, `tension_limit`, `gust_tension_limit` (the tension in the
+    /// gust), `min_altitude` (below the floor where the plan ends), `amplification_limit`, `jerk_limit`,
     /// `wind_blowdown` (the wind blows the aerostat below the target altitude), `quasi_static_ge_limit`
     /// or `quasi_static_ge_check`.
     pub binding_limit: Option<String>,

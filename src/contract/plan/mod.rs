@@ -1,10 +1,13 @@
 //! The deployment plan (SPEC §7): the JSON contract of `POST /api/v1/plan`
-//! and `tetherplan plan` ([`dto`]) and its run ([`run`]) over
+//! and `tetherplan plan` ([`dto`]), its validation (`validate`), its run
+//! in named steps ([`run`]) and the answer's pieces (`output`) over
 //! [`crate::numerics::plan`].
 
 pub mod dto;
 pub mod ge;
+mod output;
 pub mod run;
+mod validate;
 
 pub use dto::{PlanRequest, PlanResponse};
 pub use run::{plan, validate_plan};

@@ -216,7 +216,32 @@ pub(crate) fn default_reference_height() -> f64 {
     10.0
 }
 
-/// The air: its density and its steady flow. Absent: calm air.
+/// Gusts (SPEC §10): the gust speed at a height is the mean times
+/// `1 + k I` (`turbulence_intensity_nondim` I = σ_u/U, `peak_factor_nondim`
+/// k, default 3: about the 3-second gust over 10 minutes), or the gust
+/// speed `gust_m_s` at the flow's reference height (a log or power law's
+/// own, else 10 m, the anemometer height), which scales the whole profile.
+/// Give one of `turbulence_intensity_nondim` and `gust_m_s`. The gust
+/// enters the equilibrium exactly as a faster mean wind would; with I = 0
+/// every answer equals the mean-wind one.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, ToSchema, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct GustInput {
+    /// Turbulence intensity I = σ_u / U (0 to 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 0.15, minimum = 0.0, maximum = 1.0)]
+    pub turbulence_intensity_nondim: Option<f64>,
+    /// Peak factor k of the gust factor 1 + k I (default 3), with `turbulence_intensity_nondim`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 3.0, minimum = 0.0, maximum = 10.0)]
+    pub peak_factor_nondim: Option<f64>,
+    /// Gust speed at the flow's reference height (m/s), at least the mean there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 12.0, minimum = 0.0, maximum = 150.0)]
+    pub gust_m_s: Option<f64>,
+}
+
+/// The air: its density, its steady flow and its gusts. Absent: calm air.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WindInput {
@@ -225,9 +250,23 @@ pub struct WindInput {
     #[serde(default = "default_air_density")]
     #[schema(example = 1.225, exclusive_minimum = 0.0, maximum = 5.0)]
     pub air_density_kg_m3: f64,
+    /// Gusts on the mean flow (SPEC §10); absent: the mean wind only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust: Option<GustInput>,
 }
 
 impl WindInput {
+    /// Whether the air is calm everywhere, gusts included (a gust factor
+    /// on a calm flow is calm; a gust speed above zero is not).
+    pub fn is_calm(&self) -> bool {
+        self.flow.is_calm()
+            && self
+                .gust
+                .as_ref()
+                .and_then(|g| g.gust_m_s)
+                .is_none_or(|g| g == 0.0)
+    }
+
     /// Refuses a non-zero wind in an analysis computed in calm air.
     pub fn require_calm(
         wind: Option<&Self>,
@@ -241,6 +280,20 @@ impl WindInput {
                      (the plan, the equilibrium and the envelope take the wind)"
                 ),
             )),
+            Some(w)
+                if w.gust
+                    .as_ref()
+                    .and_then(|g| g.gust_m_s)
+                    .is_some_and(|g| g != 0.0) =>
+            {
+                Err(crate::numerics::params::InvalidInput::new(
+                    "wind.gust.gust_m_s",
+                    format!(
+                        "this analysis ({analysis}) is in calm air; give no gust speed \
+                         (the plan, the equilibrium and the envelope take the gusts)"
+                    ),
+                ))
+            }
             _ => Ok(()),
         }
     }

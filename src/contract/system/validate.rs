@@ -7,6 +7,10 @@ use super::*;
 use crate::numerics::aero::SteadyFlow;
 use crate::numerics::params::ranges::{AEROSTAT_MASS_KG, MASS_PER_LENGTH_KG_M, NET_BUOYANCY_N};
 use crate::numerics::params::{InvalidInput, compact, require_finite};
+use crate::numerics::tether::gust::{
+    DEFAULT_PEAK_FACTOR, DEFAULT_REFERENCE_HEIGHT_M, Gust, MAX_PEAK_FACTOR,
+    MAX_TURBULENCE_INTENSITY, gust_factor_at, gust_profile_at,
+};
 use crate::numerics::tether::presets::{BodyPreset, CYLINDER_NORMAL_DRAG, CablePreset};
 use crate::numerics::tether::{Body, Cable, WindProfile};
 
@@ -501,11 +505,120 @@ impl WindInput {
         )
     }
 
-    /// Checks the flow and the density (calm-air analyses: only that they are valid).
+    /// Checks the flow, the density and the gust (calm-air analyses: only
+    /// that they are valid).
     pub fn check(&self) -> Result<(), InvalidInput> {
-        self.flow.profile("wind.flow")?;
+        let mean = self.flow.profile("wind.flow")?;
         self.air_density()?;
+        self.gust_wind(&mean)?;
         Ok(())
+    }
+
+    /// The gust on the mean profile `mean` of this flow; `None` without `wind.gust`.
+    pub fn gust_wind(&self, mean: &WindProfile) -> Result<Option<GustWind>, InvalidInput> {
+        let Some(g) = &self.gust else {
+            return Ok(None);
+        };
+        let gust = g.gust()?;
+        let z_ref = self.flow.reference_height_m();
+        let mean_ref = mean.speed_m_s(z_ref).abs();
+        if let Gust::AtReference { gust_m_s } = gust
+            && gust_m_s < mean_ref
+        {
+            return Err(InvalidInput::new(
+                "wind.gust.gust_m_s",
+                format!(
+                    "must be at least the mean wind at the reference height {} m, {} m/s, got {}",
+                    compact(z_ref),
+                    compact(mean_ref),
+                    compact(gust_m_s)
+                ),
+            ));
+        }
+        let profile = gust_profile_at(&gust, mean, z_ref, "wind.gust")?;
+        let factor = gust_factor_at(&gust, mean, z_ref, "wind.gust")?;
+        Ok(Some(GustWind {
+            factor,
+            reference_height_m: z_ref,
+            reference_speed_m_s: profile.speed_m_s(z_ref),
+            profile,
+        }))
+    }
+}
+
+/// A gust resolved on a mean flow.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GustWind {
+    /// `G`: the gust speed over the mean at every height.
+    pub factor: f64,
+    /// Where a gust speed is read (m).
+    pub reference_height_m: f64,
+    /// The gust speed there (m/s).
+    pub reference_speed_m_s: f64,
+    /// The gust profile (the mean's speeds times `G`; with I = 0 the mean bit for bit).
+    pub profile: WindProfile,
+}
+
+impl GustInput {
+    /// The gust, its fields range-checked (each error names its field).
+    pub fn gust(&self) -> Result<Gust, InvalidInput> {
+        let f = |n: &str| format!("wind.gust.{n}");
+        match (self.turbulence_intensity_nondim, self.gust_m_s) {
+            (Some(i), None) => Ok(Gust::Intensity {
+                turbulence_intensity: require_range(
+                    &f("turbulence_intensity_nondim"),
+                    i,
+                    0.0,
+                    false,
+                    MAX_TURBULENCE_INTENSITY,
+                )?,
+                peak_factor: require_range(
+                    &f("peak_factor_nondim"),
+                    self.peak_factor_nondim.unwrap_or(DEFAULT_PEAK_FACTOR),
+                    0.0,
+                    false,
+                    MAX_PEAK_FACTOR,
+                )?,
+            }),
+            (None, Some(g)) => {
+                if self.peak_factor_nondim.is_some() {
+                    return Err(InvalidInput::new(
+                        f("peak_factor_nondim"),
+                        "goes with turbulence_intensity_nondim, not with a gust speed: leave it out",
+                    ));
+                }
+                Ok(Gust::AtReference {
+                    gust_m_s: require_range(&f("gust_m_s"), g, 0.0, false, MAX_GUST_M_S)?,
+                })
+            }
+            (Some(_), Some(_)) => Err(InvalidInput::new(
+                f("gust_m_s"),
+                "give either the turbulence intensity or the gust speed, not both",
+            )),
+            (None, None) => Err(InvalidInput::new(
+                f("turbulence_intensity_nondim"),
+                "give the turbulence intensity (σ_u/U, e.g. 0.15) or the gust speed gust_m_s at the reference height",
+            )),
+        }
+    }
+}
+
+/// Largest gust speed accepted at the reference height (m/s): the flow's bound.
+pub const MAX_GUST_M_S: f64 = 150.0;
+
+impl WindFlowInput {
+    /// The height a gust speed refers to (m): a log or power law's own
+    /// reference height, else the anemometer height of weather reports.
+    pub fn reference_height_m(&self) -> f64 {
+        match self {
+            Self::PowerLaw {
+                reference_height_m, ..
+            }
+            | Self::LogLaw {
+                reference_height_m, ..
+            } => *reference_height_m,
+            Self::Uniform { .. } | Self::Tabulated { .. } => DEFAULT_REFERENCE_HEIGHT_M,
+        }
     }
 }
 

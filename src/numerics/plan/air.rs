@@ -28,6 +28,15 @@
 //!
 //! Aerodynamic forces of the aerostat's own motion (payout speed against
 //! the wind) are neglected: the loads are those of the steady wind.
+//!
+//! **Gusts** (SPEC §10, [`SteadyWind::gust`]): every limit holds at the
+//! gust speed as well. The tensions the pass bounds are the larger of the
+//! mean's and the gust's at each length ([`SteadyWind::limit_tensions`]),
+//! and the string criterion's `S` the smaller ([`SteadyWind::stability_tension_n`];
+//! the quasi-static GE criterion is judged in the mean wind). The gust
+//! is the static equilibrium at the gust speed, which is conservative for
+//! the tension; with a gust equal to the mean (I = 0) nothing is computed
+//! twice and every number is the mean's bit for bit.
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
@@ -129,6 +138,8 @@ pub struct SteadyWind {
     /// The quasi-static GE criterion, which replaces `criterion` when set
     /// ([`super::ge_stability`]).
     pub ge: Option<super::ge_stability::GeCriterion>,
+    /// The gust profile (SPEC §10); `None`: the mean wind only.
+    pub gust: Option<WindProfile>,
     /// Answers already computed, by (length, buoyancy, kind) bits: the
     /// pass, the bound, the constant-rate plan and the jerk check of one
     /// request share their grid's lengths.
@@ -150,8 +161,20 @@ impl SteadyWind {
             criterion: string_tension_criterion,
             criterion_name: STRING_TENSION_CRITERION,
             ge: None,
+            gust: None,
             cache: Arc::default(),
         }
+    }
+
+    /// The same wind with gusts of profile `gust`.
+    pub fn with_gust(mut self, gust: WindProfile) -> Self {
+        self.gust = Some(gust);
+        self
+    }
+
+    /// The gust profile when it differs from the mean.
+    fn distinct_gust(&self) -> Option<&WindProfile> {
+        self.gust.as_ref().filter(|g| **g != self.wind)
     }
 
     fn cached(&self, key: CacheKey, f: impl FnOnce() -> [f64; 3]) -> [f64; 3] {
@@ -172,6 +195,27 @@ impl SteadyWind {
         buoyancy_n: f64,
         length_m: f64,
     ) -> EquilibriumProblem {
+        self.problem_in(&self.wind, s, buoyancy_n, length_m)
+    }
+
+    /// [`Self::problem`] in the gust; `None` without gusts.
+    pub fn gust_problem(
+        &self,
+        s: &AerostatSystem,
+        buoyancy_n: f64,
+        length_m: f64,
+    ) -> Option<EquilibriumProblem> {
+        let g = self.gust.as_ref()?;
+        Some(self.problem_in(g, s, buoyancy_n, length_m))
+    }
+
+    fn problem_in(
+        &self,
+        wind: &WindProfile,
+        s: &AerostatSystem,
+        buoyancy_n: f64,
+        length_m: f64,
+    ) -> EquilibriumProblem {
         let mut cable = self.cable.clone();
         cable.mass_per_length_kg_m = s.mass_per_length_kg_m;
         cable.axial_stiffness_n = None;
@@ -180,7 +224,7 @@ impl SteadyWind {
         EquilibriumProblem {
             cable,
             body,
-            wind: self.wind.clone(),
+            wind: wind.clone(),
             air_density_kg_m3: self.air_density_kg_m3,
             tether_length_m: length_m,
             gravity_m_s2: s.gravity_m_s2,
@@ -199,10 +243,17 @@ impl SteadyWind {
         let b = p.reserve_buoyancy_n();
         let key = key(&p.system, length_m, b, self.criterion as usize, 0);
         self.cached(key, || {
-            let pr = self.problem(&p.system, b, length_m);
-            let st = match self.solve(&pr) {
-                Some(eq) => (self.criterion)(&pr, &eq),
-                None => -b,
+            let at = |wind: &WindProfile| {
+                let pr = self.problem_in(wind, &p.system, b, length_m);
+                match self.solve(&pr) {
+                    Some(eq) => (self.criterion)(&pr, &eq),
+                    None => -b,
+                }
+            };
+            let mean = at(&self.wind);
+            let st = match self.distinct_gust() {
+                Some(g) => mean.min(at(g)),
+                None => mean,
             };
             [st, 0.0, 0.0]
         })[0]
@@ -219,6 +270,38 @@ impl SteadyWind {
             }
         });
         (w, t, a)
+    }
+
+    /// [`Self::operating`] in the gust; `None` without gusts.
+    pub fn gust_operating(&self, s: &AerostatSystem, length_m: f64) -> Option<(f64, f64, f64)> {
+        let g = self.gust.as_ref()?;
+        if *g == self.wind {
+            return Some(self.operating(s, length_m));
+        }
+        let key = key(s, length_m, s.net_buoyancy_n, 0, 2);
+        let [w, t, a] = self.cached(key, || {
+            let pr = self.problem_in(g, s, s.net_buoyancy_n, length_m);
+            match self.solve(&pr) {
+                Some(eq) => [eq.winch_tension_n, eq.top_tension_n, eq.altitude_m],
+                None => [f64::NAN; 3],
+            }
+        });
+        Some((w, t, a))
+    }
+
+    /// The winch and top tensions the limits bound: the larger of the
+    /// mean's and the gust's (N).
+    pub fn limit_tensions(&self, s: &AerostatSystem, length_m: f64) -> (f64, f64) {
+        let (w, t, _) = self.operating(s, length_m);
+        match self.distinct_gust() {
+            Some(_) => {
+                let (gw, gt, _) = self
+                    .gust_operating(s, length_m)
+                    .expect("a gust profile is set");
+                (w.max(gw), t.max(gt))
+            }
+            None => (w, t),
+        }
     }
 }
 
@@ -282,6 +365,26 @@ impl Air {
         }
     }
 
+    /// Whether the wind has gusts.
+    pub fn has_gust(&self) -> bool {
+        matches!(self, Self::Wind(w) if w.gust.is_some())
+    }
+
+    /// The loads at rest at one length in the gust (full buoyancy; its
+    /// `stability_tension_n` is the plan's `S`); `None` without gusts.
+    pub fn gust_rest_loads(&self, p: &PlanProblem, length_m: f64) -> Option<RestLoads> {
+        let Self::Wind(w) = self else {
+            return None;
+        };
+        let (winch, top, alt) = w.gust_operating(&p.system, length_m)?;
+        Some(RestLoads {
+            stability_tension_n: w.stability_tension_n(p, length_m),
+            winch_tension_n: winch,
+            top_tension_n: top,
+            altitude_m: alt,
+        })
+    }
+
     /// `S(L)` at every length (on rayon in wind).
     pub fn stability_tensions_n(&self, p: &PlanProblem, lengths: &[f64]) -> Vec<f64> {
         match self {
@@ -296,7 +399,8 @@ impl Air {
         }
     }
 
-    /// `(T_w, T_t)` with the full buoyancy at every length (on rayon in wind).
+    /// `(T_w, T_t)` with the full buoyancy at every length (on rayon in
+    /// wind): with gusts the larger of the mean's and the gust's.
     pub fn operating_tensions_n(&self, p: &PlanProblem, lengths: &[f64]) -> Vec<(f64, f64)> {
         match self {
             Self::Calm => lengths
@@ -308,10 +412,7 @@ impl Air {
                 .collect(),
             Self::Wind(w) => lengths
                 .par_iter()
-                .map(|&l| {
-                    let (wt, tt, _) = w.operating(&p.system, l);
-                    (wt, tt)
-                })
+                .map(|&l| w.limit_tensions(&p.system, l))
                 .collect(),
         }
     }

@@ -243,6 +243,20 @@ pub enum BindingLimit {
     StaticLift { length_m: f64, limit_m: f64 },
     /// The tension at rest already exceeds the allowable tension.
     Tension { tension_n: f64, allowable_n: f64 },
+    /// In the gust (SPEC §10) the tension at rest exceeds the allowable
+    /// tension, while the mean wind's is within it.
+    GustTension {
+        tension_n: f64,
+        mean_tension_n: f64,
+        allowable_n: f64,
+    },
+    /// Where the plan leaves the aerostat flying it is below the floor
+    /// `min_altitude_m` (in the gust when there are gusts: the lowest).
+    MinAltitude {
+        altitude_m: f64,
+        floor_m: f64,
+        in_gust: bool,
+    },
     /// A retrieval's oscillation growth exceeds the limit at every rate tried.
     Amplification { amplification: f64, limit: f64 },
     /// No jerk-limited schedule kept every limit after the tightenings.
@@ -273,6 +287,8 @@ impl BindingLimit {
         match self {
             Self::StaticLift { .. } => "static_lift_limit",
             Self::Tension { .. } => "tension_limit",
+            Self::GustTension { .. } => "gust_tension_limit",
+            Self::MinAltitude { .. } => "min_altitude",
             Self::Amplification { .. } => "amplification_limit",
             Self::Jerk { .. } => "jerk_limit",
             Self::WindAltitude { .. } => "wind_blowdown",
@@ -296,6 +312,28 @@ impl BindingLimit {
             } => format!(
                 "the tension at rest, {tension_n:.1} N, already exceeds the allowable tension \
                  (breaking strength / safety factor) of {allowable_n:.1} N"
+            ),
+            Self::GustTension {
+                tension_n,
+                mean_tension_n,
+                allowable_n,
+            } => format!(
+                "in the gust the tension at rest, {tension_n:.1} N, exceeds the allowable tension \
+                 (breaking strength / safety factor) of {allowable_n:.1} N (the mean wind's, {mean_tension_n:.1} N, \
+                 is within it)"
+            ),
+            Self::MinAltitude {
+                altitude_m,
+                floor_m,
+                in_gust,
+            } => format!(
+                "{} the aerostat is blown down to {altitude_m:.1} m where the plan leaves it, below the floor \
+                 min_altitude_m = {floor_m:.1} m",
+                if in_gust {
+                    "in the gust"
+                } else {
+                    "in this wind"
+                }
             ),
             Self::Amplification {
                 amplification,

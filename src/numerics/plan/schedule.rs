@@ -387,18 +387,33 @@ pub(crate) fn static_check(p: &PlanProblem, air: &Air) -> Option<BindingLimit> {
         });
     }
     if let Some(allow) = p.allowable_tension_n {
+        let ends = [p.system.initial_length_m, p.target_length_m];
         let t = if air.is_calm() {
             let low = p.target_length_m.min(p.system.initial_length_m);
             p.max_tension_n(low, 0.0)
         } else {
-            [p.system.initial_length_m, p.target_length_m]
-                .iter()
+            ends.iter()
                 .map(|&l| air.rest_loads(p, l).max_tension_at_n(&p.system, l, 0.0))
                 .fold(f64::NEG_INFINITY, f64::max)
         };
         if t > allow {
             return Some(BindingLimit::Tension {
                 tension_n: t,
+                allowable_n: allow,
+            });
+        }
+        // In the gust (SPEC §10): the same check at the gust speed.
+        let gust = ends
+            .iter()
+            .filter_map(|&l| {
+                air.gust_rest_loads(p, l)
+                    .map(|r| r.max_tension_at_n(&p.system, l, 0.0))
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
+        if gust > allow {
+            return Some(BindingLimit::GustTension {
+                tension_n: gust,
+                mean_tension_n: t,
                 allowable_n: allow,
             });
         }

@@ -5,7 +5,9 @@
 //! 1. **slack** — part of the tether rests on the ground or its tension vanishes;
 //! 2. **tension** — breaking strength / largest tension below the required factor;
 //! 3. **ceiling** — the altitude above an operating ceiling;
-//! 4. **stability** — with a payout rate `v`: the continuum string criterion
+//! 4. **min_altitude** — the altitude below a floor (terrain, airspace):
+//!    with gusts the floor is judged on the gust's equilibrium, the lowest;
+//! 5. **stability** — with a payout rate `v`: the continuum string criterion
 //!    of SPEC §1 (`h* = (F/ρA − v²)/g`, i.e. unstable once the winch tension
 //!    no longer exceeds the kinematic term `ρA v²`), applied to the smallest
 //!    tension of the blown-down tether: stable iff `min T − ρA v² > 0`. In
@@ -74,6 +76,8 @@ pub enum Limit {
     Slack,
     Tension,
     Ceiling,
+    /// The altitude below the floor `min_altitude_m`.
+    MinAltitude,
     Stability,
     /// The shooting did not meet its tolerance (should not happen).
     NotConverged,
@@ -86,6 +90,7 @@ impl Limit {
             Self::Slack,
             Self::Tension,
             Self::Ceiling,
+            Self::MinAltitude,
             Self::Stability,
             Self::NotConverged,
         ]
@@ -98,6 +103,7 @@ impl Limit {
             Self::Slack => "slack",
             Self::Tension => "tension",
             Self::Ceiling => "ceiling",
+            Self::MinAltitude => "min_altitude",
             Self::Stability => "stability",
             Self::NotConverged => "not_converged",
         }
@@ -111,6 +117,8 @@ pub struct Limits {
     pub required_safety_factor: f64,
     /// Highest allowed altitude (m).
     pub ceiling_m: Option<f64>,
+    /// Lowest allowed altitude (m).
+    pub min_altitude_m: Option<f64>,
     /// Payout rate for the stability criterion (m/s).
     pub payout_rate_m_s: Option<f64>,
 }
@@ -154,6 +162,8 @@ pub fn judge_with(
         Some(Limit::Tension)
     } else if limits.ceiling_m.is_some_and(|c| eq.altitude_m > c) {
         Some(Limit::Ceiling)
+    } else if limits.min_altitude_m.is_some_and(|f| eq.altitude_m < f) {
+        Some(Limit::MinAltitude)
     } else if stable == Some(false) {
         Some(Limit::Stability)
     } else {

@@ -95,6 +95,17 @@ pub fn reference_height_m(mean: &WindProfile) -> f64 {
 /// when a gust speed is given over a mean that is zero at the reference
 /// height of a sheared flow (nothing to scale).
 pub fn gust_factor(gust: &Gust, mean: &WindProfile, field: &str) -> Result<f64, InvalidInput> {
+    gust_factor_at(gust, mean, reference_height_m(mean), field)
+}
+
+/// [`gust_factor`] with a gust speed given at `reference_height_m` (a
+/// power law's own reference height, say).
+pub fn gust_factor_at(
+    gust: &Gust,
+    mean: &WindProfile,
+    reference_height_m: f64,
+    field: &str,
+) -> Result<f64, InvalidInput> {
     gust.validate(field)?;
     Ok(match *gust {
         Gust::Intensity {
@@ -102,7 +113,7 @@ pub fn gust_factor(gust: &Gust, mean: &WindProfile, field: &str) -> Result<f64, 
             peak_factor,
         } => 1.0 + peak_factor * turbulence_intensity,
         Gust::AtReference { gust_m_s } => {
-            let u = mean.speed_m_s(reference_height_m(mean)).abs();
+            let u = mean.speed_m_s(reference_height_m).abs();
             if u > 0.0 {
                 gust_m_s / u
             } else if gust_m_s == 0.0 {
@@ -111,8 +122,7 @@ pub fn gust_factor(gust: &Gust, mean: &WindProfile, field: &str) -> Result<f64, 
                 return Err(InvalidInput::new(
                     format!("{field}.gust_m_s"),
                     format!(
-                        "the mean wind is zero at the reference height {:.1} m, so a gust of {gust_m_s} m/s cannot scale it; give a uniform flow or turbulence_intensity_nondim",
-                        reference_height_m(mean)
+                        "the mean wind is zero at the reference height {reference_height_m:.1} m, so a gust of {gust_m_s} m/s cannot scale it; give a uniform flow or turbulence_intensity_nondim"
                     ),
                 ));
             }
@@ -155,19 +165,36 @@ pub fn scaled_profile(mean: &WindProfile, factor: f64) -> WindProfile {
 }
 
 /// The gust profile of `mean` (a uniform mean with a gust speed becomes
-/// that uniform speed exactly).
+/// that uniform speed exactly, blowing the mean's way).
 pub fn gust_profile(
     gust: &Gust,
     mean: &WindProfile,
     field: &str,
 ) -> Result<WindProfile, InvalidInput> {
-    if let (Gust::AtReference { gust_m_s }, WindProfile::Flow(SteadyFlow::Uniform { .. })) =
+    gust_profile_at(gust, mean, reference_height_m(mean), field)
+}
+
+/// [`gust_profile`] with a gust speed given at `reference_height_m`.
+pub fn gust_profile_at(
+    gust: &Gust,
+    mean: &WindProfile,
+    reference_height_m: f64,
+    field: &str,
+) -> Result<WindProfile, InvalidInput> {
+    if let (Gust::AtReference { gust_m_s }, WindProfile::Flow(SteadyFlow::Uniform { speed_m_s })) =
         (gust, mean)
     {
         gust.validate(field)?;
-        return Ok(WindProfile::uniform(*gust_m_s));
+        return Ok(WindProfile::uniform(if *speed_m_s < 0.0 {
+            -gust_m_s
+        } else {
+            *gust_m_s
+        }));
     }
-    Ok(scaled_profile(mean, gust_factor(gust, mean, field)?))
+    Ok(scaled_profile(
+        mean,
+        gust_factor_at(gust, mean, reference_height_m, field)?,
+    ))
 }
 
 #[cfg(test)]
