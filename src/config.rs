@@ -95,6 +95,10 @@ pub struct JobArgs {
     /// Seconds a finished job (and its answer) is kept; then it is deleted.
     #[arg(long, env = "TETHERPLAN_JOB_RETENTION_S", default_value_t = Limits::default().job_retention.as_secs_f64())]
     pub job_retention_s: f64,
+    /// Bytes one token's jobs (requests, answers, estimated answers of
+    /// pending jobs) and named systems may keep in the store; beyond: 429.
+    #[arg(long, env = "TETHERPLAN_TOKEN_MAX_STORED_BYTES", default_value_t = Limits::default().max_stored_bytes_per_token)]
+    pub token_max_stored_bytes: u64,
 }
 
 /// Limits of the HTTP service.
@@ -126,6 +130,8 @@ pub struct Limits {
     pub max_job_result_bytes: u64,
     /// How long a finished job is kept before it is deleted.
     pub job_retention: Duration,
+    /// Bytes one token's jobs and named systems may keep in the store.
+    pub max_stored_bytes_per_token: u64,
 }
 
 impl Default for Limits {
@@ -145,6 +151,7 @@ impl Default for Limits {
             max_job_run_time: Duration::from_secs(3600),
             max_job_result_bytes: 64 << 20,
             job_retention: Duration::from_secs(7 * 24 * 3600),
+            max_stored_bytes_per_token: 1 << 30,
         }
     }
 }
@@ -215,6 +222,7 @@ impl JobArgs {
             max_job_run_time: Duration::from_secs_f64(self.job_max_run_s.clamp(0.01, 1e7)),
             max_job_result_bytes: self.job_max_result_bytes,
             job_retention: Duration::from_secs_f64(self.job_retention_s.clamp(0.0, 1e10)),
+            max_stored_bytes_per_token: self.token_max_stored_bytes,
             ..Limits::default()
         }
     }
@@ -277,6 +285,7 @@ impl From<ServeArgs> for Config {
                 max_job_run_time: Duration::from_secs_f64(a.jobs.job_max_run_s.clamp(0.01, 1e7)),
                 max_job_result_bytes: a.jobs.job_max_result_bytes,
                 job_retention: Duration::from_secs_f64(a.jobs.job_retention_s.clamp(0.0, 1e10)),
+                max_stored_bytes_per_token: a.jobs.token_max_stored_bytes,
                 ..Limits::default()
             },
             connections: ConnectionLimits {

@@ -21,6 +21,8 @@ fn insert(store: &dyn JobBackend) -> i64 {
         max_pending: 100,
         max_pending_per_owner: 100,
         priority: 0,
+        reserve_bytes: 0,
+        max_stored_bytes: u64::MAX,
     };
     match store.insert(&job).unwrap() {
         Inserted::New(id) => id,
