@@ -195,6 +195,8 @@ fn claim_overhead(store: &dyn JobBackend, chunks: usize) -> f64 {
         max_pending: 10,
         max_pending_per_owner: 10,
         priority: 1,
+        reserve_bytes: 0,
+        max_stored_bytes: u64::MAX,
     };
     let id = match store.insert(&new).unwrap() {
         tetherplan::jobs::store::Inserted::New(id) => id,

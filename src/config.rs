@@ -98,6 +98,10 @@ pub struct JobArgs {
     /// Seconds a finished job (and its answer) is kept; then it is deleted.
     #[arg(long, env = "TETHERPLAN_JOB_RETENTION_S", default_value_t = Limits::default().job_retention.as_secs_f64())]
     pub job_retention_s: f64,
+    /// Bytes one token's jobs (requests, answers, estimated answers of
+    /// pending jobs) and named systems may keep in the store; beyond: 429.
+    #[arg(long, env = "TETHERPLAN_TOKEN_MAX_STORED_BYTES", default_value_t = Limits::default().max_stored_bytes_per_token)]
+    pub token_max_stored_bytes: u64,
 }
 
 /// `tetherplan worker` flags: the job store and the job limits.
@@ -132,6 +136,7 @@ impl JobArgs {
             max_job_run_time: Duration::from_secs_f64(self.job_max_run_s.clamp(0.01, 1e7)),
             max_job_result_bytes: self.job_max_result_bytes,
             job_retention: Duration::from_secs_f64(self.job_retention_s.clamp(0.0, 1e10)),
+            max_stored_bytes_per_token: self.token_max_stored_bytes,
             ..Limits::default()
         }
     }
@@ -186,6 +191,7 @@ impl From<ServeArgs> for Config {
                 max_job_run_time: Duration::from_secs_f64(a.jobs.job_max_run_s.clamp(0.01, 1e7)),
                 max_job_result_bytes: a.jobs.job_max_result_bytes,
                 job_retention: Duration::from_secs_f64(a.jobs.job_retention_s.clamp(0.0, 1e10)),
+                max_stored_bytes_per_token: a.jobs.token_max_stored_bytes,
                 ..Limits::default()
             },
             connections: ConnectionLimits {

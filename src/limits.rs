@@ -35,6 +35,8 @@ pub struct Limits {
     pub max_job_result_bytes: u64,
     /// How long a finished job is kept before it is deleted.
     pub job_retention: Duration,
+    /// Bytes one token's jobs and named systems may keep in the store.
+    pub max_stored_bytes_per_token: u64,
 }
 
 impl Default for Limits {
@@ -54,6 +56,7 @@ impl Default for Limits {
             max_job_run_time: Duration::from_secs(3600),
             max_job_result_bytes: 64 << 20,
             job_retention: Duration::from_secs(7 * 24 * 3600),
+            max_stored_bytes_per_token: 1 << 30,
         }
     }
 }

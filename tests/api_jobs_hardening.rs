@@ -581,6 +581,8 @@ fn the_store_keeps_one_job_per_key() {
         max_pending: 10,
         max_pending_per_owner: 10,
         priority: 0,
+        reserve_bytes: 0,
+        max_stored_bytes: u64::MAX,
     };
     let first = store.insert(&job("h1")).unwrap();
     let again = store.insert(&job("h1")).unwrap();
@@ -593,4 +595,93 @@ fn the_store_keeps_one_job_per_key() {
         Err(InsertError::KeyReused { .. })
     ));
     assert_eq!(store.list(None, 10).unwrap().len(), 1, "{first:?}");
+}
+
+// ---------------------------------------------------------------- store quota
+
+/// Issue 22: each token's jobs (request plus estimated answer while
+/// pending, then request plus answer) and named systems keep at most
+/// `max_stored_bytes_per_token`; past it a submission or a system is 429
+/// `store_quota_full` in plain words, with `Retry-After` until the token's
+/// oldest finished job expires (when one has finished). Other tokens keep
+/// their own room. On main every one of these submissions is accepted.
+#[tokio::test]
+async fn the_store_quota_is_per_token_and_answers_429() {
+    use tetherplan::jobs::estimate::SMALL_ANSWER;
+    let job = critical_job(10.0);
+    let req = serde_json::to_vec(&job).unwrap().len() as u64;
+    // a critical answer is estimated at SMALL_ANSWER (8 KiB): two jobs fit
+    let quota = 2 * (req + SMALL_ANSWER) + SMALL_ANSWER / 2;
+    let limits = Limits {
+        max_stored_bytes_per_token: quota,
+        job_retention: Duration::from_secs(600),
+        ..Limits::default()
+    };
+    let (app, queue) = app_with(limits, &["alpha", "beta"]);
+    let alpha = [("authorization", "Bearer alpha")];
+    let beta = [("authorization", "Bearer beta")];
+    for _ in 0..2 {
+        let a = send(&app, "POST", "/api/v1/jobs", &alpha, Some(&job)).await;
+        assert_eq!(a.status, StatusCode::ACCEPTED, "{}", a.text);
+    }
+    let refused = send(&app, "POST", "/api/v1/jobs", &alpha, Some(&job)).await;
+    assert_eq!(refused.status, StatusCode::TOO_MANY_REQUESTS, "{}", refused.text);
+    let e = refused.error();
+    assert_eq!(e.code, "store_quota_full");
+    assert!(
+        e.message.contains(&format!("{quota} bytes kept per token"))
+            && !e.message.contains("TETHERPLAN"),
+        "{}",
+        e.message
+    );
+    assert!(
+        refused.headers.get(header::RETRY_AFTER).is_none(),
+        "nothing finished yet: no time to name"
+    );
+    let b = send(&app, "POST", "/api/v1/jobs", &beta, Some(&job)).await;
+    assert_eq!(b.status, StatusCode::ACCEPTED, "{}", b.text);
+
+    // the first job finishes: its answer (far below its estimate) replaces the reserve
+    let q = queue.clone();
+    let ran = tokio::task::spawn_blocking(move || try_execute_next(&q).unwrap().unwrap())
+        .await
+        .unwrap();
+    assert_eq!(ran.status, JobStatus::Done);
+    let answer = send(&app, "GET", &format!("/api/v1/jobs/{}", ran.id), &alpha, None).await;
+    let answer_len = serde_json::to_vec(&answer.json()["result"]).unwrap().len() as u64;
+    assert!(req + answer_len < SMALL_ANSWER / 2, "{answer_len} bytes of answer");
+    let a = send(&app, "POST", "/api/v1/jobs", &alpha, Some(&job)).await;
+    assert_eq!(a.status, StatusCode::ACCEPTED, "{}", a.text);
+    let refused = send(&app, "POST", "/api/v1/jobs", &alpha, Some(&job)).await;
+    assert_eq!(refused.status, StatusCode::TOO_MANY_REQUESTS, "{}", refused.text);
+    let retry: u32 = refused.headers[header::RETRY_AFTER]
+        .to_str()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((590..=600).contains(&retry), "Retry-After {retry} (retention 600 s)");
+}
+
+/// Named systems count against the same quota.
+#[tokio::test]
+async fn named_systems_count_against_the_store_quota() {
+    let system = json!({"aerostat": {"net_buoyancy_n": 1000.0}, "cable": {"mass_per_length_kg_m": 0.078}});
+    let size = serde_json::to_vec(&system).unwrap().len() as u64;
+    let limits = Limits {
+        max_stored_bytes_per_token: size + size / 2,
+        ..Limits::default()
+    };
+    let (app, _) = app_with(limits, &["alpha", "beta"]);
+    let alpha = [("authorization", "Bearer alpha")];
+    let beta = [("authorization", "Bearer beta")];
+    let put = send(&app, "PUT", "/api/v1/systems/rig", &alpha, Some(&system)).await;
+    assert_eq!(put.status, StatusCode::CREATED, "{}", put.text);
+    // replacing it takes no more room; a second one does not fit
+    let put = send(&app, "PUT", "/api/v1/systems/rig", &alpha, Some(&system)).await;
+    assert_eq!(put.status, StatusCode::OK, "{}", put.text);
+    let put = send(&app, "PUT", "/api/v1/systems/rig-2", &alpha, Some(&system)).await;
+    assert_eq!(put.status, StatusCode::TOO_MANY_REQUESTS, "{}", put.text);
+    assert_eq!(put.error().code, "store_quota_full");
+    let put = send(&app, "PUT", "/api/v1/systems/rig-2", &beta, Some(&system)).await;
+    assert_eq!(put.status, StatusCode::CREATED, "{}", put.text);
 }

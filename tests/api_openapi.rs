@@ -149,7 +149,7 @@ fn every_route_is_documented_with_its_statuses() {
             "put",
             "/api/v1/systems/{name}",
             "put_system",
-            &["200", "201", "400", "401", "413", "415", "422", "500"],
+            &["200", "201", "400", "401", "413", "415", "422", "429", "500"],
         ),
         (
             "get",

@@ -6,12 +6,12 @@
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 mod common;
-use common::http::{Reply, connect, spawn_listening};
+use common::http::{Reply, connect, exchange, spawn_listening};
 
 struct Server {
     child: Child,
@@ -21,9 +21,16 @@ struct Server {
 
 impl Server {
     fn start(name: &str, envs: &[(&str, &str)]) -> Self {
+        Self::start_prepared(name, envs, |_| {})
+    }
+
+    /// [`Server::start`] after `prepare` has written into the server's
+    /// directory (its database is `jobs.db` there).
+    fn start_prepared(name: &str, envs: &[(&str, &str)], prepare: impl FnOnce(&Path)) -> Self {
         let dir = std::env::temp_dir().join(format!("tp-slow-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(dir.join("static")).unwrap();
+        prepare(&dir);
         std::fs::write(
             dir.join("static/index.html"),
             "<!doctype html><title>t</title>",
@@ -333,4 +340,101 @@ fn host_edges_are_closed() {
     }
     let own = format!("GET http://{a}/healthz HTTP/1.1\r\nHost: {a}\r\nConnection: close\r\n\r\n");
     assert_eq!(status(server.raw(&own)), 200);
+}
+
+/// Item 2, last clause: a job's answer is streamed from the store page by
+/// page as the client reads, not built in memory per GET. 16 clients GET a
+/// 24 MiB answer and never read: the server's resident memory grows by a
+/// few pages per client, not by the 384 MiB the answers would take (main:
+/// each GET held its whole answer until the write deadline), and every
+/// client is dropped at the 4 s write deadline. A client that reads gets
+/// the whole answer.
+#[test]
+fn unread_job_answers_are_streamed_not_held() {
+    use tetherplan::jobs::store::{JobBackend, JobStore};
+    const ANSWER_BYTES: usize = 24 << 20;
+    const CLIENTS: usize = 16;
+    let answer = format!("[{}0]", "1.25,".repeat(ANSWER_BYTES / 5));
+    let server = Server::start_prepared(
+        "answers",
+        &[("TETHERPLAN_WRITE_DEADLINE_S", "4")],
+        |dir: &Path| {
+            let store = JobStore::open(&dir.join("jobs.db")).unwrap();
+            let id = store.insert_simple("chart", "{}", 10).unwrap();
+            assert_eq!(id, 1);
+            let job = store.claim_next().unwrap().unwrap();
+            assert!(store.finish_done(&job.lease, &answer).unwrap());
+        },
+    );
+    let addr = server.addr;
+    // one reader gets the whole answer, spliced into the view
+    let reply = exchange(
+        connect(addr, Duration::from_secs(30)),
+        "GET",
+        "/api/v1/jobs/1",
+        &addr.to_string(),
+        None,
+        b"",
+    );
+    assert_eq!(reply.status, 200);
+    let view: serde_json::Value = serde_json::from_str(&reply.body).unwrap();
+    assert_eq!(view["status"], "done");
+    assert_eq!(
+        view["result"].as_array().map(Vec::len),
+        Some(ANSWER_BYTES / 5 + 1)
+    );
+    drop(view);
+    drop(reply);
+    std::thread::sleep(Duration::from_millis(300));
+    let before = server.rss_kb();
+    let start = Instant::now();
+    let clients: Vec<_> = (0..CLIENTS)
+        .map(|_| {
+            std::thread::spawn(move || {
+                let mut s = connect(addr, Duration::from_secs(20));
+                write!(s, "GET /api/v1/jobs/1 HTTP/1.1\r\nHost: {addr}\r\n\r\n").unwrap();
+                // never read until the deadline is well past
+                std::thread::sleep(Duration::from_secs(6));
+                let mut got = 0usize;
+                let mut buf = vec![0u8; 1 << 16];
+                loop {
+                    match s.read(&mut buf) {
+                        Ok(0) | Err(_) => break,
+                        Ok(n) => got += n,
+                    }
+                }
+                (got, start.elapsed())
+            })
+        })
+        .collect();
+    let mut peak = before;
+    for _ in 0..40 {
+        peak = peak.max(server.rss_kb());
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let results: Vec<(usize, Duration)> = clients.into_iter().map(|c| c.join().unwrap()).collect();
+    let grown_mb = peak.saturating_sub(before) as f64 / 1024.0;
+    let held_mb = (CLIENTS * ANSWER_BYTES) as f64 / (1 << 20) as f64;
+    eprintln!(
+        "RSS {before} kB before, peak {peak} kB (+{grown_mb:.1} MB) with {CLIENTS} unread GETs of a \
+         {} MiB answer ({held_mb:.0} MiB if each were held); received {:?}",
+        ANSWER_BYTES >> 20,
+        results.iter().map(|r| r.0).collect::<Vec<_>>()
+    );
+    assert!(
+        grown_mb < 48.0,
+        "RSS grew {grown_mb:.1} MB for {CLIENTS} unread answers of {} MiB",
+        ANSWER_BYTES >> 20
+    );
+    for (got, _) in &results {
+        assert!(
+            *got < ANSWER_BYTES,
+            "a client that did not read got the whole answer ({got} bytes) after the deadline"
+        );
+    }
+    // dropped at the deadline: the connection was closed when the client
+    // first read (6 s), not held open to the end of the answer
+    let slowest = results.iter().map(|r| r.1).max().unwrap();
+    assert!(slowest < Duration::from_secs(12), "held {slowest:?}");
+    assert!(server.healthy(Duration::from_secs(2)));
 }

@@ -28,6 +28,10 @@ use tetherplan::numerics::chart::Parallelism;
 
 const LEASE_S: &str = "2";
 
+/// A done job's answer as the database keeps it: its pages, in order.
+const STORED_ANSWER: &str = "SELECT convert_from(string_agg(data, ''::BYTEA ORDER BY page), 'UTF8')
+    FROM job_answers WHERE job_id = $1";
+
 /// A fresh database, dropped at the end.
 struct TestDb {
     admin_url: String,
@@ -347,7 +351,7 @@ fn run_with_a_killed_worker(db: &TestDb, job: &Value) -> String {
     let (status, text) = api.request_text("GET", &format!("/api/v1/jobs/{id}"), None);
     assert_eq!(status, 200);
     let stored: String = pg
-        .query_one("SELECT result FROM jobs WHERE id = $1", &[&id])
+        .query_one(STORED_ANSWER, &[&id])
         .unwrap()
         .get(0);
     assert!(text.contains(&stored));
@@ -538,7 +542,7 @@ fn envelope_bands_on_two_workers_equal_the_sqlite_run() {
             rows.iter().filter_map(|r| r.4.clone()).collect();
         eprintln!("{kind}: {n} chunks done by {finishers:?}");
         let stored: String = pg
-            .query_one("SELECT result FROM jobs WHERE id = $1", &[&id])
+            .query_one(STORED_ANSWER, &[&id])
             .unwrap()
             .get(0);
         assert_eq!(stored, sqlite_answer(&submission), "{kind}");

@@ -3,8 +3,8 @@
 //! Jobs belong to the token that submitted them ([`Caller`]): another
 //! token gets 404 for them and does not see them listed. `Idempotency-Key`
 //! makes a submission safe to repeat. A finished job's answer is sent as
-//! the stored JSON text, spliced into the view without being parsed or
-//! copied again.
+//! the stored JSON text, spliced into the view without being parsed, and
+//! streamed from the store one page at a time as the client reads it.
 
 use axum::body::{Body, Bytes};
 use axum::extract::{Extension, Path, Query, State};
@@ -19,8 +19,9 @@ use crate::api::auth::Caller;
 use crate::api::error::{ApiError, JsonBody};
 use crate::contract::dto::ErrorBody;
 use crate::jobs::kinds::JobSubmission;
-use crate::jobs::store::{InsertError, JobRecord, JobStatus};
-use crate::jobs::{SubmitError, Submitter};
+use crate::jobs::store::{InsertError, JobHead, JobRecord, JobStatus, StoreError};
+use crate::jobs::{JobQueue, SubmitError, Submitter};
+use std::sync::Arc;
 
 /// A job: status, progress, and its answer or error.
 #[derive(Debug, Serialize, ToSchema)]
@@ -36,7 +37,9 @@ pub struct JobView {
     pub progress: f64,
     /// Times the job was started (more than 1 after an interrupted run; a
     /// job whose process died at every one of `TETHERPLAN_JOB_MAX_ATTEMPTS`
-    /// starts fails with `attempts_exhausted`).
+    /// starts fails with `attempts_exhausted`). A chunked job's coordinator
+    /// taken over while chunks remain is a start that does not count
+    /// against that limit: each chunk counts its own starts.
     pub attempts: u32,
     /// When it was submitted (UTC, RFC 3339).
     pub created_at: String,
@@ -99,22 +102,49 @@ impl JobView {
         }
     }
 
-    /// The view as a response body: the stored answer (JSON text, possibly
-    /// hundreds of MB) is spliced in as it is, not parsed or copied.
-    fn into_body(mut rec: JobRecord) -> Body {
-        let result = rec.result.take();
-        let mut head = serde_json::to_vec(&Self::new(rec)).expect("views serialise");
-        let Some(result) = result else {
-            return Body::from(head);
+    /// The view as a response body. The stored answer (JSON text, possibly
+    /// tens of MB) is spliced in as it is, not parsed: it is read from the
+    /// store one page ([`crate::jobs::store::ANSWER_PAGE_BYTES`]) at a time, each when the
+    /// connection asks for more, so a client that does not read holds at
+    /// most a page or two in memory (hyper's write buffer), not the answer.
+    fn into_body(head: JobHead, queue: Arc<JobQueue>) -> Body {
+        let id = head.record.id;
+        let mut start = serde_json::to_vec(&Self::new(head.record)).expect("views serialise");
+        let Some(pages) = head.answer_pages else {
+            return Body::from(start);
         };
-        head.pop(); // the closing brace
-        head.extend_from_slice(br#","result":"#);
-        let parts: [Result<Bytes, std::convert::Infallible>; 3] = [
-            Ok(Bytes::from(head)),
-            Ok(Bytes::from(result)),
-            Ok(Bytes::from_static(b"}")),
-        ];
-        Body::from_stream(futures_util::stream::iter(parts))
+        start.pop(); // the closing brace
+        start.extend_from_slice(br#","result":"#);
+        if pages == 0 {
+            start.extend_from_slice(b"null}");
+            return Body::from(start);
+        }
+        let first = futures_util::stream::iter([Ok::<_, StoreError>(Bytes::from(start))]);
+        let answer = futures_util::stream::unfold(0usize, move |page| {
+            let queue = queue.clone();
+            async move {
+                if page == pages {
+                    return None;
+                }
+                let read = tokio::task::spawn_blocking(move || queue.store.answer_page(id, page))
+                    .await
+                    .map_err(|e| StoreError(format!("reading the answer of job {id}: {e}")))
+                    .and_then(|r| r)
+                    .and_then(|p| {
+                        p.map(Bytes::from).ok_or_else(|| {
+                            StoreError(format!("page {page} of the answer of job {id} is gone"))
+                        })
+                    });
+                if let Err(e) = &read {
+                    // the connection is cut: the client sees a truncated body
+                    tracing::warn!(job = id, error = %e, "answer stream stopped");
+                }
+                Some((read, page + 1))
+            }
+        });
+        let end = futures_util::stream::iter([Ok(Bytes::from_static(b"}"))]);
+        use futures_util::StreamExt;
+        Body::from_stream(first.chain(answer).chain(end))
     }
 }
 
@@ -144,6 +174,28 @@ pub struct ListQuery {
     /// At most this many jobs (default 100).
     #[param(minimum = 1, maximum = 1000)]
     pub limit: Option<usize>,
+}
+
+/// 429 `store_quota_full` with `message`, and `Retry-After` until the
+/// owner's oldest finished job expires (room is freed then), when one has
+/// finished `oldest_finished_s` ago.
+pub(crate) fn store_quota_full(
+    message: String,
+    oldest_finished_s: Option<f64>,
+    retention_s: f64,
+) -> ApiError {
+    let err = ApiError::new(
+        StatusCode::TOO_MANY_REQUESTS,
+        "store_quota_full",
+        None,
+        message,
+    );
+    match oldest_finished_s {
+        Some(age) => {
+            err.retry_after((retention_s - age).ceil().clamp(1.0, f64::from(u32::MAX)) as u32)
+        }
+        None => err,
+    }
 }
 
 pub(crate) fn json_response(status: StatusCode, value: &impl Serialize) -> Response {
@@ -228,8 +280,8 @@ fn idempotency_key(headers: &HeaderMap) -> Result<Option<String>, ApiError> {
         (status = 413, description = "Body larger than the limit", body = ErrorBody),
         (status = 415, description = "Content type is not JSON", body = ErrorBody),
         (status = 422, description = "Invalid request, answer too large for a job, or an Idempotency-Key reused with another body; `field` names the culprit", body = ErrorBody),
-        (status = 429, description = "Queue full, or this token's quota of pending jobs reached", body = ErrorBody,
-            headers(("Retry-After" = u32, description = "Seconds to wait before retrying"))),
+        (status = 429, description = "Queue full (`queue_full`), this token's quota of pending jobs reached (`quota_full`), or its store quota (`store_quota_full`): the bytes its jobs (requests, answers, the estimated answers of pending jobs) and named systems keep, at most `TETHERPLAN_TOKEN_MAX_STORED_BYTES` (1 GiB by default); room is freed when finished jobs expire or named systems are deleted", body = ErrorBody,
+            headers(("Retry-After" = u32, description = "Seconds to wait before retrying (store quota: until this token's oldest finished job expires; absent when none has finished)"))),
         (status = 500, description = "Job store failure", body = ErrorBody),
     )
 )]
@@ -244,6 +296,7 @@ pub async fn create_job(
         idempotency_key: idempotency_key(&headers)?,
     };
     let queue = app.queue.clone();
+    let retention_s = queue.limits().job_retention.as_secs_f64();
     let submitted = blocking(move || {
         queue.submit_as(&body, &who).map_err(|e| match e {
             SubmitError::Request(r) => ApiError::from(r),
@@ -261,6 +314,9 @@ pub async fn create_job(
                 e.to_string(),
             )
             .retry_after(5),
+            SubmitError::Queue(InsertError::StoreFull {
+                oldest_finished_s, ..
+            }) => store_quota_full(e.to_string(), oldest_finished_s, retention_s),
             SubmitError::Queue(InsertError::KeyReused { .. }) => ApiError::new(
                 StatusCode::UNPROCESSABLE_ENTITY,
                 "idempotency_key_reused",
@@ -355,12 +411,15 @@ pub async fn get_job(
 ) -> Result<Response, ApiError> {
     let id = parse_id(&id)?;
     let queue = app.queue.clone();
-    let rec = blocking(move || Ok(queue.store.get_owned(id, caller.owner.as_deref())?)).await?;
-    let rec = rec.ok_or_else(|| ApiError::not_found(format!("no job with id {id}")))?;
+    let head = {
+        let queue = queue.clone();
+        blocking(move || Ok(queue.store.get_head(id, caller.owner.as_deref())?)).await?
+    };
+    let head = head.ok_or_else(|| ApiError::not_found(format!("no job with id {id}")))?;
     Ok((
         StatusCode::OK,
         [(header::CONTENT_TYPE, "application/json")],
-        JobView::into_body(rec),
+        JobView::into_body(head, queue),
     )
         .into_response())
 }

@@ -116,6 +116,8 @@ pub fn check_description(body: &[u8]) -> Result<serde_json::Value, RequestError>
         (status = 413, description = "Body larger than the limit", body = ErrorBody),
         (status = 415, description = "Content type is not JSON", body = ErrorBody),
         (status = 422, description = "Invalid system or name, or this token already has 100 systems", body = ErrorBody),
+        (status = 429, description = "This token's store quota (`store_quota_full`): its jobs and named systems would keep more than `TETHERPLAN_TOKEN_MAX_STORED_BYTES` (1 GiB by default)", body = ErrorBody,
+            headers(("Retry-After" = u32, description = "Seconds until this token's oldest finished job expires (absent when none has finished)"))),
         (status = 500, description = "Job store failure", body = ErrorBody),
     )
 )]
@@ -130,10 +132,12 @@ pub async fn put_system(
     let text = serde_json::to_string(&value).expect("JSON serialises");
     let queue = app.queue.clone();
     let owner = owner(&caller);
+    let quota = queue.limits().max_stored_bytes_per_token;
+    let retention_s = queue.limits().job_retention.as_secs_f64();
     let (put, stored) = blocking(move || {
         let put = queue
             .store
-            .put_system(&owner, &name, &text, MAX_SYSTEMS_PER_OWNER)?;
+            .put_system(&owner, &name, &text, MAX_SYSTEMS_PER_OWNER, quota)?;
         let stored = queue.store.get_system(&owner, &name)?;
         Ok((put, stored))
     })
@@ -147,6 +151,21 @@ pub async fn put_system(
                 "too_many_systems",
                 Some("name"),
                 format!("this token already has {max} stored systems: delete one first"),
+            ));
+        }
+        PutSystem::StoreFull {
+            stored,
+            limit,
+            oldest_finished_s,
+        } => {
+            return Err(crate::api::jobs::store_quota_full(
+                format!(
+                    "this token keeps {stored} bytes of jobs and named systems and this system \
+                     would take it past the {limit} bytes kept per token: delete systems it no \
+                     longer needs, or wait until its finished jobs expire"
+                ),
+                oldest_finished_s,
+                retention_s,
             ));
         }
     };

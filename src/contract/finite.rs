@@ -9,7 +9,7 @@
 use std::fmt;
 
 use serde::Serialize;
-use serde::ser::{self, Impossible};
+use serde::ser;
 
 use crate::contract::RequestError;
 use crate::numerics::params::InvalidInput;
@@ -124,6 +124,24 @@ struct Compound<'a> {
     key: Option<String>,
 }
 
+/// Serializer methods of values that hold no number: nothing to check.
+macro_rules! no_number {
+    ($($m:ident($($t:ty),*)),* $(,)?) => {$(
+        fn $m(self, $(_: $t),*) -> Result<(), NonFinite> {
+            Ok(())
+        }
+    )*};
+}
+
+/// Serializer methods that open a compound value.
+macro_rules! compound {
+    ($($m:ident($($t:ty),*)),* $(,)?) => {$(
+        fn $m(self, $(_: $t),*) -> Result<Compound<'a>, NonFinite> {
+            Ok(self.compound())
+        }
+    )*};
+}
+
 impl<'a> ser::Serializer for &'a mut Walker {
     type Ok = ();
     type Error = NonFinite;
@@ -135,67 +153,42 @@ impl<'a> ser::Serializer for &'a mut Walker {
     type SerializeStruct = Compound<'a>;
     type SerializeStructVariant = Compound<'a>;
 
-    fn serialize_bool(self, _: bool) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_i8(self, _: i8) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_i16(self, _: i16) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_i32(self, _: i32) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_i64(self, _: i64) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_u8(self, _: u8) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_u16(self, _: u16) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_u32(self, _: u32) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_u64(self, _: u64) -> Result<(), NonFinite> {
-        Ok(())
-    }
+    no_number!(
+        serialize_bool(bool),
+        serialize_i8(i8),
+        serialize_i16(i16),
+        serialize_i32(i32),
+        serialize_i64(i64),
+        serialize_u8(u8),
+        serialize_u16(u16),
+        serialize_u32(u32),
+        serialize_u64(u64),
+        serialize_char(char),
+        serialize_str(&str),
+        serialize_bytes(&[u8]),
+        serialize_none(),
+        serialize_unit(),
+        serialize_unit_struct(&'static str),
+        serialize_unit_variant(&'static str, u32, &'static str),
+    );
+    compound!(
+        serialize_seq(Option<usize>),
+        serialize_tuple(usize),
+        serialize_tuple_struct(&'static str, usize),
+        serialize_tuple_variant(&'static str, u32, &'static str, usize),
+        serialize_map(Option<usize>),
+        serialize_struct(&'static str, usize),
+        serialize_struct_variant(&'static str, u32, &'static str, usize),
+    );
+
     fn serialize_f32(self, v: f32) -> Result<(), NonFinite> {
         self.float(f64::from(v))
     }
     fn serialize_f64(self, v: f64) -> Result<(), NonFinite> {
         self.float(v)
     }
-    fn serialize_char(self, _: char) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_str(self, _: &str) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_bytes(self, _: &[u8]) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_none(self) -> Result<(), NonFinite> {
-        Ok(())
-    }
     fn serialize_some<T: ?Sized + Serialize>(self, value: &T) -> Result<(), NonFinite> {
         value.serialize(self)
-    }
-    fn serialize_unit(self) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_unit_struct(self, _: &'static str) -> Result<(), NonFinite> {
-        Ok(())
-    }
-    fn serialize_unit_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-    ) -> Result<(), NonFinite> {
-        Ok(())
     }
     fn serialize_newtype_struct<T: ?Sized + Serialize>(
         self,
@@ -212,39 +205,6 @@ impl<'a> ser::Serializer for &'a mut Walker {
         value: &T,
     ) -> Result<(), NonFinite> {
         self.at(Seg::Key(variant.into()), value)
-    }
-    fn serialize_seq(self, _: Option<usize>) -> Result<Compound<'a>, NonFinite> {
-        Ok(self.compound())
-    }
-    fn serialize_tuple(self, _: usize) -> Result<Compound<'a>, NonFinite> {
-        Ok(self.compound())
-    }
-    fn serialize_tuple_struct(self, _: &'static str, _: usize) -> Result<Compound<'a>, NonFinite> {
-        Ok(self.compound())
-    }
-    fn serialize_tuple_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-        _: usize,
-    ) -> Result<Compound<'a>, NonFinite> {
-        Ok(self.compound())
-    }
-    fn serialize_map(self, _: Option<usize>) -> Result<Compound<'a>, NonFinite> {
-        Ok(self.compound())
-    }
-    fn serialize_struct(self, _: &'static str, _: usize) -> Result<Compound<'a>, NonFinite> {
-        Ok(self.compound())
-    }
-    fn serialize_struct_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-        _: usize,
-    ) -> Result<Compound<'a>, NonFinite> {
-        Ok(self.compound())
     }
 }
 
@@ -314,7 +274,7 @@ impl ser::SerializeMap for Compound<'_> {
     type Ok = ();
     type Error = NonFinite;
     fn serialize_key<T: ?Sized + Serialize>(&mut self, key: &T) -> Result<(), NonFinite> {
-        self.key = Some(key.serialize(KeyName).unwrap_or_else(|_| "?".into()));
+        self.key = Some(key_name(key));
         Ok(())
     }
     fn serialize_value<T: ?Sized + Serialize>(&mut self, value: &T) -> Result<(), NonFinite> {
@@ -326,112 +286,13 @@ impl ser::SerializeMap for Compound<'_> {
     }
 }
 
-/// A map key as text (strings and integers; anything else is `?`).
-struct KeyName;
-
-macro_rules! key_display {
-    ($($m:ident: $t:ty),*) => {$(
-        fn $m(self, v: $t) -> Result<String, NonFinite> {
-            Ok(v.to_string())
-        }
-    )*};
-}
-
-impl ser::Serializer for KeyName {
-    type Ok = String;
-    type Error = NonFinite;
-    type SerializeSeq = Impossible<String, NonFinite>;
-    type SerializeTuple = Impossible<String, NonFinite>;
-    type SerializeTupleStruct = Impossible<String, NonFinite>;
-    type SerializeTupleVariant = Impossible<String, NonFinite>;
-    type SerializeMap = Impossible<String, NonFinite>;
-    type SerializeStruct = Impossible<String, NonFinite>;
-    type SerializeStructVariant = Impossible<String, NonFinite>;
-
-    key_display!(serialize_bool: bool, serialize_i8: i8, serialize_i16: i16, serialize_i32: i32,
-        serialize_i64: i64, serialize_u8: u8, serialize_u16: u16, serialize_u32: u32,
-        serialize_u64: u64, serialize_f32: f32, serialize_f64: f64, serialize_char: char,
-        serialize_str: &str);
-
-    fn serialize_bytes(self, _: &[u8]) -> Result<String, NonFinite> {
-        Ok("?".into())
-    }
-    fn serialize_none(self) -> Result<String, NonFinite> {
-        Ok("?".into())
-    }
-    fn serialize_some<T: ?Sized + Serialize>(self, v: &T) -> Result<String, NonFinite> {
-        v.serialize(self)
-    }
-    fn serialize_unit(self) -> Result<String, NonFinite> {
-        Ok("?".into())
-    }
-    fn serialize_unit_struct(self, name: &'static str) -> Result<String, NonFinite> {
-        Ok(name.into())
-    }
-    fn serialize_unit_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        variant: &'static str,
-    ) -> Result<String, NonFinite> {
-        Ok(variant.into())
-    }
-    fn serialize_newtype_struct<T: ?Sized + Serialize>(
-        self,
-        _: &'static str,
-        v: &T,
-    ) -> Result<String, NonFinite> {
-        v.serialize(self)
-    }
-    fn serialize_newtype_variant<T: ?Sized + Serialize>(
-        self,
-        _: &'static str,
-        _: u32,
-        variant: &'static str,
-        _: &T,
-    ) -> Result<String, NonFinite> {
-        Ok(variant.into())
-    }
-    fn serialize_seq(self, _: Option<usize>) -> Result<Self::SerializeSeq, NonFinite> {
-        Err(ser::Error::custom("?"))
-    }
-    fn serialize_tuple(self, _: usize) -> Result<Self::SerializeTuple, NonFinite> {
-        Err(ser::Error::custom("?"))
-    }
-    fn serialize_tuple_struct(
-        self,
-        _: &'static str,
-        _: usize,
-    ) -> Result<Self::SerializeTupleStruct, NonFinite> {
-        Err(ser::Error::custom("?"))
-    }
-    fn serialize_tuple_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-        _: usize,
-    ) -> Result<Self::SerializeTupleVariant, NonFinite> {
-        Err(ser::Error::custom("?"))
-    }
-    fn serialize_map(self, _: Option<usize>) -> Result<Self::SerializeMap, NonFinite> {
-        Err(ser::Error::custom("?"))
-    }
-    fn serialize_struct(
-        self,
-        _: &'static str,
-        _: usize,
-    ) -> Result<Self::SerializeStruct, NonFinite> {
-        Err(ser::Error::custom("?"))
-    }
-    fn serialize_struct_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-        _: usize,
-    ) -> Result<Self::SerializeStructVariant, NonFinite> {
-        Err(ser::Error::custom("?"))
+/// A map key as text (strings and numbers; anything else is `?`). Keys
+/// are short: one small `Value` each.
+fn key_name<T: ?Sized + Serialize>(key: &T) -> String {
+    match key.serialize(serde_json::value::Serializer) {
+        Ok(serde_json::Value::String(s)) => s,
+        Ok(v @ (serde_json::Value::Number(_) | serde_json::Value::Bool(_))) => v.to_string(),
+        _ => "?".into(),
     }
 }
 
@@ -483,6 +344,10 @@ mod tests {
         let e = find_non_finite(&std::collections::BTreeMap::from([("k", f64::NAN)])).unwrap_err();
         assert_eq!(e.path, "k");
         assert!(e.value.is_nan());
+        // integer keys are named by their number
+        let e = find_non_finite(&std::collections::BTreeMap::from([(7u32, [0.0, f64::NEG_INFINITY])]))
+            .unwrap_err();
+        assert_eq!(e.path, "7[1]");
         // serde_json would have written `null` where a number belongs
         assert_eq!(
             serde_json::to_string(&bad).unwrap(),

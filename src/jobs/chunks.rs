@@ -18,8 +18,15 @@
 //! running chunk reads its job's status every [`CANCEL_POLL`] and stops
 //! once the job is no longer running (cancelled, failed, gone).
 //!
-//! If the coordinator dies, its job lease expires and another worker
-//! becomes the coordinator; the chunks already done are kept.
+//! If the coordinator dies, its job lease expires and another worker (of
+//! any process) becomes the coordinator and assembles the answer; the
+//! chunks already done are kept. Such a takeover, while chunks remain, is
+//! not counted against the job's limit of attempts (`chunk_takeovers`
+//! counts it apart): the chunks count their own
+//! (the coordinator's death while it ran a chunk is that chunk's attempt),
+//! so a job dies of a chunk that kills its process every time, not of its
+//! coordinators' deaths. A job that ends (failed, cancelled) hands its
+//! running chunks back to `pending`, where nothing claims them.
 
 use std::ops::Range;
 use std::panic::{AssertUnwindSafe, catch_unwind};

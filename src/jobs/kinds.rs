@@ -793,6 +793,19 @@ impl JobSubmission {
         }))
     }
 
+    /// Upper estimate of the answer's size, bytes of JSON (a batch: the
+    /// sum of its items'); the store reserves it until the answer is stored.
+    pub fn answer_bytes_estimate(&self) -> u64 {
+        match self {
+            Self::One(item) => item.estimate().result_bytes,
+            Self::Batch(b) => b
+                .request
+                .iter()
+                .map(|i| i.estimate().result_bytes)
+                .fold(0u64, u64::saturating_add),
+        }
+    }
+
     /// `kind` as stored: a request kind, or `batch`.
     pub fn kind(&self) -> &'static str {
         match self {

@@ -201,6 +201,10 @@ impl JobQueue {
             priority: submission
                 .chunk_plan()
                 .map_or(0, |p| i64::from(p.count() > 1)),
+            reserve_bytes: submission
+                .answer_bytes_estimate()
+                .min(self.limits.max_job_result_bytes),
+            max_stored_bytes: self.limits.max_stored_bytes_per_token,
         };
         let submitted = match self.store.insert(&new)? {
             Inserted::New(id) => {

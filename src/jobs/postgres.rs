@@ -25,7 +25,11 @@
 //! under an advisory lock (idempotent; several processes may start at once):
 //! 1. `jobs` (as SQLite's versions 1–2, with `priority`);
 //! 2. `job_chunks` and `workers`;
-//! 3. `systems`: the named systems (SPEC §9), keyed by (owner, name).
+//! 3. `systems`: the named systems (SPEC §9), keyed by (owner, name);
+//! 4. `jobs.stored_bytes` (the store quota), `jobs.chunk_takeovers` and
+//!    `job_answers`: a done
+//!    job's answer in pages (`BYTEA`, streamed by `GET /api/v1/jobs/{id}`);
+//!    the answers of version 3 move there, one page each.
 
 use std::sync::{Mutex, MutexGuard};
 use std::time::Duration;
@@ -35,8 +39,8 @@ use postgres::{Client, NoTls, Row};
 use super::chunks::{ChunkLease, ChunkState, ClaimedChunk};
 use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
 use super::store::{
-    ClaimPolicy, ClaimedJob, InsertError, Inserted, JobBackend, JobRecord, JobStatus, KeyedJob,
-    NewJob, PutSystem, StoreError, StoredSystem,
+    ClaimPolicy, ClaimedJob, InsertError, Inserted, JobBackend, JobHead, JobRecord, JobStatus,
+    KeyedJob, NewJob, PutSystem, StoreError, StoredSystem,
 };
 
 const MIGRATIONS: &[(i32, &str)] = &[
@@ -105,10 +109,48 @@ const MIGRATIONS: &[(i32, &str)] = &[
             PRIMARY KEY (owner, name)
         );",
     ),
+    (
+        4,
+        "ALTER TABLE jobs ADD COLUMN stored_bytes BIGINT NOT NULL DEFAULT 0;
+        ALTER TABLE jobs ADD COLUMN chunk_takeovers INTEGER NOT NULL DEFAULT 0;
+        CREATE TABLE job_answers (
+            job_id BIGINT NOT NULL,
+            page   INTEGER NOT NULL,
+            data   BYTEA NOT NULL,
+            PRIMARY KEY (job_id, page)
+        );
+        INSERT INTO job_answers (job_id, page, data)
+            SELECT id, 0, convert_to(result, 'UTF8') FROM jobs
+            WHERE status = 'done' AND result IS NOT NULL;
+        UPDATE jobs SET stored_bytes = octet_length(request) + coalesce(octet_length(result), 0)
+            + coalesce(octet_length(error), 0), result = NULL;",
+    ),
 ];
 
 /// The current schema version.
-pub const SCHEMA_VERSION: i32 = 3;
+pub const SCHEMA_VERSION: i32 = 4;
+
+/// See the SQLite store: a claim of a job with chunks to run is counted
+/// in `chunk_takeovers`, not against its limit of attempts.
+const UNFINISHED_CHUNKS: &str =
+    "EXISTS (SELECT 1 FROM job_chunks c WHERE c.job_id = jobs.id AND c.status <> 'done')";
+
+/// The chunks of a finished job left running go back to pending.
+const RELEASE_ENDED_CHUNKS: &str = "UPDATE job_chunks SET status = 'pending', lease_expires_ms = NULL
+    WHERE status = 'running'
+      AND job_id IN (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled'))";
+
+/// Seconds since owner `$1`'s oldest finished job finished (NULL: none).
+const OLDEST_FINISHED: &str =
+    "SELECT extract(epoch FROM clock_timestamp() - min(finished_at)::TIMESTAMPTZ)::FLOAT8
+     FROM jobs WHERE owner IS NOT DISTINCT FROM $1::TEXT
+       AND status IN ('done', 'failed', 'cancelled')";
+
+/// Bytes kept by owner `$1` (NULL: no tokens): its jobs and named systems.
+const STORED_BYTES: &str = "SELECT
+    (SELECT coalesce(sum(stored_bytes), 0) FROM jobs WHERE owner IS NOT DISTINCT FROM $1::TEXT)::BIGINT
+    + (SELECT coalesce(sum(octet_length(body)), 0) FROM systems
+       WHERE owner = coalesce($1::TEXT, ''))::BIGINT";
 
 /// Advisory lock key of migrations (and of inserts: quotas are counted
 /// and the row written under it).
@@ -374,11 +416,26 @@ impl JobBackend for PgStore {
                     }));
                 }
             }
+            let adding = (job.request.len() as u64).saturating_add(job.reserve_bytes);
+            let stored: i64 = tx.query_one(STORED_BYTES, &[&job.owner])?.get(0);
+            let stored = stored.max(0) as u64;
+            if stored.saturating_add(adding) > job.max_stored_bytes {
+                let oldest_finished_s: Option<f64> =
+                    tx.query_one(OLDEST_FINISHED, &[&job.owner])?.get(0);
+                return Ok(Err(InsertError::StoreFull {
+                    stored,
+                    adding,
+                    limit: job.max_stored_bytes,
+                    oldest_finished_s,
+                }));
+            }
             let priority = job.priority as i32;
+            let stored_bytes = adding.min(i64::MAX as u64) as i64;
             let id: i64 = tx
                 .query_one(
-                    "INSERT INTO jobs (kind, request, status, owner, idempotency_key, request_hash, priority)
-                     VALUES ($1, $2, 'queued', $3, $4, $5, $6) RETURNING id",
+                    "INSERT INTO jobs (kind, request, status, owner, idempotency_key, request_hash, priority,
+                         stored_bytes)
+                     VALUES ($1, $2, 'queued', $3, $4, $5, $6, $7) RETURNING id",
                     &[
                         &job.kind,
                         &job.request,
@@ -386,6 +443,7 @@ impl JobBackend for PgStore {
                         &job.idempotency_key,
                         &job.request_hash,
                         &priority,
+                        &stored_bytes,
                     ],
                 )?
                 .get(0);
@@ -403,12 +461,15 @@ impl JobBackend for PgStore {
             let exhausted = c.execute(
                 &format!(
                     "UPDATE jobs SET status = 'failed', result = NULL, error = $1, finished_at = {NOW},
-                        lease_expires_ms = NULL
-                     WHERE status = 'running' AND coalesce(lease_expires_ms, 0) < $2 AND attempts >= $3"
+                        lease_expires_ms = NULL,
+                        stored_bytes = octet_length(request) + octet_length($1::TEXT)
+                     WHERE status = 'running' AND coalesce(lease_expires_ms, 0) < $2 AND attempts - chunk_takeovers >= $3
+                       AND NOT {UNFINISHED_CHUNKS}"
                 ),
                 &[&policy.exhausted_error, &now, &max_attempts],
             )?;
             if exhausted > 0 {
+                c.execute(RELEASE_ENDED_CHUNKS, &[])?;
                 tracing::warn!(
                     jobs = exhausted,
                     attempts = policy.max_attempts,
@@ -418,7 +479,10 @@ impl JobBackend for PgStore {
             let expires = now.saturating_add(millis(policy.lease));
             let row = c.query_opt(
                 &format!(
-                    "UPDATE jobs SET status = 'running', progress = 0, attempts = attempts + 1,
+                    "UPDATE jobs SET status = 'running', progress = 0,
+                        attempts = attempts + 1,
+                        chunk_takeovers = chunk_takeovers
+                            + (CASE WHEN {UNFINISHED_CHUNKS} THEN 1 ELSE 0 END),
                         started_at = {NOW}, lease_owner = $1, lease_expires_ms = $2,
                         lease_epoch = lease_epoch + 1
                      WHERE id = (SELECT id FROM jobs
@@ -457,37 +521,58 @@ impl JobBackend for PgStore {
         self.fenced("progress = $4", lease, Some(&p))
     }
 
+    /// The answer goes into `job_answers` in pages, in the transaction
+    /// that marks the job done.
     fn finish_done(&self, lease: &Lease, result: &str) -> Result<bool, StoreError> {
-        let done = self.fenced(
-            &format!(
-                "status = 'done', progress = 1, result = $4, error = NULL, finished_at = {NOW},
-                 lease_expires_ms = NULL"
-            ),
-            lease,
-            Some(&result),
-        )?;
-        if done {
+        let bytes = result.len() as i64;
+        self.with(|c| {
+            let mut tx = c.transaction()?;
+            let n = tx.execute(
+                &format!(
+                    "UPDATE jobs SET status = 'done', progress = 1, result = NULL, error = NULL,
+                        finished_at = {NOW}, lease_expires_ms = NULL,
+                        stored_bytes = octet_length(request) + $4::BIGINT
+                     WHERE {FENCE}"
+                ),
+                &[&lease.job_id, &lease.owner, &lease.epoch, &bytes],
+            )?;
+            if n != 1 {
+                return Ok(false);
+            }
+            let insert = tx.prepare(
+                "INSERT INTO job_answers (job_id, page, data) VALUES ($1, $2, $3)
+                 ON CONFLICT (job_id, page) DO UPDATE SET data = excluded.data",
+            )?;
+            for (i, page) in super::store::answer_pages(result).enumerate() {
+                let i = i as i32;
+                tx.execute(&insert, &[&lease.job_id, &i, &page])?;
+            }
             // the chunks' results are in the answer now: not kept twice
-            self.with(|c| {
-                c.execute(
-                    "UPDATE job_chunks SET result = NULL WHERE job_id = $1",
-                    &[&lease.job_id],
-                )?;
-                Ok(())
-            })?;
-        }
-        Ok(done)
+            tx.execute(
+                "UPDATE job_chunks SET result = NULL WHERE job_id = $1",
+                &[&lease.job_id],
+            )?;
+            tx.commit()?;
+            Ok(true)
+        })
     }
 
     fn finish_failed(&self, lease: &Lease, error: &str) -> Result<bool, StoreError> {
-        self.fenced(
+        let failed = self.fenced(
             &format!(
                 "status = 'failed', result = NULL, error = $4, finished_at = {NOW},
-                 lease_expires_ms = NULL"
+                 lease_expires_ms = NULL, stored_bytes = octet_length(request) + octet_length($4::TEXT)"
             ),
             lease,
             Some(&error),
-        )
+        )?;
+        if failed {
+            self.with(|c| {
+                c.execute(RELEASE_ENDED_CHUNKS, &[])?;
+                Ok(())
+            })?;
+        }
+        Ok(failed)
     }
 
     fn release(&self, lease: &Lease) -> Result<bool, StoreError> {
@@ -552,32 +637,78 @@ impl JobBackend for PgStore {
             c.execute(
                 &format!(
                     "UPDATE jobs SET status = 'cancelled', error = $2, finished_at = {NOW},
-                        lease_expires_ms = NULL
+                        lease_expires_ms = NULL,
+                        stored_bytes = octet_length(request) + octet_length($2::TEXT)
                      WHERE id = $1 AND status IN ('queued', 'running')
                        AND ($3::TEXT IS NULL OR owner = $3)"
                 ),
                 &[&id, &error, &owner],
             )?;
+            c.execute(RELEASE_ENDED_CHUNKS, &[])?;
             Ok(())
         })?;
         self.get_owned(id, owner)
     }
 
     fn get_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobRecord>, StoreError> {
+        let Some(head) = self.get_head(id, owner)? else {
+            return Ok(None);
+        };
+        let mut rec = head.record;
+        if head.answer_pages.is_some() {
+            let pages: Vec<Vec<u8>> = self.with(|c| {
+                Ok(c.query(
+                    "SELECT data FROM job_answers WHERE job_id = $1 ORDER BY page",
+                    &[&id],
+                )?
+                .iter()
+                .map(|r| r.get(0))
+                .collect())
+            })?;
+            rec.result = Some(super::store::join_pages(id, pages)?);
+        }
+        Ok(Some(rec))
+    }
+
+    fn get_head(&self, id: i64, owner: Option<&str>) -> Result<Option<JobHead>, StoreError> {
         self.with(|c| {
             Ok(c.query_opt(
                 &format!(
-                    "SELECT {COLUMNS}, result, error FROM jobs
-                     WHERE id = $1 AND ($2::TEXT IS NULL OR owner = $2)"
+                    "SELECT {COLUMNS}, error,
+                        (SELECT count(*) FROM job_answers WHERE job_id = jobs.id)
+                     FROM jobs WHERE id = $1 AND ($2::TEXT IS NULL OR owner = $2)"
                 ),
                 &[&id, &owner],
             )?
             .map(|r| {
-                let mut rec = record(&r);
-                rec.result = r.get(9);
-                rec.error = r.get(10);
-                rec
+                let mut record = record(&r);
+                record.error = r.get(9);
+                let pages: i64 = r.get(10);
+                let answer_pages =
+                    (record.status == JobStatus::Done).then_some(pages.max(0) as usize);
+                JobHead {
+                    record,
+                    answer_pages,
+                }
             }))
+        })
+    }
+
+    fn answer_page(&self, id: i64, page: usize) -> Result<Option<Vec<u8>>, StoreError> {
+        let page = page.min(i32::MAX as usize) as i32;
+        self.with(|c| {
+            Ok(c.query_opt(
+                "SELECT data FROM job_answers WHERE job_id = $1 AND page = $2",
+                &[&id, &page],
+            )?
+            .map(|r| r.get(0)))
+        })
+    }
+
+    fn stored_bytes(&self, owner: Option<&str>) -> Result<u64, StoreError> {
+        self.with(|c| {
+            let n: i64 = c.query_one(STORED_BYTES, &[&owner])?.get(0);
+            Ok(n.max(0) as u64)
         })
     }
 
@@ -798,12 +929,15 @@ impl JobBackend for PgStore {
                      AND finished_at IS NOT NULL
                      AND finished_at <= to_char((clock_timestamp() - make_interval(secs => $1))
                          AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.MS\"Z\"')";
-            tx.execute(
-                &format!(
-                    "DELETE FROM job_chunks WHERE job_id IN (SELECT id FROM jobs WHERE {expired})"
-                ),
-                &[&seconds],
-            )?;
+            tx.execute(RELEASE_ENDED_CHUNKS, &[])?;
+            for table in ["job_chunks", "job_answers"] {
+                tx.execute(
+                    &format!(
+                        "DELETE FROM {table} WHERE job_id IN (SELECT id FROM jobs WHERE {expired})"
+                    ),
+                    &[&seconds],
+                )?;
+            }
             let purged = tx.execute(&format!("DELETE FROM jobs WHERE {expired}"), &[&seconds])?;
             tx.execute("DELETE FROM workers WHERE heartbeat_ms < $1", &[&since])?;
             tx.commit()?;
@@ -830,11 +964,31 @@ impl JobBackend for PgStore {
         name: &str,
         body: &str,
         max_per_owner: usize,
+        max_stored_bytes: u64,
     ) -> Result<PutSystem, StoreError> {
         self.with(|c| {
             let mut tx = c.transaction()?;
             // Counted and written under the insert lock (the quota holds across processes).
             tx.execute("SELECT pg_advisory_xact_lock($1)", &[&INSERT_LOCK])?;
+            let jobs_owner = (!owner.is_empty()).then_some(owner);
+            let stored: i64 = tx.query_one(STORED_BYTES, &[&jobs_owner])?.get(0);
+            let replaced: i64 = tx
+                .query_one(
+                    "SELECT coalesce(sum(octet_length(body)), 0)::BIGINT FROM systems
+                     WHERE owner = $1 AND name = $2",
+                    &[&owner, &name],
+                )?
+                .get(0);
+            let stored = (stored - replaced).max(0) as u64;
+            if stored.saturating_add(body.len() as u64) > max_stored_bytes {
+                let oldest_finished_s: Option<f64> =
+                    tx.query_one(OLDEST_FINISHED, &[&jobs_owner])?.get(0);
+                return Ok(PutSystem::StoreFull {
+                    stored,
+                    limit: max_stored_bytes,
+                    oldest_finished_s,
+                });
+            }
             let updated = tx.execute(
                 &format!(
                     "UPDATE systems SET body = $3, updated_at = {NOW} WHERE owner = $1 AND name = $2"

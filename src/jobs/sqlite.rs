@@ -9,7 +9,11 @@
 //! 2. owner, idempotency key and body hash, lease owner/expiry/epoch;
 //! 3. job priority, `job_chunks` (leased chunks of large jobs), `workers`
 //!    (live workers), `schema_version`;
-//! 4. `systems`: the named systems (SPEC §9), keyed by (owner, name).
+//! 4. `systems`: the named systems (SPEC §9), keyed by (owner, name);
+//! 5. `jobs.stored_bytes` (the store quota), `jobs.chunk_takeovers`
+//!    (claims of a chunked job while chunks remain) and `job_answers`: a done
+//!    job's answer in pages (streamed by `GET /api/v1/jobs/{id}`); the
+//!    answers of version 4 move there, one page each.
 
 use std::path::Path;
 use std::sync::Mutex;
@@ -20,7 +24,8 @@ use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
 use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
 use super::store::{
     ChunkLease, ChunkState, ClaimPolicy, ClaimedChunk, ClaimedJob, InsertError, Inserted,
-    JobBackend, JobRecord, JobStatus, KeyedJob, NewJob, PutSystem, StoreError, StoredSystem,
+    JobBackend, JobHead, JobRecord, JobStatus, KeyedJob, NewJob, PutSystem, StoreError,
+    StoredSystem,
 };
 
 const SCHEMA_V1: &str = "
@@ -94,8 +99,47 @@ CREATE TABLE systems (
 INSERT OR IGNORE INTO schema_version (version) VALUES (4);
 ";
 
+const SCHEMA_V5: &str = "
+ALTER TABLE jobs ADD COLUMN stored_bytes INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE jobs ADD COLUMN chunk_takeovers INTEGER NOT NULL DEFAULT 0;
+CREATE TABLE job_answers (
+    job_id INTEGER NOT NULL,
+    page   INTEGER NOT NULL,
+    data   BLOB NOT NULL,
+    PRIMARY KEY (job_id, page)
+);
+INSERT INTO job_answers (job_id, page, data)
+    SELECT id, 0, CAST(result AS BLOB) FROM jobs WHERE status = 'done' AND result IS NOT NULL;
+UPDATE jobs SET stored_bytes = octet_length(request) + ifnull(octet_length(result), 0)
+    + ifnull(octet_length(error), 0), result = NULL;
+INSERT OR IGNORE INTO schema_version (version) VALUES (5);
+";
+
 /// The current schema version.
-pub const SCHEMA_VERSION: i64 = 4;
+pub const SCHEMA_VERSION: i64 = 5;
+
+/// A job that still has chunks to run: a new claim of it (its coordinator
+/// died) is counted in `chunk_takeovers` and not against its attempts
+/// (`attempts - chunk_takeovers` is compared with the limit), and such a
+/// job is not failed for its attempts: the chunks count their own.
+const UNFINISHED_CHUNKS: &str =
+    "EXISTS (SELECT 1 FROM job_chunks c WHERE c.job_id = jobs.id AND c.status <> 'done')";
+
+/// The chunks of a finished (failed, cancelled) job that were left
+/// running go back to pending: never claimed again (their job is not
+/// running), and none is left `running`.
+const RELEASE_ENDED_CHUNKS: &str = "UPDATE job_chunks SET status = 'pending', lease_expires_ms = NULL
+    WHERE status = 'running'
+      AND job_id IN (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled'))";
+
+/// Seconds since owner `?1`'s oldest finished job finished (NULL: none).
+const OLDEST_FINISHED: &str = "SELECT (julianday('now') - julianday(min(finished_at))) * 86400
+    FROM jobs WHERE owner IS ?1 AND status IN ('done', 'failed', 'cancelled')";
+
+/// Bytes kept by owner `?1` (NULL: no tokens): its jobs and named systems.
+const STORED_BYTES: &str = "SELECT
+    (SELECT ifnull(sum(stored_bytes), 0) FROM jobs WHERE owner IS ?1)
+    + (SELECT ifnull(sum(octet_length(body)), 0) FROM systems WHERE owner = ifnull(?1, ''))";
 
 const NOW: &str = "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')";
 
@@ -168,6 +212,8 @@ impl JobStore {
             max_pending: limit,
             max_pending_per_owner: limit,
             priority: 0,
+            reserve_bytes: 0,
+            max_stored_bytes: u64::MAX,
         };
         match self.insert(&job)? {
             Inserted::New(id) | Inserted::Existing { id, .. } => Ok(id),
@@ -271,6 +317,9 @@ fn migrate(conn: &mut Connection) -> Result<(), StoreError> {
     if version < 4 {
         tx.execute_batch(SCHEMA_V4)?;
     }
+    if version < 5 {
+        tx.execute_batch(SCHEMA_V5)?;
+    }
     tx.pragma_update(None, "user_version", SCHEMA_VERSION)?;
     tx.commit()?;
     Ok(())
@@ -354,16 +403,34 @@ impl JobBackend for JobStore {
                 });
             }
         }
+        let adding = (job.request.len() as u64).saturating_add(job.reserve_bytes);
+        let stored: i64 = tx
+            .query_row(STORED_BYTES, [job.owner], |r| r.get(0))
+            .map_err(StoreError::from)?;
+        let stored = stored.max(0) as u64;
+        if stored.saturating_add(adding) > job.max_stored_bytes {
+            let oldest_finished_s: Option<f64> = tx
+                .query_row(OLDEST_FINISHED, [job.owner], |r| r.get(0))
+                .map_err(StoreError::from)?;
+            return Err(InsertError::StoreFull {
+                stored,
+                adding,
+                limit: job.max_stored_bytes,
+                oldest_finished_s,
+            });
+        }
         tx.execute(
-            "INSERT INTO jobs (kind, request, status, owner, idempotency_key, request_hash, priority)
-             VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6)",
+            "INSERT INTO jobs (kind, request, status, owner, idempotency_key, request_hash, priority,
+                 stored_bytes)
+             VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6, ?7)",
             params![
                 job.kind,
                 job.request,
                 job.owner,
                 job.idempotency_key,
                 job.request_hash,
-                job.priority
+                job.priority,
+                adding.min(i64::MAX as u64) as i64
             ],
         )
         .map_err(StoreError::from)?;
@@ -379,12 +446,14 @@ impl JobBackend for JobStore {
         let exhausted = tx.execute(
             &format!(
                 "UPDATE jobs SET status = 'failed', result = NULL, error = ?1, finished_at = {NOW},
-                    lease_expires_ms = NULL
-                 WHERE status = 'running' AND ifnull(lease_expires_ms, 0) < ?2 AND attempts >= ?3"
+                    lease_expires_ms = NULL, stored_bytes = octet_length(request) + octet_length(?1)
+                 WHERE status = 'running' AND ifnull(lease_expires_ms, 0) < ?2 AND attempts - chunk_takeovers >= ?3
+                   AND NOT {UNFINISHED_CHUNKS}"
             ),
             params![policy.exhausted_error, now, policy.max_attempts],
         )?;
         if exhausted > 0 {
+            tx.execute(RELEASE_ENDED_CHUNKS, [])?;
             tracing::warn!(
                 jobs = exhausted,
                 attempts = policy.max_attempts,
@@ -395,7 +464,10 @@ impl JobBackend for JobStore {
         let claimed = tx
             .query_row(
                 &format!(
-                    "UPDATE jobs SET status = 'running', progress = 0, attempts = attempts + 1,
+                    "UPDATE jobs SET status = 'running', progress = 0,
+                        attempts = attempts + 1,
+                        chunk_takeovers = chunk_takeovers
+                            + (CASE WHEN {UNFINISHED_CHUNKS} THEN 1 ELSE 0 END),
                         started_at = {NOW}, lease_owner = ?1, lease_expires_ms = ?2,
                         lease_epoch = lease_epoch + 1
                      WHERE id = (SELECT id FROM jobs
@@ -432,34 +504,58 @@ impl JobBackend for JobStore {
         self.fenced("progress = ?4", lease, Some(&progress.clamp(0.0, 1.0)))
     }
 
+    /// The answer goes into `job_answers` in pages, in the transaction
+    /// that marks the job done.
     fn finish_done(&self, lease: &Lease, result: &str) -> Result<bool, StoreError> {
-        let done = self.fenced(
+        let mut conn = self.conn();
+        let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
+        let n = tx.execute(
             &format!(
-                "status = 'done', progress = 1, result = ?4, error = NULL, finished_at = {NOW},
-                 lease_expires_ms = NULL"
+                "UPDATE jobs SET status = 'done', progress = 1, result = NULL, error = NULL,
+                    finished_at = {NOW}, lease_expires_ms = NULL,
+                    stored_bytes = octet_length(request) + ?4
+                 WHERE {FENCE}"
             ),
-            lease,
-            Some(&result),
+            params![
+                lease.job_id,
+                lease.owner,
+                lease.epoch,
+                result.len() as i64
+            ],
         )?;
-        if done {
-            // the chunks' results are in the answer now: not kept twice
-            self.conn().execute(
-                "UPDATE job_chunks SET result = NULL WHERE job_id = ?1",
-                [lease.job_id],
-            )?;
+        if n != 1 {
+            return Ok(false);
         }
-        Ok(done)
+        {
+            let mut stmt = tx.prepare(
+                "INSERT OR REPLACE INTO job_answers (job_id, page, data) VALUES (?1, ?2, ?3)",
+            )?;
+            for (i, page) in super::store::answer_pages(result).enumerate() {
+                stmt.execute(params![lease.job_id, i as i64, page])?;
+            }
+        }
+        // the chunks' results are in the answer now: not kept twice
+        tx.execute(
+            "UPDATE job_chunks SET result = NULL WHERE job_id = ?1",
+            [lease.job_id],
+        )?;
+        tx.commit()?;
+        Ok(true)
     }
 
     fn finish_failed(&self, lease: &Lease, error: &str) -> Result<bool, StoreError> {
-        self.fenced(
+        let failed = self.fenced(
             &format!(
                 "status = 'failed', result = NULL, error = ?4, finished_at = {NOW},
-                 lease_expires_ms = NULL"
+                 lease_expires_ms = NULL, stored_bytes = octet_length(request) + octet_length(?4)"
             ),
             lease,
             Some(&error),
-        )
+        )?;
+        if failed {
+            self.conn().execute(RELEASE_ENDED_CHUNKS, [])?;
+        }
+        Ok(failed)
     }
 
     fn release(&self, lease: &Lease) -> Result<bool, StoreError> {
@@ -521,44 +617,68 @@ impl JobBackend for JobStore {
         error: &str,
     ) -> Result<Option<JobRecord>, StoreError> {
         let sql = format!(
-            "UPDATE jobs SET status = 'cancelled', error = ?2, finished_at = {NOW}, lease_expires_ms = NULL
+            "UPDATE jobs SET status = 'cancelled', error = ?2, finished_at = {NOW}, lease_expires_ms = NULL,
+                 stored_bytes = octet_length(request) + octet_length(?2)
              WHERE id = ?1 AND status IN ('queued', 'running') AND (?3 IS NULL OR owner = ?3)"
         );
-        self.conn().execute(&sql, params![id, error, owner])?;
+        if self.conn().execute(&sql, params![id, error, owner])? == 1 {
+            self.conn().execute(RELEASE_ENDED_CHUNKS, [])?;
+        }
         self.get_owned(id, owner)
     }
 
-    /// The answer is read with SQLite's incremental I/O straight into one
-    /// buffer of its size: a 100 MB answer costs 100 MB, not twice that
-    /// (SQLite's copy of the value and ours).
     fn get_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobRecord>, StoreError> {
-        let sql = format!(
-            "SELECT {}, octet_length(result), error FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
-            Self::COLUMNS
-        );
-        let conn = self.conn();
-        let found = conn
-            .query_row(&sql, params![id, owner], |r| {
-                let mut rec = Self::record(r)?;
-                rec.error = r.get(10)?;
-                Ok((rec, r.get::<_, Option<i64>>(9)?))
-            })
-            .optional()?;
-        let Some((mut rec, result_bytes)) = found else {
+        let Some(head) = self.get_head(id, owner)? else {
             return Ok(None);
         };
-        if let Some(n) = result_bytes {
-            use std::io::Read;
-            let mut blob = conn.blob_open(rusqlite::MAIN_DB, "jobs", "result", id, true)?;
-            let mut buf = vec![0u8; n.max(0) as usize];
-            blob.read_exact(&mut buf)
-                .map_err(|e| StoreError(format!("reading the answer of job {id}: {e}")))?;
-            rec.result =
-                Some(String::from_utf8(buf).map_err(|e| {
-                    StoreError(format!("the answer of job {id} is not UTF-8: {e}"))
-                })?);
+        let mut rec = head.record;
+        if head.answer_pages.is_some() {
+            let conn = self.conn();
+            let mut stmt =
+                conn.prepare("SELECT data FROM job_answers WHERE job_id = ?1 ORDER BY page")?;
+            let pages = stmt
+                .query_map([id], |r| r.get::<_, Vec<u8>>(0))?
+                .collect::<Result<Vec<_>, _>>()?;
+            rec.result = Some(super::store::join_pages(id, pages)?);
         }
         Ok(Some(rec))
+    }
+
+    fn get_head(&self, id: i64, owner: Option<&str>) -> Result<Option<JobHead>, StoreError> {
+        let sql = format!(
+            "SELECT {}, error, (SELECT count(*) FROM job_answers WHERE job_id = jobs.id)
+             FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
+            Self::COLUMNS
+        );
+        Ok(self
+            .conn()
+            .query_row(&sql, params![id, owner], |r| {
+                let mut record = Self::record(r)?;
+                record.error = r.get(9)?;
+                let pages: i64 = r.get(10)?;
+                let answer_pages = (record.status == JobStatus::Done).then_some(pages as usize);
+                Ok(JobHead {
+                    record,
+                    answer_pages,
+                })
+            })
+            .optional()?)
+    }
+
+    fn answer_page(&self, id: i64, page: usize) -> Result<Option<Vec<u8>>, StoreError> {
+        Ok(self
+            .conn()
+            .query_row(
+                "SELECT data FROM job_answers WHERE job_id = ?1 AND page = ?2",
+                params![id, page as i64],
+                |r| r.get(0),
+            )
+            .optional()?)
+    }
+
+    fn stored_bytes(&self, owner: Option<&str>) -> Result<u64, StoreError> {
+        let n: i64 = self.conn().query_row(STORED_BYTES, [owner], |r| r.get(0))?;
+        Ok(n.max(0) as u64)
     }
 
     fn list_owned(
@@ -775,12 +895,17 @@ impl JobBackend for JobStore {
                  (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled'))",
             [],
         )?;
-        tx.execute(
-            "DELETE FROM job_chunks WHERE job_id IN
-                 (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled')
-                     AND finished_at IS NOT NULL AND finished_at <= ?1)",
-            [&cutoff],
-        )?;
+        tx.execute(RELEASE_ENDED_CHUNKS, [])?;
+        for table in ["job_chunks", "job_answers"] {
+            tx.execute(
+                &format!(
+                    "DELETE FROM {table} WHERE job_id IN
+                         (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled')
+                             AND finished_at IS NOT NULL AND finished_at <= ?1)"
+                ),
+                [&cutoff],
+            )?;
+        }
         let purged = tx.execute(
             "DELETE FROM jobs WHERE status IN ('done', 'failed', 'cancelled')
                  AND finished_at IS NOT NULL AND finished_at <= ?1",
@@ -808,9 +933,27 @@ impl JobBackend for JobStore {
         name: &str,
         body: &str,
         max_per_owner: usize,
+        max_stored_bytes: u64,
     ) -> Result<PutSystem, StoreError> {
         let mut conn = self.conn();
         let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
+        let jobs_owner = (!owner.is_empty()).then_some(owner);
+        let stored: i64 = tx.query_row(STORED_BYTES, [jobs_owner], |r| r.get(0))?;
+        let replaced: i64 = tx.query_row(
+            "SELECT ifnull(sum(octet_length(body)), 0) FROM systems WHERE owner = ?1 AND name = ?2",
+            params![owner, name],
+            |r| r.get(0),
+        )?;
+        let stored = (stored - replaced).max(0) as u64;
+        if stored.saturating_add(body.len() as u64) > max_stored_bytes {
+            let oldest_finished_s: Option<f64> =
+                tx.query_row(OLDEST_FINISHED, [jobs_owner], |r| r.get(0))?;
+            return Ok(PutSystem::StoreFull {
+                stored,
+                limit: max_stored_bytes,
+                oldest_finished_s,
+            });
+        }
         let updated = tx.execute(
             &format!(
                 "UPDATE systems SET body = ?3, updated_at = {NOW} WHERE owner = ?1 AND name = ?2"

@@ -13,6 +13,17 @@
 //!
 //! Jobs carry an owner (the hash of the API token that submitted them, or
 //! none without tokens) and optionally an idempotency key, unique per owner.
+//!
+//! A done job's answer is stored in pages of [`ANSWER_PAGE_BYTES`], so that
+//! `GET /api/v1/jobs/{id}` streams it page by page ([`JobBackend::get_head`],
+//! [`JobBackend::answer_page`]) instead of building it in memory.
+//!
+//! Store quota (issue 22): every job row counts the bytes it keeps
+//! (`stored_bytes`: its request, plus its estimated answer while queued or
+//! running, then its answer or error), and an owner's jobs and named
+//! systems together may keep at most [`NewJob::max_stored_bytes`]; a
+//! submission or a named system past it is refused
+//! ([`InsertError::StoreFull`], [`PutSystem::StoreFull`]).
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -87,6 +98,19 @@ pub enum InsertError {
     )]
     QuotaFull { pending: usize, limit: usize },
     #[error(
+        "this token keeps {stored} bytes of jobs and named systems and this job would add about \
+         {adding} more (its request and its estimated answer), past the {limit} bytes kept per \
+         token: delete named systems it no longer needs, or wait until its finished jobs expire"
+    )]
+    StoreFull {
+        stored: u64,
+        adding: u64,
+        limit: u64,
+        /// Seconds since the owner's oldest finished job finished (None: none
+        /// finished): with the retention, when room is freed next.
+        oldest_finished_s: Option<f64>,
+    },
+    #[error(
         "Idempotency-Key `{key}` was first used for job {id} with a different body; \
          use a new key for a different request"
     )]
@@ -114,6 +138,36 @@ pub struct NewJob<'a> {
     /// Claim order: lower first (0: one piece of work, 1: a chunked job),
     /// then oldest first; short jobs pass long ones.
     pub priority: i64,
+    /// Bytes reserved for the answer until it is stored (its estimate).
+    pub reserve_bytes: u64,
+    /// Bytes the owner's jobs and named systems may keep at once.
+    pub max_stored_bytes: u64,
+}
+
+/// Bytes of one page of a stored answer.
+pub const ANSWER_PAGE_BYTES: usize = 256 << 10;
+
+/// A job row without its answer, and how many pages its answer has.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JobHead {
+    /// The row (`result` is None).
+    pub record: JobRecord,
+    /// Pages of the answer ([`JobBackend::answer_page`]); None unless done.
+    pub answer_pages: Option<usize>,
+}
+
+/// `text` cut into the pages it is stored in.
+pub fn answer_pages(text: &str) -> impl Iterator<Item = &[u8]> {
+    text.as_bytes().chunks(ANSWER_PAGE_BYTES)
+}
+
+/// Pages read back into the answer text.
+pub fn join_pages(id: i64, pages: Vec<Vec<u8>>) -> Result<String, StoreError> {
+    let mut buf = Vec::with_capacity(pages.iter().map(Vec::len).sum());
+    for p in pages {
+        buf.extend_from_slice(&p);
+    }
+    String::from_utf8(buf).map_err(|e| StoreError(format!("the answer of job {id} is not UTF-8: {e}")))
 }
 
 /// What an insert did.
@@ -218,6 +272,15 @@ pub trait JobBackend: Send + Sync {
     ) -> Result<Option<JobRecord>, StoreError>;
     /// One job with its answer or error (None: unknown or another owner's).
     fn get_owned(&self, id: i64, owner: Option<&str>) -> Result<Option<JobRecord>, StoreError>;
+    /// One job with its error but without its answer, and the number of
+    /// pages of its answer (None: unknown or another owner's).
+    fn get_head(&self, id: i64, owner: Option<&str>) -> Result<Option<JobHead>, StoreError>;
+    /// Page `page` of a done job's answer (None: no such page, or the job
+    /// is gone).
+    fn answer_page(&self, id: i64, page: usize) -> Result<Option<Vec<u8>>, StoreError>;
+    /// Bytes kept for `owner` (None: no tokens): its jobs' `stored_bytes`
+    /// and its named systems.
+    fn stored_bytes(&self, owner: Option<&str>) -> Result<u64, StoreError>;
     /// Jobs, newest first, without answers.
     fn list_owned(
         &self,
@@ -290,13 +353,15 @@ pub trait JobBackend: Send + Sync {
     // Named systems (SPEC §9), keyed by (owner, name); `owner` is the
     // token's hash, "" without tokens.
 
-    /// Stores (or replaces) a named system; at most `max_per_owner` per owner.
+    /// Stores (or replaces) a named system; at most `max_per_owner` per
+    /// owner, and within the owner's `max_stored_bytes`.
     fn put_system(
         &self,
         owner: &str,
         name: &str,
         body: &str,
         max_per_owner: usize,
+        max_stored_bytes: u64,
     ) -> Result<PutSystem, StoreError>;
     /// One named system of `owner`.
     fn get_system(&self, owner: &str, name: &str) -> Result<Option<StoredSystem>, StoreError>;
@@ -320,13 +385,21 @@ pub struct StoredSystem {
 }
 
 /// What storing a named system did.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PutSystem {
     Created,
     Updated,
     /// The owner already has `max` systems (nothing stored).
     Full {
         max: usize,
+    },
+    /// The owner's jobs and systems would keep more than `limit` bytes
+    /// (they keep `stored`; nothing stored).
+    StoreFull {
+        stored: u64,
+        limit: u64,
+        /// As [`InsertError::StoreFull`]'s.
+        oldest_finished_s: Option<f64>,
     },
 }
 
