@@ -6,6 +6,7 @@
 pub mod bands;
 pub mod chart_chunks;
 pub mod dto;
+pub mod dynamics;
 pub mod envelope;
 pub mod equilibrium;
 pub mod finite;
