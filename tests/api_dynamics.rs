@@ -107,8 +107,10 @@ async fn steady_wind_stays_at_its_equilibrium() {
     assert!((peak - start).abs() < 1e-6 * start, "{peak} {start}");
     assert!((min - start).abs() < 1e-6 * start, "{min} {start}");
     assert_eq!(body["quasi_static"]["max_wind_change_m_s"], 0.0);
+    // The static tension at the same wind is the continuum §6 one, which
+    // the lumped tether of 50 segments matches to O(N⁻²) (3.6e-5 here).
     let factor = f(&body["dynamic_factor_nondim"]);
-    assert!((factor - 1.0).abs() < 1e-6, "{factor}");
+    assert!((factor - 1.0).abs() < 1e-4, "{factor}");
     // The continuum equilibrium of /equilibrium (RK4, 100 steps) and the
     // lumped tether of 50 segments differ by O(N⁻²): within 0.1 % here.
     let eq = json!({
@@ -184,7 +186,8 @@ async fn a_one_minus_cosine_gust_is_the_direct_numerics_run() {
     }
     assert_eq!(body["shapes"].as_array().unwrap().len(), 5);
     assert_eq!(body["shapes"][0]["nodes"].as_array().unwrap().len(), 51);
-    assert_eq!(body["shapes"][2]["time_s"], 30.0);
+    // Shapes at the step nearest each asked time (steps of 0.05 s).
+    assert!((f(&body["shapes"][2]["time_s"]) - 30.0).abs() < 0.026, "{}", body["shapes"][2]["time_s"]);
 }
 
 #[tokio::test]
@@ -248,7 +251,7 @@ async fn bad_input_is_refused_naming_the_field() {
     let cases: Vec<(Value, &str)> = vec![
         (
             with_history(json!({"kind": "gale", "speed_m_s": 3.0})),
-            "wind.time_history",
+            "wind.time_history.kind",
         ),
         (
             with_history(json!({"kind": "one_minus_cosine", "start_time_s": 5.0,

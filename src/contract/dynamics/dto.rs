@@ -285,10 +285,14 @@ pub struct SlackEventOutput {
 /// at the same wind.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
 pub struct QuasiStaticOutput {
-    /// Winch tension in the steady flow at the start (N): where the run starts.
+    /// Winch tension at rest in the steady flow at t = 0 (N): the lumped
+    /// tether's static equilibrium, where the run starts.
     pub start_winch_tension_n: f64,
-    /// Aerostat altitude in the steady flow at the start (m).
+    /// Aerostat altitude at t = 0 (m).
     pub start_aerostat_altitude_m: f64,
+    /// The same from the continuum equilibrium of SPEC §6 (N): the lumped
+    /// tether's differs from it by O(segments⁻²).
+    pub continuum_start_winch_tension_n: f64,
     /// Largest and smallest change of the wind over the run (m/s): the
     /// time history's (turbulence: the fluctuation at the aerostat, over the samples).
     pub max_wind_change_m_s: f64,

@@ -184,8 +184,15 @@ pub fn response(req: &DynamicsRequest, prepared: &Prepared, ran: &Ran) -> Dynami
         .fold(f64::INFINITY, f64::min);
     let params = p.parameters(c.segments);
     let quasi_static = QuasiStaticOutput {
-        start_winch_tension_n: run.equilibrium.winch_tension_n,
-        start_aerostat_altitude_m: run.equilibrium.altitude_m,
+        start_winch_tension_n: run
+            .samples
+            .first()
+            .map_or(run.equilibrium.winch_tension_n, |s| s.winch_tension_n),
+        start_aerostat_altitude_m: run
+            .samples
+            .first()
+            .map_or(run.equilibrium.altitude_m, |s| s.aerostat_altitude_m),
+        continuum_start_winch_tension_n: run.equilibrium.winch_tension_n,
         max_wind_change_m_s: max_change,
         min_wind_change_m_s: min_change,
         winch_tension_at_max_wind_n: at_max.as_ref().map(|e| e.winch_tension_n),
