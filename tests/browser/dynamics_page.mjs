@@ -116,9 +116,9 @@ try {
   check(p1 === p0, "Pause stops it");
   await page.click("#dyn-play");
 
-  // The inputs are in the URL by their request paths.
+  // The inputs are in the URL by their request paths (those that differ from the page's defaults).
   const href = await page.evaluate(() => window.location.search);
-  check(/dynamics\.wind\.time_history\.amplitude_m_s=6/.test(href) && /dynamics\.tether_length_m=800/.test(href), "the panel's inputs are in the URL");
+  check(/dynamics\.tether_length_m=800/.test(href) && /dynamics\.duration_s=40/.test(href) && /dynamics\.numerics\.segments=30/.test(href), `the panel's inputs are in the URL (${href.length} characters)`);
   await page.locator("#dynamics").screenshot({ path: path.join(artifacts, "dynamics_page.png") });
 
   phase = "peaks";
