@@ -96,7 +96,12 @@ fn f(v: &Value) -> f64 {
 #[tokio::test]
 async fn steady_wind_stays_at_its_equilibrium() {
     let (app, _) = app();
-    let (status, body) = post(&app, "/api/v1/dynamics", &request(json!({"duration_s": 120.0}))).await;
+    let (status, body) = post(
+        &app,
+        "/api/v1/dynamics",
+        &request(json!({"duration_s": 120.0})),
+    )
+    .await;
     assert_eq!(status, StatusCode::OK, "{body}");
     assert_eq!(body["outcome"], "completed");
     let start = f(&body["quasi_static"]["start_winch_tension_n"]);
@@ -125,7 +130,10 @@ async fn steady_wind_stays_at_its_equilibrium() {
         "steady: start {start} N, peak {peak} N, continuum {continuum} N ({:+.3e} relative)",
         start / continuum - 1.0
     );
-    assert!((start / continuum - 1.0).abs() < 1e-3, "{start} {continuum}");
+    assert!(
+        (start / continuum - 1.0).abs() < 1e-3,
+        "{start} {continuum}"
+    );
     let alt = f(&body["samples"][120]["aerostat_altitude_m"]);
     assert!(
         (alt - f(&eq["aerostat_altitude_m"])).abs() < 1.0,
@@ -148,7 +156,10 @@ async fn a_one_minus_cosine_gust_is_the_direct_numerics_run() {
     let start = f(&body["quasi_static"]["start_winch_tension_n"]);
     let peak = f(&body["peak_winch_tension_n"]);
     let qs = f(&body["quasi_static"]["winch_tension_at_max_wind_n"]);
-    assert!(peak > start * 1.01, "the gust raises the tension: {peak} {start}");
+    assert!(
+        peak > start * 1.01,
+        "the gust raises the tension: {peak} {start}"
+    );
     assert!(qs > start, "{qs} {start}");
     assert_eq!(f(&body["quasi_static"]["max_wind_change_m_s"]), 6.0);
     eprintln!(
@@ -175,7 +186,10 @@ async fn a_one_minus_cosine_gust_is_the_direct_numerics_run() {
     )
     .unwrap();
     assert_eq!(run.peak_winch_tension.value, peak);
-    assert_eq!(run.peak_winch_tension.time_s, f(&body["peak_winch_tension_time_s"]));
+    assert_eq!(
+        run.peak_winch_tension.time_s,
+        f(&body["peak_winch_tension_time_s"])
+    );
     assert_eq!(run.min_winch_tension.value, f(&body["min_winch_tension_n"]));
     let samples = body["samples"].as_array().unwrap();
     assert_eq!(samples.len(), run.samples.len());
@@ -187,7 +201,11 @@ async fn a_one_minus_cosine_gust_is_the_direct_numerics_run() {
     assert_eq!(body["shapes"].as_array().unwrap().len(), 5);
     assert_eq!(body["shapes"][0]["nodes"].as_array().unwrap().len(), 51);
     // Shapes at the step nearest each asked time (steps of 0.05 s).
-    assert!((f(&body["shapes"][2]["time_s"]) - 30.0).abs() < 0.026, "{}", body["shapes"][2]["time_s"]);
+    assert!(
+        (f(&body["shapes"][2]["time_s"]) - 30.0).abs() < 0.026,
+        "{}",
+        body["shapes"][2]["time_s"]
+    );
 }
 
 #[tokio::test]
@@ -203,7 +221,9 @@ async fn a_step_gust_raises_the_tension_above_the_mean() {
     assert!(peak > start, "{peak} {start}");
     eprintln!("step 8 → 12 m/s: start {start:.2} N, peak {peak:.2} N, static at 12 m/s {qs:.2} N");
     // The gust blows the aerostat down.
-    assert!(f(&body["min_aerostat_altitude_m"]) < f(&body["quasi_static"]["start_aerostat_altitude_m"]));
+    assert!(
+        f(&body["min_aerostat_altitude_m"]) < f(&body["quasi_static"]["start_aerostat_altitude_m"])
+    );
 }
 
 #[tokio::test]
@@ -259,7 +279,9 @@ async fn bad_input_is_refused_naming_the_field() {
             "wind.time_history.duration_s",
         ),
         (
-            with_history(json!({"kind": "step", "time_s": 5.0, "speed_m_s": 10.0, "gust_m_s": 3.0})),
+            with_history(
+                json!({"kind": "step", "time_s": 5.0, "speed_m_s": 10.0, "gust_m_s": 3.0}),
+            ),
             "wind.time_history.gust_m_s",
         ),
         (
@@ -278,7 +300,10 @@ async fn bad_input_is_refused_naming_the_field() {
         (request(json!({"duration_s": -1.0})), "duration_s"),
         (request(json!({"duration_s": 1.0e9})), "duration_s"),
         (request(json!({"sample_count": 1})), "sample_count"),
-        (request(json!({"numerics": {"segments": 1}})), "numerics.segments"),
+        (
+            request(json!({"numerics": {"segments": 1}})),
+            "numerics.segments",
+        ),
         (request(json!({"shape_count": 1001})), "shape_count"),
         (
             request(json!({"profile": {"kind": "constant_rate", "rate_m_s": 1.0}})),
@@ -295,10 +320,16 @@ async fn bad_input_is_refused_naming_the_field() {
     }
     // No EA: the dynamics needs the elastic response.
     let mut req = request(json!({}));
-    req["cable"].as_object_mut().unwrap().remove("axial_stiffness_n");
+    req["cable"]
+        .as_object_mut()
+        .unwrap()
+        .remove("axial_stiffness_n");
     let (status, text) = post_text(&app, "/api/v1/dynamics", &req).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{text}");
-    assert_eq!(common::error(&text).1.as_deref(), Some("cable.axial_stiffness_n"));
+    assert_eq!(
+        common::error(&text).1.as_deref(),
+        Some("cable.axial_stiffness_n")
+    );
     // Too long for a synchronous answer: 422 too_large naming the field; a job takes it.
     let req = request(json!({"duration_s": 4000.0}));
     let (status, text) = post_text(&app, "/api/v1/dynamics", &req).await;
@@ -319,8 +350,10 @@ async fn bad_input_is_refused_naming_the_field() {
 #[tokio::test]
 async fn the_job_door_gives_the_synchronous_answer() {
     let (app, queue) = app();
-    let req = with_history(json!({"kind": "ramp", "start_time_s": 5.0, "duration_s": 10.0,
-        "speed_m_s": 11.0}));
+    let req = with_history(
+        json!({"kind": "ramp", "start_time_s": 5.0, "duration_s": 10.0,
+        "speed_m_s": 11.0}),
+    );
     let (status, direct) = post(&app, "/api/v1/dynamics", &req).await;
     assert_eq!(status, StatusCode::OK, "{direct}");
     let (status, body) = post(
@@ -337,7 +370,11 @@ async fn the_job_door_gives_the_synchronous_answer() {
         .unwrap()
         .expect("a job ran");
     let job = common::get(&app, &format!("/api/v1/jobs/{id}")).await;
-    assert_eq!(job["status"], serde_json::to_value(JobStatus::Done).unwrap(), "{job}");
+    assert_eq!(
+        job["status"],
+        serde_json::to_value(JobStatus::Done).unwrap(),
+        "{job}"
+    );
     assert_eq!(job["progress"], 1.0);
     assert_eq!(job["result"], direct);
 }
@@ -401,7 +438,11 @@ fn peaks_are_the_same_at_any_chunk_size_and_worker_count() {
         let parts: Vec<String> = (0..plan.count())
             .map(|c| sub.run_chunk(plan.range(c), &NoProgress).unwrap())
             .collect();
-        assert_eq!(sub.assemble(plan, &parts).unwrap(), single, "chunks of {per_chunk}");
+        assert_eq!(
+            sub.assemble(plan, &parts).unwrap(),
+            single,
+            "chunks of {per_chunk}"
+        );
     }
     // Through the queue, two workers sharing the job's chunks.
     let dir = std::env::temp_dir().join(format!("tetherplan-dyn-peaks-{}", std::process::id()));

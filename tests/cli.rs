@@ -185,7 +185,9 @@ fn dynamics_and_its_peaks_from_stdin() {
     assert_eq!(json["outcome"], "completed");
     assert!(
         json["peak_winch_tension_n"].as_f64().unwrap()
-            > json["quasi_static"]["start_winch_tension_n"].as_f64().unwrap()
+            > json["quasi_static"]["start_winch_tension_n"]
+                .as_f64()
+                .unwrap()
     );
     let (code, json) = run(
         &["dynamics"],

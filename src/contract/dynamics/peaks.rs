@@ -367,11 +367,7 @@ pub fn peak_samples(
     out
 }
 
-fn distribution(
-    mut values: Vec<f64>,
-    levels: &[f64],
-    confidence: f64,
-) -> PeakDistributionOutput {
+fn distribution(mut values: Vec<f64>, levels: &[f64], confidence: f64) -> PeakDistributionOutput {
     let n = values.len();
     let (mean, std) = mean_std(&values);
     let intervals: Vec<_> = levels
@@ -467,7 +463,9 @@ pub fn summarise(
         ));
     }
     if let Some(t) = quasi_static.mean_wind_winch_tension_n {
-        explanation.push_str(&format!("; the static tension is {t:.1} N in the mean wind"));
+        explanation.push_str(&format!(
+            "; the static tension is {t:.1} N in the mean wind"
+        ));
     }
     if let (Some(g), Some(pa)) = (quasi_static.gust_check_winch_tension_n, &above) {
         explanation.push_str(&format!(

@@ -398,21 +398,20 @@ impl DynamicsRequest {
         };
         problem.validate()?;
         // A tabulated flow's "speed" is read at the aerostat's starting altitude.
-        let start_altitude = if reference_height(&self.wind.flow).is_none()
-            && self.wind.time_history.is_some()
-        {
-            let l0 = problem.length.at(0.0).length_m;
-            problem
-                .static_problem(l0)
-                .solve(&EquilibriumConfig {
-                    steps: segments.max(50),
-                    max_iterations: 60,
-                    keep_shape: false,
-                })?
-                .altitude_m
-        } else {
-            0.0
-        };
+        let start_altitude =
+            if reference_height(&self.wind.flow).is_none() && self.wind.time_history.is_some() {
+                let l0 = problem.length.at(0.0).length_m;
+                problem
+                    .static_problem(l0)
+                    .solve(&EquilibriumConfig {
+                        steps: segments.max(50),
+                        max_iterations: 60,
+                        keep_shape: false,
+                    })?
+                    .altitude_m
+            } else {
+                0.0
+            };
         let (gusts, turbulence) = self.wind_in_time(&problem.flow, start_altitude);
         problem.gusts = gusts;
         problem.turbulence = turbulence;
