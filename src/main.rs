@@ -115,6 +115,12 @@ enum Command {
     /// Uncertainty bands of a deployment chart: 5/50/95 % of h* and t*
     /// per rate under uncertain inputs (seeded Monte Carlo).
     Bands(InputArg),
+    /// The tether in time through a gust or turbulence, from rest in the
+    /// static equilibrium of `wind.flow` (progress bar in time steps).
+    Dynamics(InputArg),
+    /// The largest tension over an exposure, Monte Carlo over turbulence
+    /// seeds (progress bar in samples).
+    DynamicsPeaks(InputArg),
 }
 
 /// A progress bar on standard error for `total` units of `what`.
@@ -269,6 +275,21 @@ fn main() -> ExitCode {
         Command::Bands(arg) => answer_with(arg, contract::bands::parse_bands, |req| {
             let bar = progress_bar(req.params.uncertainty.samples as u64, "samples");
             let out = contract::bands::bands(req, Parallelism::Rayon, &bar);
+            bar.0.finish_and_clear();
+            out
+        }),
+        Command::Dynamics(arg) => answer_with(arg, contract::dynamics::parse_dynamics, |req| {
+            let prepared = req.prepare()?;
+            let bar = progress_bar(prepared.steps as u64, "time steps");
+            let out = contract::dynamics::run::run_prepared(&prepared, &bar)
+                .map(|ran| contract::dynamics::run::response(req, &prepared, &ran));
+            bar.0.finish_and_clear();
+            out
+        }),
+        Command::DynamicsPeaks(arg) => answer_with(arg, contract::dynamics::parse_peaks, |req| {
+            req.prepare()?;
+            let bar = progress_bar(req.samples as u64, "samples");
+            let out = contract::dynamics::peaks::peaks(req, Parallelism::Rayon, &bar);
             bar.0.finish_and_clear();
             out
         }),

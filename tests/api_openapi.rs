@@ -121,6 +121,22 @@ fn every_route_is_documented_with_its_statuses() {
         ),
         (
             "post",
+            "/api/v1/dynamics",
+            "run_dynamics",
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
+        ),
+        (
+            "post",
+            "/api/v1/dynamics/peaks",
+            "run_dynamics_peaks",
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
+        ),
+        (
+            "post",
             "/api/v1/jobs",
             "create_job",
             &[
@@ -249,6 +265,10 @@ fn numeric_fields_name_their_unit() {
         "low",
         "high",
         "seed",
+        // The dynamics' mesh (segments), its step halvings, a sample's index.
+        "segments",
+        "halvings",
+        "sample",
     ];
     // Dimensionless by name: ratios (E*, γ̃ as the issues name them), step
     // and sample counts, Newton iteration counts, relative tolerances,
@@ -268,6 +288,8 @@ fn numeric_fields_name_their_unit() {
         "_cuts",
         // Counts of processes (`/healthz` live_workers).
         "_workers",
+        // Counts of kept outputs (the dynamics' `sample_count`, `shape_count`).
+        "_count",
     ];
     let doc = doc();
     let mut offenders = vec![];

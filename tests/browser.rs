@@ -22,6 +22,11 @@
 //!   the feasible region's outline, the region labels, CSV/PNG export with
 //!   the inputs, a job with progress, and screenshots the page at 1280×800
 //!   and 390×844.
+//! * `dynamics_page.mjs` opens a shared URL with a 1 − cos gust case: the
+//!   panel runs at once; the peak winch tension shown is the API's, the
+//!   tension and altitude plots are drawn, the shape animation advances and
+//!   pauses; the peak distribution of 6 seeds is drawn with the gust check;
+//!   an invalid gust duration shows the API's error beside its field.
 //! * `docs_page.mjs` runs every POST operation's "Try it out" in `/docs`
 //!   with the document's example (each must answer 2xx) under the CSP.
 //!
@@ -217,4 +222,9 @@ fn bands_page_in_headless_chromium() {
 #[test]
 fn envelope_page_in_headless_chromium() {
     run_page_script("envelope_page.mjs");
+}
+
+#[test]
+fn dynamics_page_in_headless_chromium() {
+    run_page_script("dynamics_page.mjs");
 }

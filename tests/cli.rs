@@ -172,3 +172,31 @@ fn ge_chart_and_base_excitation_from_stdin() {
     assert_eq!(json["points"].as_array().unwrap().len(), 2);
     assert_eq!(json["reduced_model_bands"].as_array().unwrap().len(), 2);
 }
+
+#[test]
+fn dynamics_and_its_peaks_from_stdin() {
+    use utoipa::PartialSchema;
+    let example = |schema: utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>| {
+        serde_json::to_value(schema).unwrap()["example"].to_string()
+    };
+    let req = example(tetherplan::contract::dynamics::DynamicsRequest::schema());
+    let (code, json) = run(&["dynamics"], &req);
+    assert_eq!(code, 0, "{json}");
+    assert_eq!(json["outcome"], "completed");
+    assert!(
+        json["peak_winch_tension_n"].as_f64().unwrap()
+            > json["quasi_static"]["start_winch_tension_n"]
+                .as_f64()
+                .unwrap()
+    );
+    let (code, json) = run(
+        &["dynamics"],
+        &req.replace(r#""amplitude_m_s":6.0"#, r#""amplitude_m_s":600.0"#),
+    );
+    assert_eq!(code, 2, "{json}");
+    assert_eq!(json["error"]["field"], "wind.time_history.amplitude_m_s");
+    let req = example(tetherplan::contract::dynamics::DynamicsPeaksRequest::schema());
+    let (code, json) = run(&["dynamics-peaks"], &req);
+    assert_eq!(code, 0, "{json}");
+    assert_eq!(json["samples"].as_array().unwrap().len(), 8);
+}

@@ -13,6 +13,7 @@ pub mod assets;
 pub mod auth;
 pub mod auth_doc;
 pub mod bands;
+pub mod dynamics;
 pub mod error;
 pub mod guard;
 pub mod jobs;
@@ -160,6 +161,8 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
             "/api/v1/envelope/bands",
             post(bands::compute_envelope_bands),
         )
+        .route("/api/v1/dynamics", post(dynamics::run_dynamics))
+        .route("/api/v1/dynamics/peaks", post(dynamics::run_dynamics_peaks))
         .route("/api/v1/systems", get(systems::list_systems))
         .route(
             "/api/v1/systems/{name}",

@@ -39,6 +39,8 @@ use crate::jobs::store::JobStatus;
         solve::compute_bands,
         crate::api::bands::compute_plan_bands,
         crate::api::bands::compute_envelope_bands,
+        crate::api::dynamics::run_dynamics,
+        crate::api::dynamics::run_dynamics_peaks,
         crate::api::systems::put_system,
         crate::api::systems::get_system,
         crate::api::systems::delete_system,
@@ -58,6 +60,7 @@ use crate::jobs::store::JobStatus;
         crate::contract::ge_critical::GeCriticalResponse, crate::contract::ge_critical::GeStabilityResponse,
         Health, crate::contract::bands::BandsResponse,
         crate::contract::bands::PlanBandsResponse, crate::contract::bands::EnvelopeBandsResponse,
+        crate::contract::dynamics::DynamicsResponse, crate::contract::dynamics::DynamicsPeaksResponse,
     )),
     modifiers(&BearerTokens),
     tags(

@@ -4,6 +4,7 @@
 //! ([`run`]). Everything here is synchronous and CPU-bound.
 
 pub mod bands;
+pub mod dynamics;
 pub mod envelope;
 pub mod equilibrium;
 pub mod error;

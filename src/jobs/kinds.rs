@@ -575,6 +575,10 @@ job_kinds!(
     PlanBands(crate::contract::bands::PlanBandsRequest),
     /// `POST /api/v1/envelope/bands`, up to 2 000 000 equilibria (samples × cells).
     EnvelopeBands(crate::contract::bands::EnvelopeBandsRequest),
+    /// `POST /api/v1/dynamics`: one run in time (progress in steps).
+    Dynamics(crate::contract::dynamics::DynamicsRequest),
+    /// `POST /api/v1/dynamics/peaks`: Monte Carlo over turbulence seeds, chunked by sample.
+    DynamicsPeaks(crate::contract::dynamics::DynamicsPeaksRequest),
 );
 
 impl JobItem {
@@ -704,6 +708,8 @@ pub const ITEM_RESULT_SCHEMAS: &[&str] = &[
     "PlanResponse",
     "PlanBandsResponse",
     "EnvelopeBandsResponse",
+    "DynamicsResponse",
+    "DynamicsPeaksResponse",
 ];
 
 fn item_result_schema() -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {
@@ -963,6 +969,10 @@ impl JobItem {
                 let cost = cells * config.steps as f64 * ENVELOPE_BAND_CELL_STEP_S;
                 Some((samples, cost))
             }
+            Self::DynamicsPeaks(r) => {
+                let per = r.prepare().ok()?.work() * super::dynamics::SEGMENT_STEP_S;
+                Some((r.samples, per))
+            }
             _ => None,
         }
     }
@@ -1024,6 +1034,12 @@ impl JobItem {
                 Parallelism::Rayon,
                 progress,
             ),
+            Self::DynamicsPeaks(r) => crate::contract::dynamics::peaks::peaks_chunk(
+                r,
+                range,
+                Parallelism::Rayon,
+                progress,
+            ),
             _ => self.run_kind(progress),
         }
     }
@@ -1054,6 +1070,9 @@ impl JobItem {
             Self::EnvelopeBands(r) => {
                 to_json(&crate::contract::bands::envelope::envelope_bands_from_chunks(r, parts)?)
             }
+            Self::DynamicsPeaks(r) => to_json(
+                &crate::contract::dynamics::peaks::peaks_from_chunks(r, parts)?,
+            ),
             _ => parts
                 .first()
                 .cloned()
@@ -1168,6 +1187,9 @@ mod tests {
             return v;
         }
         if let Some(v) = crate::jobs::bands::example_request(kind) {
+            return v;
+        }
+        if let Some(v) = crate::jobs::dynamics::example_request(kind) {
             return v;
         }
         let mut v = json!({"cable": {"mass_per_length_kg_m": 0.078}, "aerostat": {"net_buoyancy_n": 1000.0}});

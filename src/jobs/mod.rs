@@ -16,6 +16,7 @@
 
 pub mod bands;
 pub mod chunks;
+pub mod dynamics;
 pub mod estimate;
 pub mod kinds;
 pub mod lease;

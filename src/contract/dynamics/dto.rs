@@ -1,0 +1,380 @@
+//! Request and response bodies of `POST /api/v1/dynamics` (SPEC §11): the
+//! one system of §9 (cable, aerostat, wind with its `time_history`,
+//! winch …), the unstretched length (fixed or a profile), the duration and
+//! the numerics. SI units; every bound in the schema is the bound the
+//! validation applies ([`super::validate`]).
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use crate::contract::dto::ProfileInput;
+use crate::contract::equilibrium::dto::{AerostatInput, CableInput, WindFlowInput};
+use crate::contract::system::WinchInput;
+
+pub(crate) fn default_gravity() -> f64 {
+    9.81
+}
+fn default_air_density() -> f64 {
+    1.225
+}
+fn default_segments() -> usize {
+    50
+}
+fn default_time_step() -> f64 {
+    0.05
+}
+fn default_spectral_radius() -> f64 {
+    0.8
+}
+fn default_sample_count() -> usize {
+    601
+}
+fn default_shape_count() -> usize {
+    31
+}
+
+/// The turbulence spectrum.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum TurbulenceModelInput {
+    /// `S(f) = 4σ²(L_u/U)/(1 + 70.8 n²)^(5/6)`, `n = f L_u/U`.
+    VonKarman,
+    /// `S(f) = 4σ²(L_u/U)/(1 + 6 n)^(5/3)`.
+    Kaimal,
+}
+
+/// A change of the wind in time, added to the steady `wind.flow`. The
+/// discrete kinds are spatially uniform: the same change at every height.
+/// A "speed" is the new wind at the flow's reference height (`uniform`:
+/// everywhere; `power_law`, `log_law`: their `reference_height_m`;
+/// `tabulated`: the aerostat's starting altitude).
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum TimeHistoryInput {
+    /// The wind jumps to `speed_m_s` at `time_s`.
+    Step {
+        /// When the step happens (s).
+        #[schema(example = 10.0, minimum = 0.0, maximum = 1000000.0)]
+        time_s: f64,
+        /// The new speed (m/s).
+        #[schema(example = 15.0, minimum = -150.0, maximum = 150.0)]
+        speed_m_s: f64,
+    },
+    /// The wind rises (or falls) linearly to `speed_m_s` over `duration_s` from `start_time_s`.
+    Ramp {
+        #[schema(example = 10.0, minimum = 0.0, maximum = 1000000.0)]
+        start_time_s: f64,
+        #[schema(example = 5.0, exclusive_minimum = 0.0, maximum = 1000000.0)]
+        duration_s: f64,
+        /// The speed reached (m/s).
+        #[schema(example = 15.0, minimum = -150.0, maximum = 150.0)]
+        speed_m_s: f64,
+    },
+    /// A `1 − cos` gust: `ΔU = (A/2)(1 − cos 2π(t − t₀)/T)` on `[t₀, t₀ + T]`,
+    /// peak `A` at `t₀ + T/2`, zero before and after.
+    OneMinusCosine {
+        #[schema(example = 10.0, minimum = 0.0, maximum = 1000000.0)]
+        start_time_s: f64,
+        #[schema(example = 8.0, exclusive_minimum = 0.0, maximum = 1000000.0)]
+        duration_s: f64,
+        /// Peak change A (m/s).
+        #[schema(example = 6.0, minimum = -100.0, maximum = 100.0)]
+        amplitude_m_s: f64,
+    },
+    /// `ΔU = A sin(2π t/T)`.
+    Sinusoid {
+        #[schema(example = 2.0, minimum = -100.0, maximum = 100.0)]
+        amplitude_m_s: f64,
+        /// Period T (s), at least four time steps.
+        #[schema(example = 30.0, exclusive_minimum = 0.0, maximum = 1000000.0)]
+        period_s: f64,
+    },
+    /// Seeded turbulence of the longitudinal component: a field, not a
+    /// uniform change. Spectrum of intensity `I = σ_u/U` and length scale
+    /// `L_u` at every height, Davenport's vertical coherence, frozen and
+    /// carried downwind at the mean speed at the aerostat. The same seed
+    /// gives the same field on any machine and worker count.
+    Turbulence {
+        model: TurbulenceModelInput,
+        /// `I = σ_u/U`.
+        #[schema(example = 0.15, minimum = 0.0, maximum = 1.0)]
+        turbulence_intensity_nondim: f64,
+        /// `L_u` (m), e.g. 340 m (von Kármán, IEC 61400-1 at heights above 60 m).
+        #[schema(example = 340.0, exclusive_minimum = 0.0, maximum = 100000.0)]
+        length_scale_m: f64,
+        #[serde(default)]
+        #[schema(example = 7, minimum = 0, maximum = 9007199254740991_u64)]
+        seed: u64,
+    },
+}
+
+/// The air of a dynamic run: the steady flow (where the run starts at
+/// rest, in its static equilibrium) and how the wind changes in time.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsWindInput {
+    pub flow: WindFlowInput,
+    /// Air density (kg/m³), default 1.225 (ISA sea level).
+    #[serde(default = "default_air_density")]
+    #[schema(example = 1.225, exclusive_minimum = 0.0, maximum = 5.0)]
+    pub air_density_kg_m3: f64,
+    /// The change in time; absent: the steady flow only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_history: Option<TimeHistoryInput>,
+}
+
+/// Discretisation and integrator.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsNumericsInput {
+    /// Equal segments of the tether (lumped masses at their ends).
+    #[serde(default = "default_segments")]
+    #[schema(example = 50, minimum = 2, maximum = 1000)]
+    pub segments: usize,
+    /// Time step (s); the generalized-α step is unconditionally stable, so
+    /// it is set by the accuracy wanted (0.05 s resolves gusts of a few seconds).
+    #[serde(default = "default_time_step")]
+    #[schema(example = 0.05, minimum = 0.0001, maximum = 10.0)]
+    pub time_step_s: f64,
+    /// Spectral radius ρ∞ at infinite frequency: 1 keeps every mode
+    /// (trapezoidal rule), smaller damps the unresolved axial waves.
+    #[serde(default = "default_spectral_radius")]
+    #[schema(example = 0.8, minimum = 0.0, maximum = 1.0)]
+    pub spectral_radius_nondim: f64,
+}
+
+impl Default for DynamicsNumericsInput {
+    fn default() -> Self {
+        Self {
+            segments: default_segments(),
+            time_step_s: default_time_step(),
+            spectral_radius_nondim: default_spectral_radius(),
+        }
+    }
+}
+
+/// `POST /api/v1/dynamics`: the tether in time through a gust or
+/// turbulence, from rest in the static equilibrium of `wind.flow`.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({
+    "cable": {"preset": "dyneema", "diameter_m": 0.006},
+    "aerostat": {"net_buoyancy_n": 2000.0, "mass_kg": 100.0, "drag_coefficient_nondim": 0.3,
+                 "reference_area_m2": 20.0, "added_mass_coefficient_nondim": 0.5},
+    "wind": {"flow": {"kind": "uniform", "speed_m_s": 8.0}, "air_density_kg_m3": 1.225,
+             "time_history": {"kind": "one_minus_cosine", "start_time_s": 10.0, "duration_s": 8.0,
+                              "amplitude_m_s": 6.0}},
+    "tether_length_m": 1000.0,
+    "duration_s": 60.0,
+    "sample_count": 601,
+    "shape_count": 31,
+    "numerics": {"segments": 50, "time_step_s": 0.05, "spectral_radius_nondim": 0.8}
+}))]
+pub struct DynamicsRequest {
+    pub cable: CableInput,
+    pub aerostat: AerostatInput,
+    pub wind: DynamicsWindInput,
+    /// A fixed unstretched length L (m); give this or `profile`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 1000.0, minimum = 1.0, maximum = 20000.0)]
+    pub tether_length_m: Option<f64>,
+    /// The length following a deployment profile from `initial_length_m`
+    /// (a plan's schedule: its `(time_s, rate_m_s)` as a
+    /// `piecewise_linear_rate`); give this or `tether_length_m`. The
+    /// length must stay at least 1 m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<ProfileInput>,
+    /// Length at t = 0 with a `profile` (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 100.0, minimum = 1.0, maximum = 10000.0)]
+    pub initial_length_m: Option<f64>,
+    /// Simulated time (s).
+    #[schema(example = 60.0, exclusive_minimum = 0.0, maximum = 100000.0)]
+    pub duration_s: f64,
+    /// Samples kept, evenly spaced from 0 to `duration_s` (at most one per
+    /// time step); peaks, minima and slack are checked at every step.
+    #[serde(default = "default_sample_count")]
+    #[schema(example = 601, minimum = 2, maximum = 200000)]
+    pub sample_count: usize,
+    /// Tether shapes kept, evenly spaced from 0 to `duration_s` (0: none);
+    /// `shape_times_s` instead names the times. Shapes × (segments + 1)
+    /// nodes at most 200 000.
+    #[serde(default = "default_shape_count")]
+    #[schema(example = 31, minimum = 0, maximum = 1000)]
+    pub shape_count: usize,
+    /// The times of the kept shapes (s), instead of `shape_count` (at most 1000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_times_s: Option<Vec<f64>>,
+    /// Kelvin–Voigt internal damping of the tether `c` in `T = EA ε + c ε̇`
+    /// (N s), default 0 (the integrator's ρ∞ damps the unresolved axial waves).
+    #[serde(default)]
+    #[schema(example = 0.0, minimum = 0.0, maximum = 1e12)]
+    pub internal_damping_n_s: f64,
+    /// Tangential (skin-friction) drag coefficient on π d, default 0.
+    #[serde(default)]
+    #[schema(example = 0.0, minimum = 0.0, maximum = 1.0)]
+    pub tangential_drag_coefficient_nondim: f64,
+    #[serde(default)]
+    pub numerics: DynamicsNumericsInput,
+    /// Gravitational acceleration (m/s²).
+    #[serde(default = "default_gravity")]
+    #[schema(example = 9.81, exclusive_minimum = 0.0, maximum = 100.0)]
+    pub gravity_m_s2: f64,
+    /// Safety factor required of the peak tension (breaking strength / peak), default 5.
+    #[serde(default = "crate::contract::system::default_safety_factor")]
+    #[schema(example = 5.0, minimum = 1.0, maximum = 100.0)]
+    pub required_safety_factor_nondim: f64,
+    /// The rest of the system (accepted and checked; the run has no use for them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub winch: Option<WinchInput>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 0.05, minimum = 0.0, maximum = 0.9)]
+    pub lift_reserve_nondim: Option<f64>,
+}
+
+/// One kept sample.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct DynamicsSampleOutput {
+    pub time_s: f64,
+    /// Tension at the winch `|τ(0)|` (N).
+    pub winch_tension_n: f64,
+    /// Tension at the aerostat `|τ(L)|` (N).
+    pub top_tension_n: f64,
+    /// Height of the aerostat above the winch (m).
+    pub aerostat_altitude_m: f64,
+    /// Downwind distance of the aerostat from the winch (m).
+    pub aerostat_downwind_m: f64,
+    /// Unstretched length (m).
+    pub tether_length_m: f64,
+    /// Wind speed at the aerostat (m/s).
+    pub aerostat_wind_m_s: f64,
+}
+
+/// One node of a kept shape.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct DynamicsShapeNodeOutput {
+    /// Unstretched arc length from the winch (m).
+    pub s_m: f64,
+    /// Downwind distance from the winch (m).
+    pub x_m: f64,
+    /// Height above the winch (m).
+    pub z_m: f64,
+    /// Tension of the segment below the node (the winch tension at s = 0) (N).
+    pub tension_n: f64,
+}
+
+/// The tether at one time.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct DynamicsShapeOutput {
+    pub time_s: f64,
+    /// From the winch (s = 0) to the aerostat.
+    pub nodes: Vec<DynamicsShapeNodeOutput>,
+}
+
+/// An interval during which some segment carries no tension.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct SlackEventOutput {
+    pub start_time_s: f64,
+    /// Null: still slack at the end of the run.
+    pub end_time_s: Option<f64>,
+    /// Lowest slack point seen (unstretched arc length from the winch, m).
+    pub lowest_s_m: f64,
+}
+
+/// The static equilibrium (SPEC §6) the dynamic answer is judged against,
+/// at the same wind.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct QuasiStaticOutput {
+    /// Winch tension at rest in the steady flow at t = 0 (N): the lumped
+    /// tether's static equilibrium, where the run starts.
+    pub start_winch_tension_n: f64,
+    /// Aerostat altitude at t = 0 (m).
+    pub start_aerostat_altitude_m: f64,
+    /// The same from the continuum equilibrium of SPEC §6 (N): the lumped
+    /// tether's differs from it by O(segments⁻²).
+    pub continuum_start_winch_tension_n: f64,
+    /// Largest and smallest change of the wind over the run (m/s): the
+    /// time history's (turbulence: the fluctuation at the aerostat, over the samples).
+    pub max_wind_change_m_s: f64,
+    pub min_wind_change_m_s: f64,
+    /// Static winch tension with the flow raised by `max_wind_change_m_s`,
+    /// at the length of the dynamic peak's instant (N); null: no static
+    /// equilibrium there.
+    pub winch_tension_at_max_wind_n: Option<f64>,
+    /// Largest static tension along the tether at the same wind (N).
+    pub max_tension_at_max_wind_n: Option<f64>,
+    /// Static aerostat altitude at the same wind (m): the blown-down height.
+    pub aerostat_altitude_at_max_wind_m: Option<f64>,
+    /// Static winch tension with the flow changed by `min_wind_change_m_s`,
+    /// at the length of the dynamic minimum's instant (N).
+    pub winch_tension_at_min_wind_n: Option<f64>,
+    /// Whether the static equilibrium at the smallest wind is slack.
+    pub slack_at_min_wind: Option<bool>,
+}
+
+/// How the run ended.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum DynamicsOutcomeOutput {
+    /// Ran to `duration_s`.
+    Completed,
+    /// The Newton iteration failed even on the smallest sub-step (`stopped_at_s`).
+    NewtonFailed,
+    /// The state became non-finite (`stopped_at_s`).
+    Diverged,
+}
+
+/// How the answer was computed.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct DynamicsNumericsOutput {
+    pub segments: usize,
+    /// The time step used (s): `duration_s` divided into equal steps of at most the one asked.
+    pub time_step_s: f64,
+    pub spectral_radius_nondim: f64,
+    /// Accepted steps (halved steps count each half).
+    pub steps: usize,
+    pub newton_iterations: usize,
+    /// Steps retried as two halves after a failed Newton iteration.
+    pub halvings: usize,
+    /// Axial stiffness EA used (N).
+    pub axial_stiffness_n: f64,
+    /// Aerostat inertia `m + C_a ρ V` (kg).
+    pub aerostat_inertia_kg: f64,
+    /// Largest nodal force left by the static start (N).
+    pub start_residual_n: f64,
+    /// `generalized_alpha` (Chung & Hulbert 1993), second order.
+    pub method: String,
+}
+
+/// The answer of `POST /api/v1/dynamics`.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct DynamicsResponse {
+    pub outcome: DynamicsOutcomeOutput,
+    /// Time the run stopped at (s): `duration_s` when completed.
+    pub stopped_at_s: f64,
+    pub samples: Vec<DynamicsSampleOutput>,
+    pub shapes: Vec<DynamicsShapeOutput>,
+    pub slack_events: Vec<SlackEventOutput>,
+    /// Largest winch tension at any step and when (N, s).
+    pub peak_winch_tension_n: f64,
+    pub peak_winch_tension_time_s: f64,
+    /// Smallest winch tension at any step and when (N, s).
+    pub min_winch_tension_n: f64,
+    pub min_winch_tension_time_s: f64,
+    /// Largest tension anywhere along the tether and when (N, s).
+    pub peak_tension_n: f64,
+    pub peak_tension_time_s: f64,
+    /// Lowest aerostat altitude among the samples (m).
+    pub min_aerostat_altitude_m: f64,
+    pub quasi_static: QuasiStaticOutput,
+    /// Peak winch tension / static winch tension at the largest wind; null without it.
+    pub dynamic_factor_nondim: Option<f64>,
+    /// Breaking strength / peak tension; null without a breaking strength.
+    pub safety_factor_nondim: Option<f64>,
+    pub required_safety_factor_nondim: f64,
+    /// Whether the safety factor meets the required one; null without a breaking strength.
+    pub meets_required_safety_factor: Option<bool>,
+    /// Plain-language account of the run.
+    pub explanation: String,
+    pub numerics: DynamicsNumericsOutput,
+}

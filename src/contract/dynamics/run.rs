@@ -1,0 +1,314 @@
+//! One dynamic run through the contract: the static start, the march with
+//! progress and cancellation, and the answer beside the quasi-static one
+//! at the same wind.
+
+use super::dto::*;
+use super::validate::Prepared;
+use crate::contract::{Progress, RequestError};
+use crate::numerics::aero::SteadyFlow;
+use crate::numerics::dynamics::{
+    DynamicsError, DynamicsProblem, Outcome, Run, StepView, simulate_from, static_start,
+};
+use crate::numerics::params::InvalidInput;
+use crate::numerics::tether::{Equilibrium, EquilibriumConfig, WindProfile};
+
+/// Points of the tabulated flow that stands for a sheared flow plus a
+/// uniform change (quadratic spacing: dense near the ground).
+const SHIFTED_FLOW_POINTS: usize = 400;
+
+/// Steps between progress reports and cancellation checks.
+const REPORT_EVERY: usize = 64;
+
+impl From<DynamicsError> for RequestError {
+    fn from(e: DynamicsError) -> Self {
+        match e {
+            DynamicsError::Invalid(i) => i.into(),
+            DynamicsError::SlackStart => InvalidInput::new(
+                "wind.flow",
+                "leaves the tether slack at the start (part of it rests on the ground): the dynamic model starts from a taut static equilibrium; give less wind, more lift or a shorter tether",
+            )
+            .into(),
+            DynamicsError::NoStaticEquilibrium { residual_n } => InvalidInput::new(
+                "tether_length_m",
+                format!(
+                    "no static equilibrium of the lumped tether was found to start from (force left {residual_n:.3e} N); try more segments"
+                ),
+            )
+            .into(),
+        }
+    }
+}
+
+/// `flow` with `change` added at every height: the same flow for a
+/// uniform one, else a table up to `top_m` (linear between points;
+/// quadratic spacing keeps a log law's ground layer).
+pub fn shifted_flow(flow: &WindProfile, change: f64, top_m: f64) -> WindProfile {
+    if let WindProfile::Flow(SteadyFlow::Uniform { speed_m_s }) = flow {
+        return WindProfile::uniform(speed_m_s + change);
+    }
+    if change == 0.0 {
+        return flow.clone();
+    }
+    let n = SHIFTED_FLOW_POINTS;
+    let (elevations_m, speeds_m_s): (Vec<f64>, Vec<f64>) = (0..=n)
+        .map(|k| {
+            let z = top_m * (k as f64 / n as f64).powi(2);
+            (z, flow.speed_m_s(z) + change)
+        })
+        .unzip();
+    WindProfile::Flow(SteadyFlow::Tabulated {
+        elevations_m,
+        speeds_m_s,
+    })
+}
+
+/// The §6 equilibrium of `problem` at `length_m` with the flow changed by
+/// `change` (None: none found).
+pub fn equilibrium_at(
+    problem: &DynamicsProblem,
+    length_m: f64,
+    change: f64,
+    segments: usize,
+) -> Option<Equilibrium> {
+    let mut eq = problem.static_problem(length_m);
+    eq.wind = shifted_flow(&problem.flow, change, 1.5 * length_m + 10.0);
+    eq.solve(&EquilibriumConfig {
+        steps: segments.max(100),
+        max_iterations: 60,
+        keep_shape: false,
+    })
+    .ok()
+}
+
+/// A run and the force its static start left (N).
+pub struct Ran {
+    pub run: Run,
+    pub start_residual_n: f64,
+}
+
+/// Runs a prepared problem from its static start, reporting steps done.
+pub fn run_prepared(prepared: &Prepared, progress: &dyn Progress) -> Result<Ran, RequestError> {
+    let p = &prepared.problem;
+    let c = &prepared.config;
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    let start = static_start(p, c.segments)?;
+    let start_residual_n = start.residual_n;
+    let total = prepared.steps;
+    let mut done = 0usize;
+    let mut observer = |_: &StepView| {
+        done += 1;
+        if done.is_multiple_of(REPORT_EVERY) {
+            progress.report(done.min(total), total);
+            return !progress.cancelled();
+        }
+        true
+    };
+    let run = simulate_from(p, c, start.state, start.equilibrium, &mut observer)?;
+    if let Outcome::Stopped { .. } = run.outcome {
+        return Err(RequestError::Cancelled);
+    }
+    progress.report(total, total);
+    Ok(Ran {
+        run,
+        start_residual_n,
+    })
+}
+
+/// The largest and smallest wind change of the run (m/s).
+fn wind_change_range(problem: &DynamicsProblem, run: &Run, duration_s: f64) -> (f64, f64) {
+    let (mut hi, mut lo) = (0.0f64, 0.0f64);
+    for g in &problem.gusts {
+        let (h, l) = g.range_m_s(duration_s);
+        hi += h;
+        lo += l;
+    }
+    if problem.turbulence.is_some() {
+        for s in &run.samples {
+            let d = s.aerostat_wind_m_s - problem.flow.speed_m_s(s.aerostat_altitude_m);
+            hi = hi.max(d);
+            lo = lo.min(d);
+        }
+    }
+    (hi, lo)
+}
+
+/// Answers one dynamics request.
+pub fn dynamics(
+    req: &DynamicsRequest,
+    progress: &dyn Progress,
+) -> Result<DynamicsResponse, RequestError> {
+    let prepared = req.prepare()?;
+    let ran = run_prepared(&prepared, progress)?;
+    Ok(response(req, &prepared, &ran))
+}
+
+/// The answer of a run.
+pub fn response(req: &DynamicsRequest, prepared: &Prepared, ran: &Ran) -> DynamicsResponse {
+    let run = &ran.run;
+    let p = &prepared.problem;
+    let c = &prepared.config;
+    let (max_change, min_change) = wind_change_range(p, run, c.duration_s);
+    let at_max = equilibrium_at(
+        p,
+        p.length.at(run.peak_winch_tension.time_s).length_m,
+        max_change,
+        c.segments,
+    );
+    let at_min = equilibrium_at(
+        p,
+        p.length.at(run.min_winch_tension.time_s).length_m,
+        min_change,
+        c.segments,
+    );
+    let (outcome, stopped_at_s) = match run.outcome {
+        Outcome::Completed | Outcome::Stopped { .. } => {
+            (DynamicsOutcomeOutput::Completed, run.final_state.time_s)
+        }
+        Outcome::NewtonFailed { time_s } => (DynamicsOutcomeOutput::NewtonFailed, time_s),
+        Outcome::Diverged { time_s } => (DynamicsOutcomeOutput::Diverged, time_s),
+    };
+    let peak = run.peak_winch_tension.value;
+    let dynamic_factor = at_max
+        .as_ref()
+        .filter(|e| e.winch_tension_n > 0.0)
+        .map(|e| peak / e.winch_tension_n);
+    let safety = prepared
+        .breaking_strength_n
+        .map(|b| b / run.peak_tension.value);
+    let min_altitude = run
+        .samples
+        .iter()
+        .map(|s| s.aerostat_altitude_m)
+        .fold(f64::INFINITY, f64::min);
+    let params = p.parameters(c.segments);
+    let quasi_static = QuasiStaticOutput {
+        start_winch_tension_n: run
+            .samples
+            .first()
+            .map_or(run.equilibrium.winch_tension_n, |s| s.winch_tension_n),
+        start_aerostat_altitude_m: run
+            .samples
+            .first()
+            .map_or(run.equilibrium.altitude_m, |s| s.aerostat_altitude_m),
+        continuum_start_winch_tension_n: run.equilibrium.winch_tension_n,
+        max_wind_change_m_s: max_change,
+        min_wind_change_m_s: min_change,
+        winch_tension_at_max_wind_n: at_max.as_ref().map(|e| e.winch_tension_n),
+        max_tension_at_max_wind_n: at_max.as_ref().map(|e| e.max_tension_n),
+        aerostat_altitude_at_max_wind_m: at_max.as_ref().map(|e| e.altitude_m),
+        winch_tension_at_min_wind_n: at_min.as_ref().map(|e| e.winch_tension_n),
+        slack_at_min_wind: at_min.as_ref().map(|e| e.slack),
+    };
+    let explanation = explain(run, &quasi_static, dynamic_factor, outcome, stopped_at_s);
+    DynamicsResponse {
+        outcome,
+        stopped_at_s,
+        samples: run
+            .samples
+            .iter()
+            .map(|s| DynamicsSampleOutput {
+                time_s: s.time_s,
+                winch_tension_n: s.winch_tension_n,
+                top_tension_n: s.top_tension_n,
+                aerostat_altitude_m: s.aerostat_altitude_m,
+                aerostat_downwind_m: s.aerostat_downwind_m,
+                tether_length_m: s.length_m,
+                aerostat_wind_m_s: s.aerostat_wind_m_s,
+            })
+            .collect(),
+        shapes: run
+            .shapes
+            .iter()
+            .map(|s| DynamicsShapeOutput {
+                time_s: s.time_s,
+                nodes: s
+                    .nodes
+                    .iter()
+                    .map(|n| DynamicsShapeNodeOutput {
+                        s_m: n.s_m,
+                        x_m: n.x_m,
+                        z_m: n.z_m,
+                        tension_n: n.tension_n,
+                    })
+                    .collect(),
+            })
+            .collect(),
+        slack_events: run
+            .slack_events
+            .iter()
+            .map(|e| SlackEventOutput {
+                start_time_s: e.start_s,
+                end_time_s: e.end_s,
+                lowest_s_m: e.lowest_s_m,
+            })
+            .collect(),
+        peak_winch_tension_n: peak,
+        peak_winch_tension_time_s: run.peak_winch_tension.time_s,
+        min_winch_tension_n: run.min_winch_tension.value,
+        min_winch_tension_time_s: run.min_winch_tension.time_s,
+        peak_tension_n: run.peak_tension.value,
+        peak_tension_time_s: run.peak_tension.time_s,
+        min_aerostat_altitude_m: min_altitude,
+        quasi_static,
+        dynamic_factor_nondim: dynamic_factor,
+        safety_factor_nondim: safety,
+        required_safety_factor_nondim: req.required_safety_factor_nondim,
+        meets_required_safety_factor: safety.map(|f| f >= req.required_safety_factor_nondim),
+        explanation,
+        numerics: DynamicsNumericsOutput {
+            segments: c.segments,
+            time_step_s: c.duration_s / prepared.steps as f64,
+            spectral_radius_nondim: c.spectral_radius,
+            steps: run.statistics.steps,
+            newton_iterations: run.statistics.newton_iterations,
+            halvings: run.statistics.halvings,
+            axial_stiffness_n: p.tether.axial_stiffness_n,
+            aerostat_inertia_kg: params.aerostat_inertia_kg,
+            start_residual_n: ran.start_residual_n,
+            method: "generalized_alpha".into(),
+        },
+    }
+}
+
+fn explain(
+    run: &Run,
+    qs: &QuasiStaticOutput,
+    factor: Option<f64>,
+    outcome: DynamicsOutcomeOutput,
+    stopped_at_s: f64,
+) -> String {
+    let mut s = format!(
+        "From rest at {:.1} N winch tension, the winch tension peaked at {:.1} N (t = {:.2} s) and fell to {:.1} N (t = {:.2} s).",
+        qs.start_winch_tension_n,
+        run.peak_winch_tension.value,
+        run.peak_winch_tension.time_s,
+        run.min_winch_tension.value,
+        run.min_winch_tension.time_s
+    );
+    match (qs.winch_tension_at_max_wind_n, factor) {
+        (Some(t), Some(f)) => s.push_str(&format!(
+            " The static tension at the largest wind ({:+.2} m/s) is {t:.1} N: the dynamic peak is {f:.3} times it.",
+            qs.max_wind_change_m_s
+        )),
+        _ => s.push_str(" No static equilibrium was found at the largest wind."),
+    }
+    if !run.slack_events.is_empty() {
+        s.push_str(&format!(
+            " The tether went slack {} time(s), first at t = {:.2} s.",
+            run.slack_events.len(),
+            run.slack_events[0].start_s
+        ));
+    }
+    match outcome {
+        DynamicsOutcomeOutput::Completed => {}
+        DynamicsOutcomeOutput::NewtonFailed => s.push_str(&format!(
+            " The run stopped at t = {stopped_at_s:.2} s: the implicit step did not converge even after halving (try a smaller numerics.time_step_s)."
+        )),
+        DynamicsOutcomeOutput::Diverged => s.push_str(&format!(
+            " The run stopped at t = {stopped_at_s:.2} s: the state became non-finite."
+        )),
+    }
+    s
+}

@@ -1,0 +1,434 @@
+//! A dynamics request checked and turned into the numerical problem
+//! ([`crate::numerics::dynamics::DynamicsProblem`]) and its configuration.
+//! Every bound is the schema's; every error names its field in plain words.
+
+use super::dto::*;
+use crate::contract::system::WindFlowInput;
+use crate::contract::system::validate::{check_rest, require_count, require_range};
+use crate::numerics::dynamics::{
+    self, Aerostat, DynamicsConfig, DynamicsProblem, GustHistory, LengthSchedule, SpectrumModel,
+    Tether, Turbulence,
+};
+use crate::numerics::params::InvalidInput;
+use crate::numerics::tether::{EquilibriumConfig, WindProfile};
+
+/// Most segments through the contract.
+pub const MAX_SEGMENTS: usize = 1000;
+/// Most kept samples.
+pub const MAX_SAMPLE_COUNT: usize = 200_000;
+/// Most kept shapes.
+pub const MAX_SHAPES: usize = 1000;
+/// Most shape nodes kept (shapes × (segments + 1)).
+pub const MAX_SHAPE_NODES: usize = 200_000;
+/// Longest run (s).
+pub const MAX_DURATION_S: f64 = 1e5;
+/// Shortest unstretched length a profile may reach (m).
+pub const MIN_LENGTH_M: f64 = 1.0;
+/// Largest seed (2^53 − 1: exact in every JSON reader).
+pub const MAX_SEED: u64 = (1 << 53) - 1;
+
+/// A validated request: the problem, the configuration, and what the
+/// answer needs beside them.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    pub problem: DynamicsProblem,
+    pub config: DynamicsConfig,
+    pub breaking_strength_n: Option<f64>,
+    /// Steps of the run.
+    pub steps: usize,
+}
+
+impl Prepared {
+    /// Segment-steps of the run (its cost).
+    pub fn work(&self) -> f64 {
+        self.steps as f64 * self.config.segments as f64
+    }
+}
+
+/// The reference height of a flow (m): where a time history's "speed" is
+/// read; `None` for a tabulated flow (the aerostat's starting altitude).
+fn reference_height(flow: &WindFlowInput) -> Option<f64> {
+    match flow {
+        WindFlowInput::Uniform { .. } => Some(0.0),
+        WindFlowInput::PowerLaw {
+            reference_height_m, ..
+        }
+        | WindFlowInput::LogLaw {
+            reference_height_m, ..
+        } => Some(*reference_height_m),
+        WindFlowInput::Tabulated { .. } => None,
+    }
+}
+
+impl DynamicsRequest {
+    /// The unstretched length in time.
+    fn schedule(&self) -> Result<LengthSchedule, InvalidInput> {
+        match (&self.tether_length_m, &self.profile) {
+            (Some(l), None) => Ok(LengthSchedule::Fixed(require_range(
+                "tether_length_m",
+                *l,
+                MIN_LENGTH_M,
+                false,
+                20_000.0,
+            )?)),
+            (None, Some(p)) => {
+                let Some(l0) = self.initial_length_m else {
+                    return Err(InvalidInput::new(
+                        "initial_length_m",
+                        "is needed with a profile: the unstretched length at t = 0 in metres",
+                    ));
+                };
+                let l0 = require_range("initial_length_m", l0, MIN_LENGTH_M, false, 10_000.0)?;
+                let profile = p.profile(l0)?;
+                let schedule = LengthSchedule::Profile(profile);
+                // The length must stay on the mesh: sampled finely, profiles
+                // being monotone between their knots.
+                let n = 4096;
+                for i in 0..=n {
+                    let t = self.duration_s * i as f64 / n as f64;
+                    let l = schedule.at(t).length_m;
+                    if !(l.is_finite() && (MIN_LENGTH_M..=20_000.0).contains(&l)) {
+                        return Err(InvalidInput::new(
+                            "profile",
+                            format!(
+                                "takes the length to {l:.3} m at t = {t:.2} s; the dynamics needs it between {MIN_LENGTH_M} m and 20000 m over the run (shorten duration_s or add a target_length_m)"
+                            ),
+                        ));
+                    }
+                }
+                Ok(schedule)
+            }
+            (Some(_), Some(_)) => Err(InvalidInput::new(
+                "profile",
+                "give either tether_length_m (a fixed length) or a profile (from initial_length_m), not both",
+            )),
+            (None, None) => Err(InvalidInput::new(
+                "tether_length_m",
+                "is required: give the unstretched length in metres, or a profile with initial_length_m",
+            )),
+        }
+    }
+
+    /// The tether (EA is required: the elastic response sets the tension).
+    fn tether(&self) -> Result<(Tether, Option<f64>), InvalidInput> {
+        let cable = self.cable.cable("cable")?;
+        let Some(ea) = cable.axial_stiffness_n else {
+            return Err(InvalidInput::new(
+                "cable.axial_stiffness_n",
+                "is needed by the dynamics (the tether's elastic response sets the peak tension): give EA in newtons, or a cable preset",
+            ));
+        };
+        Ok((
+            Tether {
+                mass_per_length_kg_m: cable.mass_per_length_kg_m,
+                diameter_m: cable.diameter_m,
+                normal_drag_coefficient: cable.normal_drag_coefficient,
+                tangential_drag_coefficient: require_range(
+                    "tangential_drag_coefficient_nondim",
+                    self.tangential_drag_coefficient_nondim,
+                    0.0,
+                    false,
+                    1.0,
+                )?,
+                axial_stiffness_n: ea,
+                internal_damping_n_s: require_range(
+                    "internal_damping_n_s",
+                    self.internal_damping_n_s,
+                    0.0,
+                    false,
+                    1e12,
+                )?,
+                drag_on_stretched_length: true,
+            },
+            cable.breaking_strength_n,
+        ))
+    }
+
+    fn aerostat(&self) -> Result<Aerostat, InvalidInput> {
+        let body = self.aerostat.body("aerostat")?;
+        Ok(Aerostat {
+            net_buoyancy_n: body.net_buoyancy_n,
+            mass_kg: self.aerostat.mass("aerostat")?,
+            reference_area_m2: body.reference_area_m2,
+            drag_coefficient: body.drag_coefficient,
+            lift_coefficient: body.lift_coefficient,
+            added_mass_coefficient: self.aerostat.added_mass_coefficient("aerostat")?,
+        })
+    }
+
+    /// Checks the time history's fields (bounds of the schema).
+    fn check_time_history(&self, time_step_s: f64) -> Result<(), InvalidInput> {
+        let at = |n: &str| format!("wind.time_history.{n}");
+        let time = |n: &str, v: f64| require_range(&at(n), v, 0.0, false, 1e6);
+        let span = |n: &str, v: f64| require_range(&at(n), v, 0.0, true, 1e6);
+        match self.wind.time_history {
+            None => {}
+            Some(TimeHistoryInput::Step { time_s, speed_m_s }) => {
+                time("time_s", time_s)?;
+                require_range(&at("speed_m_s"), speed_m_s, -150.0, false, 150.0)?;
+            }
+            Some(TimeHistoryInput::Ramp {
+                start_time_s,
+                duration_s,
+                speed_m_s,
+            }) => {
+                time("start_time_s", start_time_s)?;
+                span("duration_s", duration_s)?;
+                require_range(&at("speed_m_s"), speed_m_s, -150.0, false, 150.0)?;
+            }
+            Some(TimeHistoryInput::OneMinusCosine {
+                start_time_s,
+                duration_s,
+                amplitude_m_s,
+            }) => {
+                time("start_time_s", start_time_s)?;
+                span("duration_s", duration_s)?;
+                require_range(&at("amplitude_m_s"), amplitude_m_s, -100.0, false, 100.0)?;
+            }
+            Some(TimeHistoryInput::Sinusoid {
+                amplitude_m_s,
+                period_s,
+            }) => {
+                require_range(&at("amplitude_m_s"), amplitude_m_s, -100.0, false, 100.0)?;
+                span("period_s", period_s)?;
+                if period_s < 4.0 * time_step_s {
+                    return Err(InvalidInput::new(
+                        at("period_s"),
+                        format!(
+                            "must be at least four time steps ({} s) to be resolved, got {period_s}",
+                            4.0 * time_step_s
+                        ),
+                    ));
+                }
+            }
+            Some(TimeHistoryInput::Turbulence {
+                turbulence_intensity_nondim,
+                length_scale_m,
+                seed,
+                ..
+            }) => {
+                require_range(
+                    &at("turbulence_intensity_nondim"),
+                    turbulence_intensity_nondim,
+                    0.0,
+                    false,
+                    1.0,
+                )?;
+                require_range(&at("length_scale_m"), length_scale_m, 0.0, true, 1e5)?;
+                if seed > MAX_SEED {
+                    return Err(InvalidInput::new(
+                        at("seed"),
+                        format!("must be at most {MAX_SEED} (2^53 − 1), got {seed}"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The gusts and turbulence of the time history over `flow`;
+    /// `start_altitude_m` is where a tabulated flow's speed is read.
+    fn wind_in_time(
+        &self,
+        flow: &WindProfile,
+        start_altitude_m: f64,
+    ) -> (Vec<GustHistory>, Option<Turbulence>) {
+        let z_ref = reference_height(&self.wind.flow).unwrap_or(start_altitude_m);
+        let change_to = |speed: f64| speed - flow.speed_m_s(z_ref);
+        match self.wind.time_history.clone() {
+            None => (vec![], None),
+            Some(TimeHistoryInput::Step { time_s, speed_m_s }) => (
+                vec![GustHistory::Step {
+                    time_s,
+                    change_m_s: change_to(speed_m_s),
+                }],
+                None,
+            ),
+            Some(TimeHistoryInput::Ramp {
+                start_time_s,
+                duration_s,
+                speed_m_s,
+            }) => (
+                vec![GustHistory::Ramp {
+                    start_time_s,
+                    duration_s,
+                    change_m_s: change_to(speed_m_s),
+                }],
+                None,
+            ),
+            Some(TimeHistoryInput::OneMinusCosine {
+                start_time_s,
+                duration_s,
+                amplitude_m_s,
+            }) => (
+                vec![GustHistory::OneMinusCosine {
+                    start_time_s,
+                    duration_s,
+                    amplitude_m_s,
+                }],
+                None,
+            ),
+            Some(TimeHistoryInput::Sinusoid {
+                amplitude_m_s,
+                period_s,
+            }) => (
+                vec![GustHistory::Sinusoid {
+                    amplitude_m_s,
+                    period_s,
+                }],
+                None,
+            ),
+            Some(TimeHistoryInput::Turbulence {
+                model,
+                turbulence_intensity_nondim,
+                length_scale_m,
+                seed,
+            }) => (
+                vec![],
+                Some(Turbulence {
+                    model: match model {
+                        TurbulenceModelInput::VonKarman => SpectrumModel::VonKarman,
+                        TurbulenceModelInput::Kaimal => SpectrumModel::Kaimal,
+                    },
+                    intensity: turbulence_intensity_nondim,
+                    length_scale_m,
+                    seed,
+                }),
+            ),
+        }
+    }
+
+    /// The validated problem and configuration (no dynamic step taken; the
+    /// §6 equilibrium at the start is solved for a tabulated flow's
+    /// reference).
+    pub fn prepare(&self) -> Result<Prepared, InvalidInput> {
+        let (tether, breaking_strength_n) = self.tether()?;
+        let aerostat = self.aerostat()?;
+        let flow = self.wind.flow.profile("wind.flow")?;
+        let air = require_range(
+            "wind.air_density_kg_m3",
+            self.wind.air_density_kg_m3,
+            0.0,
+            true,
+            5.0,
+        )?;
+        let gravity = require_range("gravity_m_s2", self.gravity_m_s2, 0.0, true, 100.0)?;
+        require_range(
+            "required_safety_factor_nondim",
+            self.required_safety_factor_nondim,
+            1.0,
+            false,
+            100.0,
+        )?;
+        check_rest(self.winch.as_ref(), None, self.lift_reserve_nondim)?;
+        let duration = require_range("duration_s", self.duration_s, 0.0, true, MAX_DURATION_S)?;
+        let n = &self.numerics;
+        let segments = require_count("numerics.segments", n.segments, 2, MAX_SEGMENTS)?;
+        let dt = require_range("numerics.time_step_s", n.time_step_s, 1e-4, false, 10.0)?;
+        let rho_inf = require_range(
+            "numerics.spectral_radius_nondim",
+            n.spectral_radius_nondim,
+            0.0,
+            false,
+            1.0,
+        )?;
+        let steps = ((duration / dt) - 1e-9).ceil().max(1.0);
+        if steps > dynamics::MAX_STEPS as f64 || steps * segments as f64 > dynamics::MAX_WORK {
+            return Err(InvalidInput::new(
+                "duration_s",
+                format!(
+                    "needs {steps:.0} steps of {segments} segments; a run takes at most {} steps and {:e} segment-steps (lengthen numerics.time_step_s or shorten the run)",
+                    dynamics::MAX_STEPS,
+                    dynamics::MAX_WORK
+                ),
+            ));
+        }
+        let steps = steps as usize;
+        let count = require_count("sample_count", self.sample_count, 2, MAX_SAMPLE_COUNT)?;
+        let sample_interval = duration / (count - 1) as f64;
+        let shape_times = match &self.shape_times_s {
+            Some(times) => {
+                if times.len() > MAX_SHAPES {
+                    return Err(InvalidInput::new(
+                        "shape_times_s",
+                        format!("at most {MAX_SHAPES} times, got {}", times.len()),
+                    ));
+                }
+                for (i, t) in times.iter().enumerate() {
+                    require_range(&format!("shape_times_s[{i}]"), *t, 0.0, false, duration)?;
+                }
+                times.clone()
+            }
+            None => {
+                let k = require_count("shape_count", self.shape_count, 0, MAX_SHAPES)?;
+                match k {
+                    0 => vec![],
+                    1 => vec![duration],
+                    k => (0..k)
+                        .map(|i| duration * i as f64 / (k - 1) as f64)
+                        .collect(),
+                }
+            }
+        };
+        if shape_times.len() * (segments + 1) > MAX_SHAPE_NODES {
+            return Err(InvalidInput::new(
+                if self.shape_times_s.is_some() {
+                    "shape_times_s"
+                } else {
+                    "shape_count"
+                },
+                format!(
+                    "{} shapes of {} nodes exceed {MAX_SHAPE_NODES} nodes: keep fewer shapes or segments",
+                    shape_times.len(),
+                    segments + 1
+                ),
+            ));
+        }
+        self.check_time_history(dt)?;
+        let length = self.schedule()?;
+        let mut problem = DynamicsProblem {
+            tether,
+            aerostat,
+            flow,
+            gusts: vec![],
+            turbulence: None,
+            air_density_kg_m3: air,
+            gravity_m_s2: gravity,
+            length,
+        };
+        problem.validate()?;
+        // A tabulated flow's "speed" is read at the aerostat's starting altitude.
+        let start_altitude =
+            if reference_height(&self.wind.flow).is_none() && self.wind.time_history.is_some() {
+                let l0 = problem.length.at(0.0).length_m;
+                problem
+                    .static_problem(l0)
+                    .solve(&EquilibriumConfig {
+                        steps: segments.max(50),
+                        max_iterations: 60,
+                        keep_shape: false,
+                    })?
+                    .altitude_m
+            } else {
+                0.0
+            };
+        let (gusts, turbulence) = self.wind_in_time(&problem.flow, start_altitude);
+        problem.gusts = gusts;
+        problem.turbulence = turbulence;
+        let config = DynamicsConfig {
+            segments,
+            time_step_s: dt,
+            duration_s: duration,
+            spectral_radius: rho_inf,
+            sample_interval_s: sample_interval,
+            shape_times_s: shape_times,
+            ..DynamicsConfig::default()
+        };
+        Ok(Prepared {
+            problem,
+            config,
+            breaking_strength_n,
+            steps,
+        })
+    }
+}
