@@ -3,8 +3,8 @@
 //! integrator's order. Numbers measured on this tree are in each test's doc.
 
 use tetherplan::numerics::dynamics::{
-    self, Aerostat, DynamicsConfig, DynamicsProblem, GustHistory, LengthSchedule, Outcome, State,
-    StepView, Tether, model,
+    self, DynamicsConfig, DynamicsProblem, GustHistory, LengthSchedule, Outcome, State, StepView,
+    model,
 };
 use tetherplan::numerics::params::AerostatSystem;
 use tetherplan::numerics::params::NondimState;
@@ -14,35 +14,10 @@ use tetherplan::numerics::string::transient::{rest_eigenvalue, rest_mode_shape};
 use tetherplan::numerics::tether::equilibrium::EquilibriumConfig;
 use tetherplan::numerics::tether::wind::WindProfile;
 
-/// The bench tether of issue 23: 1000 m, 0.078 kg/m, 5 mm, F = 1000 N,
-/// m = 10 kg, C_D A = 6 m², EA = 1 MN, c = 10 kN s.
-fn problem(wind_m_s: f64) -> DynamicsProblem {
-    DynamicsProblem {
-        tether: Tether {
-            mass_per_length_kg_m: 0.078,
-            diameter_m: 0.005,
-            normal_drag_coefficient: 1.2,
-            tangential_drag_coefficient: 0.0,
-            axial_stiffness_n: 1e6,
-            internal_damping_n_s: 1e4,
-            drag_on_stretched_length: true,
-        },
-        aerostat: Aerostat {
-            net_buoyancy_n: 1000.0,
-            mass_kg: 10.0,
-            reference_area_m2: 20.0,
-            drag_coefficient: 0.3,
-            lift_coefficient: 0.0,
-            added_mass_coefficient: 0.5,
-        },
-        flow: WindProfile::uniform(wind_m_s),
-        gusts: vec![],
-        turbulence: None,
-        air_density_kg_m3: 1.225,
-        gravity_m_s2: 9.81,
-        length: LengthSchedule::Fixed(1000.0),
-    }
-}
+/// The reference tether of issue 23 (`dynamics::reference`): 1000 m,
+/// 0.078 kg/m, 5 mm, F = 1000 N, m = 10 kg, C_D A = 6 m², EA = 1 MN,
+/// c = 10 kN s, in a uniform wind (m/s).
+use tetherplan::numerics::dynamics::reference::reference_problem as problem;
 
 /// Calm air, no drag, no internal damping.
 fn undamped(mut p: DynamicsProblem) -> DynamicsProblem {
