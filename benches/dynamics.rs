@@ -29,8 +29,9 @@
 
 use std::time::{Duration, Instant};
 
-use criterion::{Criterion, SamplingMode, criterion_group};
-use tetherplan::numerics::dynamics::{self, DynamicsConfig, reference};
+use criterion::measurement::WallTime;
+use criterion::{BenchmarkGroup, Criterion, SamplingMode, criterion_group};
+use tetherplan::numerics::dynamics::{self, DynamicsConfig, DynamicsProblem, reference};
 
 #[path = "../tests/peers/moordyn_case.rs"]
 mod moordyn_case;
@@ -54,38 +55,36 @@ fn hour() -> DynamicsConfig {
     }
 }
 
+/// `name` on the wall clock, and `name_cpu` on the thread's CPU clock.
+fn timed(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    problem: &DynamicsProblem,
+    config: &DynamicsConfig,
+) {
+    g.bench_function(name, |b| {
+        b.iter(|| dynamics::simulate(problem, config).unwrap())
+    });
+    g.bench_function(format!("{name}_cpu"), |b| {
+        b.iter_custom(|iters| {
+            let start = thread_cpu();
+            for _ in 0..iters {
+                std::hint::black_box(dynamics::simulate(problem, config).unwrap());
+            }
+            thread_cpu() - start
+        })
+    });
+}
+
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("dynamics");
     g.sample_size(10);
     g.sampling_mode(SamplingMode::Flat);
-    let turbulent = reference::turbulence_case(7);
     let hour = hour();
-    g.bench_function("hour_of_turbulence_50_segments", |b| {
-        b.iter(|| dynamics::simulate(&turbulent, &hour).unwrap())
-    });
-    g.bench_function("hour_of_turbulence_50_segments_cpu", |b| {
-        b.iter_custom(|iters| {
-            let start = thread_cpu();
-            for _ in 0..iters {
-                std::hint::black_box(dynamics::simulate(&turbulent, &hour).unwrap());
-            }
-            thread_cpu() - start
-        })
-    });
+    timed(&mut g, "hour_of_turbulence_50_segments", &reference::turbulence_case(7), &hour);
     let gust = reference::gust_case();
     let gust_config = reference::gust_case_config();
-    g.bench_function("gust_case_300s", |b| {
-        b.iter(|| dynamics::simulate(&gust, &gust_config).unwrap())
-    });
-    g.bench_function("gust_case_300s_cpu", |b| {
-        b.iter_custom(|iters| {
-            let start = thread_cpu();
-            for _ in 0..iters {
-                std::hint::black_box(dynamics::simulate(&gust, &gust_config).unwrap());
-            }
-            thread_cpu() - start
-        })
-    });
+    timed(&mut g, "gust_case_300s", &gust, &gust_config);
     match moordyn_case::python() {
         Some(py) => {
             let case = moordyn_case::gust_case_json(&gust, gust_config.segments);

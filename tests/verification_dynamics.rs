@@ -29,7 +29,8 @@ fn undamped(mut p: DynamicsProblem) -> DynamicsProblem {
 }
 
 /// Started at the §6 equilibrium in a steady 8 m/s wind (and in a log-law
-/// wind), the tether stays there: every node within 1e-6 L over 600 s
+/// wind), the tether stays there at the default step: every node within
+/// 1e-6 L over 600 s
 /// (measured 1.5e-6 m uniform, 3.5e-7 m log law: 1.5e-9 L). The discrete
 /// equilibrium the run starts from is the §6 shooting solution within
 /// 2e-4 L (the lumped model's `O(N⁻²)`; measured 0.027 m in altitude).
@@ -50,9 +51,9 @@ fn steady_wind_equilibrium_does_not_drift() {
         );
         assert!((top[1] - eq.altitude_m).abs() < 2e-4 * 1000.0);
         assert!((top[0] - eq.downwind_m).abs() < 2e-4 * 1000.0);
+        // The default step.
         let cfg = DynamicsConfig {
             duration_s: 600.0,
-            time_step_s: 0.05,
             ..Default::default()
         };
         let x0 = start.state.positions.clone();
@@ -219,8 +220,8 @@ fn calm_air_oscillations_have_the_string_frequencies() {
 /// large transverse oscillation (10 m at the top, 10 segments, geometrically
 /// nonlinear through the tension) is conserved to second order with
 /// `ρ∞ = 1` (the trapezoidal rule): the largest energy error over 30 s
-/// falls by 4× per halving of the step (measured 1.07e-6, 2.5e-7, 6.3e-8,
-/// 1.65e-8 J for h = 5, 2.5, 1.25, 0.625 ms: orders 2.09, 2.00, 1.92). A
+/// falls by 4× per halving of the step (measured 1.02e-6, 2.55e-7, 6.41e-8,
+/// 1.58e-8 J for h = 5, 2.5, 1.25, 0.625 ms: orders 2.00, 1.99, 2.02). A
 /// purely axial oscillation is linear and conserved to roundoff (≈ 1e-9 J
 /// of 6e5 J); with both together the energy exchange between the axial
 /// and the transverse motion makes the error erratic in `h` (not used).

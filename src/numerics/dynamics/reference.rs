@@ -74,8 +74,9 @@ pub fn gust_case() -> DynamicsProblem {
     p
 }
 
-/// The gust case's run: 50 segments, the default step, a sample every
-/// 0.05 s (MoorDyn's coupling step) over [`GUST_CASE_DURATION_S`].
+/// The gust case's run: 50 segments, the default step, a sample at every
+/// step (asked every 0.05 s, MoorDyn's coupling step) over
+/// [`GUST_CASE_DURATION_S`].
 pub fn gust_case_config() -> DynamicsConfig {
     DynamicsConfig {
         segments: 50,
