@@ -23,9 +23,25 @@
 //! counts do not depend on the load); `…=step_study` runs the hour at
 //! steps from 0.0125 to 0.2 s and prints how far each is from the finest.
 //!
-//! Measured (2 cores shared by six helpers; load average 8–12):
-//! see the table at the end of this comment, filled in by the session
-//! that measured it.
+//! Measured 2026-12-02 (criterion medians, 10 flat samples; 2 cores
+//! shared by six helpers, load average 10–12, two callgrind runs beside
+//! it, so the wall clock measures the load; the CPU clock and the
+//! instruction counts do not), default step 0.1 s:
+//!
+//! | bench | wall | CPU | instructions (callgrind) |
+//! | --- | --- | --- | --- |
+//! | hour_of_turbulence_50_segments | 2.45 s | 0.359 s | 3.71 G (13.61 G before, at h = 0.05 s: 1.41 s CPU) |
+//! | gust_case_300s | 101 ms | 12.8 ms | 0.132 G (0.729 G before) |
+//! | moordyn_gust_case_300s (CPU of its stepping loop) | — | 3.15 s | — |
+//! | seeds_4_hours_2_threads | 4.26 s | — | — |
+//!
+//! The gust case is 245× MoorDyn's CPU on the CPU clock (31× even on this
+//! loaded wall clock), its histories within 0.45 N (0.09 %) of MoorDyn's;
+//! 100 seeds of an hour on two workers: 25 × 4.26 s ≈ 107 s (extrapolated
+//! from the four, under this load).
+//!
+//! At h = 0.05 s (the former default) the hour is 6.86 G instructions,
+//! 0.61 s CPU.
 
 use std::time::{Duration, Instant};
 
