@@ -1,88 +1,206 @@
-//! Dynamic tether (SPEC §11): one hour of von Kármán turbulence (I = 0.15,
-//! L_u = 150 m, mean 8 m/s) on the issue-23 tether (50 segments, 1000 m,
-//! 0.078 kg/m, 5 mm, F = 1000 N, EA = 1 MN) at h = 0.05 s; and the 300 s
-//! gust case of `tests/peer_moordyn.rs` (whose output prints MoorDyn's CPU
-//! time on the same case, side by side).
+//! Dynamic tether (SPEC §11), on the reference tether of issue 23
+//! (`dynamics::reference`: 50 segments, 1000 m, 0.078 kg/m, 5 mm,
+//! F = 1000 N, EA = 1 MN) at the default step:
+//!
+//! * `hour_of_turbulence_50_segments`: one hour of von Kármán turbulence
+//!   (I = 0.15, L_u = 150 m, mean 8 m/s, seed 7), field synthesis included;
+//! * `gust_case_300s`: the 300 s gust case of `tests/peer_moordyn.rs`, and
+//!   beside it `moordyn_gust_case_300s`: MoorDyn 2.7.2 on the same case in
+//!   the same bench run (the CPU time of its stepping loop as its driver
+//!   reports it; skipped without `target/peers-venv`). The two time
+//!   histories agree within the tolerance of `tests/peer_moordyn.rs`
+//!   (winch and top tension within 2 % of their peaks, the aerostat within
+//!   5 m) at the same configuration (`reference::gust_case_config`);
+//! * `seeds_4_hours_2_threads`: four seeds of the hour on a rayon pool of
+//!   two threads (100 seeds take 25 times as long).
+//!
+//! The `_cpu` variants time the CPU of the running thread rather than the
+//! wall clock: the machine is shared, and the wall clock of a loaded
+//! machine measures the load.
+//!
+//! `TETHERPLAN_DYNAMICS_ONCE=turbulence_60s|turbulence_hour|gust_300s` runs
+//! one case once and exits, for `valgrind --tool=callgrind` (instruction
+//! counts do not depend on the load); `…=step_study` runs the hour at
+//! steps from 0.0125 to 0.2 s and prints how far each is from the finest.
+//!
+//! Measured 2026-12-02 (criterion medians, 10 flat samples; 2 cores
+//! shared by six helpers, load average 10–12, two callgrind runs beside
+//! it, so the wall clock measures the load; the CPU clock and the
+//! instruction counts do not), default step 0.1 s:
+//!
+//! | bench | wall | CPU | instructions (callgrind) |
+//! | --- | --- | --- | --- |
+//! | hour_of_turbulence_50_segments | 2.45 s | 0.359 s | 3.71 G (13.61 G before, at h = 0.05 s: 1.41 s CPU) |
+//! | gust_case_300s | 101 ms | 12.8 ms | 0.132 G (0.729 G before) |
+//! | moordyn_gust_case_300s (CPU of its stepping loop) | — | 3.15 s | — |
+//! | seeds_4_hours_2_threads | 4.26 s | — | — |
+//!
+//! The gust case is 245× MoorDyn's CPU on the CPU clock (31× even on this
+//! loaded wall clock), its histories within 0.45 N (0.09 %) of MoorDyn's;
+//! 100 seeds of an hour on two workers: 25 × 4.26 s ≈ 107 s (extrapolated
+//! from the four, under this load).
+//!
+//! At h = 0.05 s (the former default) the hour is 6.86 G instructions,
+//! 0.61 s CPU.
 
-use criterion::{Criterion, criterion_group, criterion_main};
-use tetherplan::numerics::dynamics::{
-    self, Aerostat, DynamicsConfig, DynamicsProblem, GustHistory, LengthSchedule, SpectrumModel,
-    Tether, Turbulence,
-};
-use tetherplan::numerics::tether::wind::WindProfile;
+use std::time::{Duration, Instant};
 
-fn problem() -> DynamicsProblem {
-    DynamicsProblem {
-        tether: Tether {
-            mass_per_length_kg_m: 0.078,
-            diameter_m: 0.005,
-            normal_drag_coefficient: 1.2,
-            tangential_drag_coefficient: 0.0,
-            axial_stiffness_n: 1e6,
-            internal_damping_n_s: 1e4,
-            drag_on_stretched_length: false,
-        },
-        aerostat: Aerostat {
-            net_buoyancy_n: 1000.0,
-            mass_kg: 10.0,
-            reference_area_m2: 20.0,
-            drag_coefficient: 0.3,
-            lift_coefficient: 0.0,
-            added_mass_coefficient: 0.5,
-        },
-        flow: WindProfile::uniform(8.0),
-        gusts: vec![],
-        turbulence: None,
-        air_density_kg_m3: 1.225,
-        gravity_m_s2: 9.81,
-        length: LengthSchedule::Fixed(1000.0),
+use criterion::measurement::WallTime;
+use criterion::{BenchmarkGroup, Criterion, SamplingMode, criterion_group};
+use tetherplan::numerics::dynamics::{self, DynamicsConfig, DynamicsProblem, reference};
+
+#[path = "../tests/peers/moordyn_case.rs"]
+mod moordyn_case;
+
+/// CPU time of the calling thread.
+fn thread_cpu() -> Duration {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
+}
+
+fn hour() -> DynamicsConfig {
+    DynamicsConfig {
+        duration_s: 3600.0,
+        sample_interval_s: 1.0,
+        ..Default::default()
     }
+}
+
+/// `name` on the wall clock, and `name_cpu` on the thread's CPU clock.
+fn timed(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    problem: &DynamicsProblem,
+    config: &DynamicsConfig,
+) {
+    g.bench_function(name, |b| {
+        b.iter(|| dynamics::simulate(problem, config).unwrap())
+    });
+    g.bench_function(format!("{name}_cpu"), |b| {
+        b.iter_custom(|iters| {
+            let start = thread_cpu();
+            for _ in 0..iters {
+                std::hint::black_box(dynamics::simulate(problem, config).unwrap());
+            }
+            thread_cpu() - start
+        })
+    });
 }
 
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("dynamics");
     g.sample_size(10);
-    let mut turbulent = problem();
-    turbulent.turbulence = Some(Turbulence {
-        model: SpectrumModel::VonKarman,
-        intensity: 0.15,
-        length_scale_m: 150.0,
-        seed: 7,
-    });
-    let hour = DynamicsConfig {
-        duration_s: 3600.0,
-        time_step_s: 0.05,
-        sample_interval_s: 1.0,
-        ..Default::default()
-    };
-    g.bench_function("hour_of_turbulence_50_segments", |b| {
-        b.iter(|| dynamics::simulate(&turbulent, &hour).unwrap())
-    });
-    let mut gust = problem();
-    gust.flow = WindProfile::calm();
-    gust.gusts = vec![
-        GustHistory::Ramp {
-            start_time_s: 0.0,
-            duration_s: 30.0,
-            change_m_s: 8.0,
-        },
-        GustHistory::OneMinusCosine {
-            start_time_s: 200.0,
-            duration_s: 20.0,
-            amplitude_m_s: 6.0,
-        },
-    ];
-    let short = DynamicsConfig {
-        duration_s: 300.0,
-        time_step_s: 0.05,
-        sample_interval_s: 0.05,
-        ..Default::default()
-    };
-    g.bench_function("moordyn_gust_case_300s", |b| {
-        b.iter(|| dynamics::simulate(&gust, &short).unwrap())
+    g.sampling_mode(SamplingMode::Flat);
+    let hour = hour();
+    timed(&mut g, "hour_of_turbulence_50_segments", &reference::turbulence_case(7), &hour);
+    let gust = reference::gust_case();
+    let gust_config = reference::gust_case_config();
+    timed(&mut g, "gust_case_300s", &gust, &gust_config);
+    match moordyn_case::python() {
+        Some(py) => {
+            let case = moordyn_case::gust_case_json(&gust, gust_config.segments);
+            g.bench_function("moordyn_gust_case_300s", |b| {
+                b.iter_custom(|iters| {
+                    (0..iters)
+                        .map(|_| Duration::from_secs_f64(moordyn_case::run(&py, &case).cpu_s))
+                        .sum()
+                })
+            });
+        }
+        None => eprintln!("moordyn_gust_case_300s skipped: no target/peers-venv"),
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let seeds: Vec<_> = (0..4).map(reference::turbulence_case).collect();
+    g.bench_function("seeds_4_hours_2_threads", |b| {
+        b.iter(|| {
+            use rayon::prelude::*;
+            pool.install(|| {
+                seeds
+                    .par_iter()
+                    .map(|p| dynamics::simulate(p, &hour).unwrap().peak_winch_tension.value)
+                    .collect::<Vec<_>>()
+            })
+        })
     });
     g.finish();
 }
 
 criterion_group!(benches, bench);
-criterion_main!(benches);
+
+/// The hour of turbulence at several steps against the finest: the
+/// largest difference of the winch tension over the 1 s samples, and the
+/// peak (the accuracy a step buys; `TETHERPLAN_DYNAMICS_ONCE=step_study`).
+fn step_study() {
+    let p = reference::turbulence_case(7);
+    let runs: Vec<_> = [0.0125, 0.025, 0.05, 0.1, 0.2]
+        .iter()
+        .map(|&h| {
+            let cpu = thread_cpu();
+            let run = dynamics::simulate(
+                &p,
+                &DynamicsConfig {
+                    time_step_s: h,
+                    ..hour()
+                },
+            )
+            .unwrap();
+            (h, run, (thread_cpu() - cpu).as_secs_f64())
+        })
+        .collect();
+    let fine = &runs[0].1;
+    for (h, run, cpu) in &runs {
+        let worst = run
+            .samples
+            .iter()
+            .zip(&fine.samples)
+            .map(|(a, b)| (a.winch_tension_n - b.winch_tension_n).abs())
+            .fold(0.0, f64::max);
+        println!(
+            "h = {h} s: {:?}; peak winch {:.3} N at {:.2} s; worst |ΔT| against h = 0.0125 s: {worst:.3} N; {cpu:.3} s CPU",
+            run.statistics, run.peak_winch_tension.value, run.peak_winch_tension.time_s
+        );
+    }
+}
+
+fn main() {
+    if std::env::var("TETHERPLAN_DYNAMICS_ONCE").as_deref() == Ok("step_study") {
+        step_study();
+        return;
+    }
+    if let Ok(case) = std::env::var("TETHERPLAN_DYNAMICS_ONCE") {
+        let clock = Instant::now();
+        let cpu = thread_cpu();
+        let run = match case.as_str() {
+            "turbulence_60s" => dynamics::simulate(
+                &reference::turbulence_case(7),
+                &DynamicsConfig {
+                    duration_s: 60.0,
+                    ..Default::default()
+                },
+            ),
+            "turbulence_hour" => dynamics::simulate(&reference::turbulence_case(7), &hour()),
+            "gust_300s" => dynamics::simulate(&reference::gust_case(), &reference::gust_case_config()),
+            _ => panic!("unknown case {case}"),
+        }
+        .unwrap();
+        println!(
+            "{case}: {:?}; peak winch tension {:.4} N at {:.2} s; {:.3} s CPU, {:.3} s wall",
+            run.statistics,
+            run.peak_winch_tension.value,
+            run.peak_winch_tension.time_s,
+            (thread_cpu() - cpu).as_secs_f64(),
+            clock.elapsed().as_secs_f64()
+        );
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -3,8 +3,8 @@
 //! integrator's order. Numbers measured on this tree are in each test's doc.
 
 use tetherplan::numerics::dynamics::{
-    self, Aerostat, DynamicsConfig, DynamicsProblem, GustHistory, LengthSchedule, Outcome, State,
-    StepView, Tether, model,
+    self, DynamicsConfig, DynamicsProblem, GustHistory, LengthSchedule, Outcome, State, StepView,
+    model,
 };
 use tetherplan::numerics::params::AerostatSystem;
 use tetherplan::numerics::params::NondimState;
@@ -14,35 +14,10 @@ use tetherplan::numerics::string::transient::{rest_eigenvalue, rest_mode_shape};
 use tetherplan::numerics::tether::equilibrium::EquilibriumConfig;
 use tetherplan::numerics::tether::wind::WindProfile;
 
-/// The bench tether of issue 23: 1000 m, 0.078 kg/m, 5 mm, F = 1000 N,
-/// m = 10 kg, C_D A = 6 m², EA = 1 MN, c = 10 kN s.
-fn problem(wind_m_s: f64) -> DynamicsProblem {
-    DynamicsProblem {
-        tether: Tether {
-            mass_per_length_kg_m: 0.078,
-            diameter_m: 0.005,
-            normal_drag_coefficient: 1.2,
-            tangential_drag_coefficient: 0.0,
-            axial_stiffness_n: 1e6,
-            internal_damping_n_s: 1e4,
-            drag_on_stretched_length: true,
-        },
-        aerostat: Aerostat {
-            net_buoyancy_n: 1000.0,
-            mass_kg: 10.0,
-            reference_area_m2: 20.0,
-            drag_coefficient: 0.3,
-            lift_coefficient: 0.0,
-            added_mass_coefficient: 0.5,
-        },
-        flow: WindProfile::uniform(wind_m_s),
-        gusts: vec![],
-        turbulence: None,
-        air_density_kg_m3: 1.225,
-        gravity_m_s2: 9.81,
-        length: LengthSchedule::Fixed(1000.0),
-    }
-}
+/// The reference tether of issue 23 (`dynamics::reference`): 1000 m,
+/// 0.078 kg/m, 5 mm, F = 1000 N, m = 10 kg, C_D A = 6 m², EA = 1 MN,
+/// c = 10 kN s, in a uniform wind (m/s).
+use tetherplan::numerics::dynamics::reference::reference_problem as problem;
 
 /// Calm air, no drag, no internal damping.
 fn undamped(mut p: DynamicsProblem) -> DynamicsProblem {
@@ -54,7 +29,8 @@ fn undamped(mut p: DynamicsProblem) -> DynamicsProblem {
 }
 
 /// Started at the §6 equilibrium in a steady 8 m/s wind (and in a log-law
-/// wind), the tether stays there: every node within 1e-6 L over 600 s
+/// wind), the tether stays there at the default step: every node within
+/// 1e-6 L over 600 s
 /// (measured 1.5e-6 m uniform, 3.5e-7 m log law: 1.5e-9 L). The discrete
 /// equilibrium the run starts from is the §6 shooting solution within
 /// 2e-4 L (the lumped model's `O(N⁻²)`; measured 0.027 m in altitude).
@@ -75,9 +51,9 @@ fn steady_wind_equilibrium_does_not_drift() {
         );
         assert!((top[1] - eq.altitude_m).abs() < 2e-4 * 1000.0);
         assert!((top[0] - eq.downwind_m).abs() < 2e-4 * 1000.0);
+        // The default step.
         let cfg = DynamicsConfig {
             duration_s: 600.0,
-            time_step_s: 0.05,
             ..Default::default()
         };
         let x0 = start.state.positions.clone();
@@ -244,8 +220,8 @@ fn calm_air_oscillations_have_the_string_frequencies() {
 /// large transverse oscillation (10 m at the top, 10 segments, geometrically
 /// nonlinear through the tension) is conserved to second order with
 /// `ρ∞ = 1` (the trapezoidal rule): the largest energy error over 30 s
-/// falls by 4× per halving of the step (measured 1.07e-6, 2.5e-7, 6.3e-8,
-/// 1.65e-8 J for h = 5, 2.5, 1.25, 0.625 ms: orders 2.09, 2.00, 1.92). A
+/// falls by 4× per halving of the step (measured 1.02e-6, 2.55e-7, 6.41e-8,
+/// 1.58e-8 J for h = 5, 2.5, 1.25, 0.625 ms: orders 2.00, 1.99, 2.02). A
 /// purely axial oscillation is linear and conserved to roundoff (≈ 1e-9 J
 /// of 6e5 J); with both together the energy exchange between the axial
 /// and the transverse motion makes the error erratic in `h` (not used).

@@ -32,7 +32,9 @@ pub fn dot(a: V2, b: V2) -> f64 {
 
 #[inline]
 pub fn norm(a: V2) -> f64 {
-    a[0].hypot(a[1])
+    // √(x² + z²), not `hypot`: a libm call ten times the cost, and these
+    // magnitudes (m, m/s, N) are far from overflow and underflow.
+    (a[0] * a[0] + a[1] * a[1]).sqrt()
 }
 
 /// `s a bᵀ`.

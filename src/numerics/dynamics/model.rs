@@ -89,7 +89,8 @@ pub struct Evaluation {
     pub force: Vec<V2>,
     /// Diagonal mass `m_i` (kg), `i = 1 … N`.
     pub mass: Vec<f64>,
-    /// `∂P/∂R`: lower / diagonal / upper blocks.
+    /// `∂P/∂R`: lower / diagonal / upper blocks (filled by [`evaluate`]
+    /// with `jacobian`; [`evaluate_with`] sends them to its sink instead).
     pub kx: [Vec<B2>; 3],
     /// `∂P/∂Ṙ`.
     pub cv: [Vec<B2>; 3],
@@ -130,23 +131,168 @@ impl Evaluation {
     }
 }
 
-/// Drag of a tether piece of length `lam` with tangent `q` on `u_r`;
-/// with `jac`, adds `−∂f/∂V` (= `∂f/∂u_r`, times −1 for the node velocity) to it.
-#[inline]
-fn tether_drag(p: &Parameters, q: V2, lam: f64, ur: V2, jac: Option<&mut B2>) -> V2 {
+/// Where the Jacobian of an evaluation goes, term by term (block row `k`
+/// is node `k + 1`; block `b = 0, 1, 2` couples it to node `k`, `k + 1`,
+/// `k + 2`). [`evaluate`] keeps `∂P/∂R` and `∂P/∂Ṙ` apart
+/// ([`Evaluation::kx`], [`Evaluation::cv`]); the integrator takes the
+/// weighted sum [`IterationMatrix`] directly.
+pub trait JacobianSink {
+    /// Whether the Jacobian is wanted at all.
+    const WANTED: bool;
+    /// Sets every block of `n` rows to zero.
+    fn clear(&mut self, n: usize);
+    /// Segment `j = 1 … N` (nodes `j − 1`, `j`) with unit tangent `t`: its
+    /// force on node `j` has `∂/∂R_j = −K`, `K = g I + (k_a − g) t tᵀ`, and
+    /// `∂/∂Ṙ_j = −C`, `C = c t tᵀ`; `+K`, `+C` on node `j − 1`, and the
+    /// opposite on node `j − 1`'s row.
+    fn segment(&mut self, j: usize, t: V2, g: f64, k_a: f64, c: f64);
+    /// Adds `d` to `∂P_k/∂Ṙ_k`.
+    fn velocity_diagonal(&mut self, k: usize, d: &B2);
+    /// Adds `x I` to `∂P_k/∂R` and `v I` to `∂P_k/∂Ṙ` of block `b`.
+    fn identity(&mut self, k: usize, b: usize, x: f64, v: f64);
+}
+
+/// No Jacobian.
+pub struct NoJacobian;
+
+impl JacobianSink for NoJacobian {
+    const WANTED: bool = false;
+    #[inline]
+    fn clear(&mut self, _: usize) {}
+    #[inline]
+    fn segment(&mut self, _: usize, _: V2, _: f64, _: f64, _: f64) {}
+    #[inline]
+    fn velocity_diagonal(&mut self, _: usize, _: &B2) {}
+    #[inline]
+    fn identity(&mut self, _: usize, _: usize, _: f64, _: f64) {}
+}
+
+/// `∂P/∂R` and `∂P/∂Ṙ` kept apart.
+struct Separate {
+    kx: [Vec<B2>; 3],
+    cv: [Vec<B2>; 3],
+}
+
+/// Adds the symmetric `s` to the four blocks a segment touches.
+#[inline(always)]
+fn scatter_segment(lower: &mut [B2], diag: &mut [B2], upper: &mut [B2], j: usize, s: &B2) {
+    let b = j - 1;
+    add_to(&mut diag[b], -1.0, s);
+    if j >= 2 {
+        let a = j - 2;
+        add_to(&mut lower[b], 1.0, s);
+        add_to(&mut diag[a], -1.0, s);
+        add_to(&mut upper[a], 1.0, s);
+    }
+}
+
+impl JacobianSink for Separate {
+    const WANTED: bool = true;
+    fn clear(&mut self, n: usize) {
+        for b in 0..3 {
+            self.kx[b][..n].fill(ZERO);
+            self.cv[b][..n].fill(ZERO);
+        }
+    }
+    #[inline]
+    fn segment(&mut self, j: usize, t: V2, g: f64, k_a: f64, c: f64) {
+        let mut ks = outer(k_a - g, t, t);
+        add_identity(&mut ks, g);
+        let cs = outer(c, t, t);
+        let [kl, kd, ku] = &mut self.kx;
+        scatter_segment(kl, kd, ku, j, &ks);
+        let [cl, cd, cu] = &mut self.cv;
+        scatter_segment(cl, cd, cu, j, &cs);
+    }
+    #[inline]
+    fn velocity_diagonal(&mut self, k: usize, d: &B2) {
+        add_to(&mut self.cv[1][k], 1.0, d);
+    }
+    #[inline]
+    fn identity(&mut self, k: usize, b: usize, x: f64, v: f64) {
+        add_identity(&mut self.kx[b][k], x);
+        add_identity(&mut self.cv[b][k], v);
+    }
+}
+
+/// `w_x ∂P/∂R + w_v ∂P/∂Ṙ` in three block diagonals (the integrator's
+/// iteration matrix, before its mass term).
+#[derive(Clone, Debug)]
+pub struct IterationMatrix {
+    pub position_weight: f64,
+    pub velocity_weight: f64,
+    pub lower: Vec<B2>,
+    pub diag: Vec<B2>,
+    pub upper: Vec<B2>,
+}
+
+impl IterationMatrix {
+    pub fn new(segments: usize) -> Self {
+        Self {
+            position_weight: 0.0,
+            velocity_weight: 0.0,
+            lower: vec![ZERO; segments],
+            diag: vec![ZERO; segments],
+            upper: vec![ZERO; segments],
+        }
+    }
+}
+
+impl JacobianSink for IterationMatrix {
+    const WANTED: bool = true;
+    fn clear(&mut self, n: usize) {
+        self.lower[..n].fill(ZERO);
+        self.diag[..n].fill(ZERO);
+        self.upper[..n].fill(ZERO);
+    }
+    #[inline]
+    fn segment(&mut self, j: usize, t: V2, g: f64, k_a: f64, c: f64) {
+        let wx = self.position_weight;
+        let mut s = outer(wx * (k_a - g) + self.velocity_weight * c, t, t);
+        add_identity(&mut s, wx * g);
+        scatter_segment(&mut self.lower, &mut self.diag, &mut self.upper, j, &s);
+    }
+    #[inline]
+    fn velocity_diagonal(&mut self, k: usize, d: &B2) {
+        add_to(&mut self.diag[k], self.velocity_weight, d);
+    }
+    #[inline]
+    fn identity(&mut self, k: usize, b: usize, x: f64, v: f64) {
+        let s = self.position_weight * x + self.velocity_weight * v;
+        let m = match b {
+            0 => &mut self.lower[k],
+            1 => &mut self.diag[k],
+            _ => &mut self.upper[k],
+        };
+        add_identity(m, s);
+    }
+}
+
+/// Drag of a tether piece of length `lam` with tangent `q` on `u_r`, and
+/// `∂f/∂V` (the node velocity enters `u_r` with −1) when `jac`.
+#[inline(always)]
+fn tether_drag(p: &Parameters, q: V2, lam: f64, ur: V2, jac: bool) -> (V2, B2) {
     let n = [-q[1], q[0]];
     let un = dot(ur, n);
     let ut = dot(ur, q);
     let kn = p.normal_drag * lam;
     let kt = p.tangential_drag * lam;
-    let f = add(scale(kn * un.abs() * un, n), scale(kt * ut.abs() * ut, q));
-    if let Some(j) = jac {
-        add_to(j, -1.0, &outer(2.0 * kn * un.abs(), n, n));
-        add_to(j, -1.0, &outer(2.0 * kt * ut.abs(), q, q));
+    let an = kn * un.abs();
+    let at = kt * ut.abs();
+    let f = [an * un * n[0] + at * ut * q[0], an * un * n[1] + at * ut * q[1]];
+    let mut d = ZERO;
+    if jac {
+        // −(2 k_n |u_n| n nᵀ + 2 k_t |u_t| q qᵀ).
+        let (a, b) = (-2.0 * an, -2.0 * at);
+        d = [
+            [a * n[0] * n[0] + b * q[0] * q[0], a * n[0] * n[1] + b * q[0] * q[1]],
+            [a * n[1] * n[0] + b * q[1] * q[0], a * n[1] * n[1] + b * q[1] * q[1]],
+        ];
     }
-    f
+    (f, d)
 }
 
+/// `v/|v|`, or straight up for a zero vector.
 #[inline]
 fn unit(v: V2) -> V2 {
     let r = norm(v);
@@ -157,9 +303,10 @@ fn unit(v: V2) -> V2 {
     }
 }
 
-/// Evaluates `P(t, R, Ṙ)` and, when `jacobian`, its blocks. `pos`, `vel`
-/// hold nodes `1 … N` (the winch is the origin, at rest); `wind(x, z)`
-/// is the air velocity `(u, 0)` at a point at this instant.
+/// Evaluates `P(t, R, Ṙ)` and, when `jacobian`, its blocks
+/// ([`Evaluation::kx`], [`Evaluation::cv`]). `pos`, `vel` hold nodes
+/// `1 … N` (the winch is the origin, at rest); `wind(x, z)` is the air
+/// velocity `(u, 0)` at a point at this instant.
 pub fn evaluate(
     p: &Parameters,
     len: Length,
@@ -169,93 +316,90 @@ pub fn evaluate(
     jacobian: bool,
     out: &mut Evaluation,
 ) {
+    if jacobian {
+        let mut sink = Separate {
+            kx: std::mem::take(&mut out.kx),
+            cv: std::mem::take(&mut out.cv),
+        };
+        evaluate_with(p, len, pos, vel, wind, &mut sink, out);
+        out.kx = sink.kx;
+        out.cv = sink.cv;
+    } else {
+        evaluate_with(p, len, pos, vel, wind, &mut NoJacobian, out);
+    }
+}
+
+/// [`evaluate`] with the Jacobian sent to `jac` (the blocks
+/// [`Evaluation::kx`], [`Evaluation::cv`] are left as they are).
+pub fn evaluate_with<W: Fn(f64, f64) -> f64 + ?Sized, J: JacobianSink>(
+    p: &Parameters,
+    len: Length,
+    pos: &[V2],
+    vel: &[V2],
+    wind: &W,
+    jac: &mut J,
+    out: &mut Evaluation,
+) {
     let n = p.segments;
+    let (pos, vel) = (&pos[..n], &vel[..n]);
     let big_l = len.length_m;
     let l = big_l / n as f64;
     let dzeta = 1.0 / n as f64;
     let rate = len.rate_m_s / big_l;
     let accel_term = len.acceleration_m_s2 / big_l - 2.0 * rate * rate;
     let node = |i: usize| -> V2 { if i == 0 { [0.0; 2] } else { pos[i - 1] } };
-    let nvel = |i: usize| -> V2 { if i == 0 { [0.0; 2] } else { vel[i - 1] } };
     let rho_a = p.mass_per_length_kg_m;
 
     // Mapped derivatives and material velocities.
     let zeta_dot = |i: usize| (1.0 - i as f64 * dzeta) * rate;
-    for i in 0..=n {
-        let zd = zeta_dot(i);
-        let d = if i == 0 {
-            scale(1.0 / dzeta, sub(node(1), node(0)))
-        } else if i < n {
-            scale(0.5 / dzeta, sub(node(i + 1), node(i - 1)))
-        } else {
-            [0.0; 2]
-        };
-        out.material_velocity[i] = add(nvel(i), scale(zd, d));
+    let mv = &mut out.material_velocity[..=n];
+    if rate != 0.0 {
+        mv[0] = scale(zeta_dot(0) / dzeta, node(1));
+        for i in 1..n {
+            let d = scale(0.5 / dzeta, sub(node(i + 1), node(i - 1)));
+            mv[i] = add(vel[i - 1], scale(zeta_dot(i), d));
+        }
+        mv[n] = vel[n - 1];
+    } else {
+        mv[0] = [0.0; 2];
+        mv[1..].copy_from_slice(vel);
     }
 
-    for k in 0..n {
-        out.force[k] = [0.0; 2];
-        out.mass[k] = if k + 1 == n {
-            0.5 * rho_a * l + p.aerostat_inertia_kg
-        } else {
-            rho_a * l
-        };
-        if jacobian {
-            for b in 0..3 {
-                out.kx[b][k] = ZERO;
-                out.cv[b][k] = ZERO;
-            }
-        }
-    }
+    let node_mass = rho_a * l;
+    out.mass[..n].fill(node_mass);
+    out.mass[n - 1] = 0.5 * node_mass + p.aerostat_inertia_kg;
+    jac.clear(n);
 
     // Segments.
     let ea_l = p.axial_stiffness_n / l;
     let c_l = p.damping_n_s / l;
+    let inv_l = 1.0 / l;
+    let mut prev = [0.0; 2];
     for j in 1..=n {
-        let e = sub(node(j), node(j - 1));
-        let ell = norm(e);
-        let t = unit(e);
-        let strain = ell / l - 1.0;
-        let strain_rate = dot(
-            t,
-            sub(out.material_velocity[j], out.material_velocity[j - 1]),
-        ) / l;
+        let r = pos[j - 1];
+        let e = sub(r, prev);
+        prev = r;
+        let ell = dot(e, e).sqrt();
+        let t = if ell > 0.0 {
+            scale(1.0 / ell, e)
+        } else {
+            [0.0, 1.0]
+        };
+        let strain = ell * inv_l - 1.0;
+        let strain_rate = dot(t, sub(out.material_velocity[j], out.material_velocity[j - 1])) * inv_l;
         let raw = p.axial_stiffness_n * strain + p.damping_n_s * strain_rate;
         let active = strain > 0.0 && raw > 0.0;
         let tension = if active { raw } else { 0.0 };
         out.tension[j - 1] = tension;
         out.tangent[j - 1] = t;
         out.stretched[j - 1] = ell;
-        let f = scale(tension, t);
-        // Node j (index j−1) is pulled back, node j−1 forward.
-        out.force[j - 1] = sub(out.force[j - 1], f);
-        if j >= 2 {
-            out.force[j - 2] = add(out.force[j - 2], f);
-        }
-        if jacobian && active {
-            let mut ks = outer(ea_l, t, t);
-            if ell > 0.0 {
-                let g = tension / ell;
-                add_identity(&mut ks, g);
-                add_to(&mut ks, -1.0, &outer(g, t, t));
-            }
-            let cs = outer(c_l, t, t);
-            let b = j - 1;
-            add_to(&mut out.kx[1][b], -1.0, &ks);
-            add_to(&mut out.cv[1][b], -1.0, &cs);
-            if j >= 2 {
-                let a = j - 2;
-                add_to(&mut out.kx[0][b], 1.0, &ks);
-                add_to(&mut out.cv[0][b], 1.0, &cs);
-                add_to(&mut out.kx[1][a], -1.0, &ks);
-                add_to(&mut out.cv[1][a], -1.0, &cs);
-                add_to(&mut out.kx[2][a], 1.0, &ks);
-                add_to(&mut out.cv[2][a], 1.0, &cs);
-            }
+        if J::WANTED && active {
+            let g = if ell > 0.0 { tension / ell } else { 0.0 };
+            jac.segment(j, t, g, ea_l, c_l);
         }
     }
 
-    // Weight, buoyancy, drag.
+    // Tension, weight, buoyancy, drag at the nodes.
     let lam = |j: usize| {
         if p.drag_on_stretched_length {
             out.stretched[j - 1]
@@ -263,60 +407,62 @@ pub fn evaluate(
             l
         }
     };
+    let any_drag = p.normal_drag > 0.0 || p.tangential_drag > 0.0;
+    let weight = node_mass * p.gravity_m_s2;
     let mut tether_drag_sum = [0.0; 2];
-    for i in 1..=n {
+    for i in 1..n {
         let k = i - 1;
-        let r = node(i);
-        let v = out.material_velocity[i];
-        let (q, length, wmass) = if i < n {
-            (
-                unit(sub(node(i + 1), node(i - 1))),
-                0.5 * (lam(i) + lam(i + 1)),
-                rho_a * l,
-            )
-        } else {
-            (out.tangent[n - 1], 0.5 * lam(n), 0.5 * rho_a * l)
-        };
-        out.force[k][1] -= wmass * p.gravity_m_s2;
-        let u = wind(r[0], r[1]);
-        let ur = sub([u, 0.0], v);
-        let jac = if jacobian {
-            Some(&mut out.cv[1][k])
-        } else {
-            None
-        };
-        let fd = if p.normal_drag > 0.0 || p.tangential_drag > 0.0 {
-            tether_drag(p, q, length, ur, jac)
+        let (below, above) = (scale(out.tension[k], out.tangent[k]), scale(out.tension[i], out.tangent[i]));
+        let mut f = sub(above, below);
+        f[1] -= weight;
+        if any_drag {
+            let r = pos[k];
+            let q = unit(sub(node(i + 1), node(i - 1)));
+            let ur = [wind(r[0], r[1]) - out.material_velocity[i][0], -out.material_velocity[i][1]];
+            let (fd, d) = tether_drag(p, q, 0.5 * (lam(i) + lam(i + 1)), ur, J::WANTED);
+            if J::WANTED {
+                jac.velocity_diagonal(k, &d);
+            }
+            tether_drag_sum = add(tether_drag_sum, fd);
+            f = add(f, fd);
+        }
+        out.force[k] = f;
+    }
+    {
+        // The aerostat's node.
+        let k = n - 1;
+        let r = pos[k];
+        let top = scale(out.tension[k], out.tangent[k]);
+        let ur = [wind(r[0], r[1]) - out.material_velocity[n][0], -out.material_velocity[n][1]];
+        let fd = if any_drag {
+            let (fd, d) = tether_drag(p, out.tangent[k], 0.5 * lam(n), ur, J::WANTED);
+            if J::WANTED {
+                jac.velocity_diagonal(k, &d);
+            }
+            fd
         } else {
             [0.0; 2]
         };
         tether_drag_sum = add(tether_drag_sum, fd);
-        out.force[k] = add(out.force[k], fd);
-        if i == n {
-            out.top_force = add(
-                add(
-                    scale(out.tension[n - 1], out.tangent[n - 1]),
-                    [0.0, 0.5 * rho_a * l * p.gravity_m_s2],
-                ),
-                scale(-1.0, fd),
-            );
-            out.force[k][1] += p.net_buoyancy_n;
-            let speed = norm(ur);
-            let fa = [
-                p.aerostat_drag * speed * ur[0] - p.aerostat_lift * speed * ur[1],
-                p.aerostat_drag * speed * ur[1] + p.aerostat_lift * speed * ur[0],
-            ];
-            out.force[k] = add(out.force[k], fa);
-            if jacobian && speed > 0.0 {
-                // ∂f/∂u_r of k_D |u| u + k_L |u| J u; the node velocity enters with −1.
-                let mut d = outer(p.aerostat_drag / speed, ur, ur);
-                add_identity(&mut d, p.aerostat_drag * speed);
-                let ju = [-ur[1], ur[0]];
-                add_to(&mut d, 1.0, &outer(p.aerostat_lift / speed, ju, ur));
-                d[0][1] -= p.aerostat_lift * speed;
-                d[1][0] += p.aerostat_lift * speed;
-                add_to(&mut out.cv[1][k], -1.0, &d);
-            }
+        out.top_force = [top[0] - fd[0], top[1] + 0.5 * weight - fd[1]];
+        let speed = norm(ur);
+        let fa = [
+            p.aerostat_drag * speed * ur[0] - p.aerostat_lift * speed * ur[1],
+            p.aerostat_drag * speed * ur[1] + p.aerostat_lift * speed * ur[0],
+        ];
+        out.force[k] = [
+            -top[0] + fd[0] + fa[0],
+            -top[1] - 0.5 * weight + p.net_buoyancy_n + fd[1] + fa[1],
+        ];
+        if J::WANTED && speed > 0.0 {
+            // ∂f/∂u_r of k_D |u| u + k_L |u| J u; the node velocity enters with −1.
+            let mut d = outer(p.aerostat_drag / speed, ur, ur);
+            add_identity(&mut d, p.aerostat_drag * speed);
+            let ju = [-ur[1], ur[0]];
+            add_to(&mut d, 1.0, &outer(p.aerostat_lift / speed, ju, ur));
+            d[0][1] -= p.aerostat_lift * speed;
+            d[1][0] += p.aerostat_lift * speed;
+            jac.velocity_diagonal(k, &scale_block(-1.0, &d));
         }
     }
     out.tether_drag = tether_drag_sum;
@@ -324,24 +470,18 @@ pub fn evaluate(
     // The winch's half segment.
     {
         let t = out.tangent[0];
-        let u = wind(0.0, 0.0);
-        let ur = sub([u, 0.0], out.material_velocity[0]);
-        let fd = if p.normal_drag > 0.0 || p.tangential_drag > 0.0 {
-            tether_drag(p, t, 0.5 * lam(1), ur, None)
+        let ur = sub([wind(0.0, 0.0), 0.0], out.material_velocity[0]);
+        let fd = if any_drag {
+            tether_drag(p, t, 0.5 * lam(1), ur, false).0
         } else {
             [0.0; 2]
         };
-        out.winch_force = add(
-            sub(
-                scale(out.tension[0], t),
-                [0.0, 0.5 * rho_a * l * p.gravity_m_s2],
-            ),
-            fd,
-        );
+        out.winch_force = add(sub(scale(out.tension[0], t), [0.0, 0.5 * weight]), fd);
     }
 
     // Convective inertia −m_i (2 ζ̇ Ṙ_ζ + ζ̇² R_ζζ + ζ̈ R_ζ) at the interior nodes.
     if rate != 0.0 || len.acceleration_m_s2 != 0.0 {
+        let nvel = |i: usize| -> V2 { if i == 0 { [0.0; 2] } else { vel[i - 1] } };
         for i in 1..n {
             let k = i - 1;
             let zd = zeta_dot(i);
@@ -358,17 +498,20 @@ pub fn evaluate(
                     + c_1 * (rp[c] - rm[c]);
                 out.force[k][c] -= m * conv;
             }
-            if jacobian {
-                add_identity(&mut out.kx[1][k], 2.0 * m * c_2);
-                add_identity(&mut out.kx[2][k], -m * (c_2 + c_1));
-                add_identity(&mut out.cv[2][k], -m * c_v);
+            if J::WANTED {
+                jac.identity(k, 1, 2.0 * m * c_2, 0.0);
+                jac.identity(k, 2, -m * (c_2 + c_1), -m * c_v);
                 if i >= 2 {
-                    add_identity(&mut out.kx[0][k], -m * (c_2 - c_1));
-                    add_identity(&mut out.cv[0][k], m * c_v);
+                    jac.identity(k, 0, -m * (c_2 - c_1), m * c_v);
                 }
             }
         }
     }
+}
+
+#[inline]
+fn scale_block(s: f64, m: &B2) -> B2 {
+    [[s * m[0][0], s * m[0][1]], [s * m[1][0], s * m[1][1]]]
 }
 
 /// Energy of the tether and aerostat at constant length (J): kinetic

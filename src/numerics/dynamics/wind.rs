@@ -229,6 +229,10 @@ pub struct TurbulenceField {
     samples: usize,
     levels: usize,
     convection_m_s: f64,
+    /// `1/Δt_w`, `1/Δz`, `1/U_c`: sampling multiplies.
+    inv_dt: f64,
+    inv_dz: f64,
+    inv_convection: f64,
     /// Level-major.
     data: Vec<f64>,
 }
@@ -325,6 +329,9 @@ impl TurbulenceField {
             samples: m,
             levels,
             convection_m_s: grid.convection_m_s,
+            inv_dt: 1.0 / grid.time_step_s,
+            inv_dz: 1.0 / dz,
+            inv_convection: 1.0 / grid.convection_m_s,
             data,
         })
     }
@@ -344,23 +351,36 @@ impl TurbulenceField {
         self.dz
     }
 
-    /// `u′(x, z, t)` (m/s).
-    #[inline]
+    /// The Taylor convection speed `U_c` (m/s).
+    pub fn convection_m_s(&self) -> f64 {
+        self.convection_m_s
+    }
+
+    /// `u′(x, z, t)` (m/s): bilinear in `τ = t − x/U_c` and `z` (no libm
+    /// call, no division: it is evaluated at every node in every Newton
+    /// iteration).
+    #[inline(always)]
     pub fn sample(&self, x: f64, z: f64, t: f64) -> f64 {
-        let tau = t - x / self.convection_m_s;
-        let p = tau / self.dt;
-        let fl = p.floor();
-        let frac = p - fl;
-        let n = self.samples as i64;
-        let i0 = (fl as i64).rem_euclid(n) as usize;
-        let i1 = if i0 + 1 == self.samples { 0 } else { i0 + 1 };
-        let zk = (z.max(0.0) / self.dz).min((self.levels - 1) as f64);
-        let k0 = (zk.floor() as usize).min(self.levels - 2);
+        let p = (t - x * self.inv_convection) * self.inv_dt;
+        // ⌊p⌋ without a libm call; the period is a power of two, so the
+        // wrap is a mask (two's complement gives the Euclidean remainder).
+        let mut i = p as i64;
+        if (i as f64) > p {
+            i -= 1;
+        }
+        let frac = p - i as f64;
+        let mask = self.samples - 1;
+        let i0 = (i as usize) & mask;
+        let i1 = (i0 + 1) & mask;
+        let top = (self.levels - 1) as f64;
+        let zk = (z.max(0.0) * self.inv_dz).min(top);
+        let k0 = (zk as usize).min(self.levels - 2);
         let fz = zk - k0 as f64;
-        let a = &self.data[k0 * self.samples..];
-        let b = &self.data[(k0 + 1) * self.samples..];
-        let va = a[i0] + frac * (a[i1] - a[i0]);
-        let vb = b[i0] + frac * (b[i1] - b[i0]);
+        let a = &self.data[k0 * self.samples..(k0 + 2) * self.samples];
+        let (a0, a1) = (a[i0], a[i1]);
+        let (b0, b1) = (a[self.samples + i0], a[self.samples + i1]);
+        let va = a0 + frac * (a1 - a0);
+        let vb = b0 + frac * (b1 - b0);
         va + fz * (vb - va)
     }
 }
@@ -425,6 +445,53 @@ mod tests {
             }
             assert!((yn.0 - re).abs() < 1e-12 && (yn.1 - im).abs() < 1e-12);
         }
+    }
+
+    /// The sampling (floor and wrap without libm) is the bilinear
+    /// interpolation of the stored series, periodic in `τ` also for
+    /// negative `τ`, constant above the top level.
+    #[test]
+    fn field_sampling_interpolates_the_series() {
+        let t = Turbulence {
+            model: SpectrumModel::Kaimal,
+            intensity: 0.1,
+            length_scale_m: 100.0,
+            seed: 3,
+        };
+        let grid = FieldGrid {
+            time_step_s: 0.25,
+            period_s: 60.0,
+            top_m: 200.0,
+            levels: 5,
+            convection_m_s: 10.0,
+        };
+        let f = TurbulenceField::synthesise(&t, &WindProfile::uniform(10.0), &grid).unwrap();
+        let (m, dz, dt) = (f.samples, f.level_spacing_m(), 0.25);
+        let period = f.period_s();
+        let direct = |x: f64, z: f64, t: f64| {
+            let tau = (t - x / 10.0).rem_euclid(period) / dt;
+            let i0 = tau.floor() as usize % m;
+            let i1 = (i0 + 1) % m;
+            let fr = tau - tau.floor();
+            let zk = (z.max(0.0) / dz).min(4.0);
+            let k0 = (zk.floor() as usize).min(3);
+            let fz = zk - k0 as f64;
+            let at = |k: usize| f.level(k)[i0] + fr * (f.level(k)[i1] - f.level(k)[i0]);
+            at(k0) + fz * (at(k0 + 1) - at(k0))
+        };
+        for &(x, z, tt) in &[
+            (0.0, 0.0, 0.0),
+            (0.0, 50.0, 0.25),
+            (37.0, 61.3, 12.34),
+            (900.0, 130.0, 3.0),
+            (-15.0, 199.0, 59.9),
+            (0.0, 500.0, 7.7),
+            (123.0, -4.0, -30.1),
+        ] {
+            let (a, b) = (f.sample(x, z, tt), direct(x, z, tt));
+            assert!((a - b).abs() < 1e-12, "{x} {z} {tt}: {a} vs {b}");
+        }
+        assert_eq!(f.sample(0.0, 50.0, 0.5), f.level(1)[2]);
     }
 
     #[test]

@@ -1,0 +1,301 @@
+//! What a dynamic run is asked (SPEC §11): the tether, the aerostat, the
+//! steady flow and its changes in time, the unstretched length in time
+//! ([`DynamicsProblem`]); the mesh, step, outputs and iteration settings
+//! ([`DynamicsConfig`]); and their checks (fields named as in the JSON
+//! contract).
+
+use super::model::{Length, Parameters};
+use super::wind::{GustHistory, Turbulence};
+use super::{MAX_SAMPLES, MAX_SEGMENTS, MAX_SHAPES, MAX_STEPS, MAX_WORK, MIN_SEGMENTS};
+use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
+use crate::numerics::profile::Profile;
+use crate::numerics::tether::equilibrium::{Body, Cable, EquilibriumProblem};
+use crate::numerics::tether::wind::WindProfile;
+
+/// The tether's properties.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tether {
+    /// ρA (kg/m).
+    pub mass_per_length_kg_m: f64,
+    /// Diameter `d` (m).
+    pub diameter_m: f64,
+    /// Normal drag coefficient `C_n`.
+    pub normal_drag_coefficient: f64,
+    /// Tangential (skin-friction) drag coefficient `C_t` on `π d`; 0: none.
+    pub tangential_drag_coefficient: f64,
+    /// `EA` (N).
+    pub axial_stiffness_n: f64,
+    /// Kelvin–Voigt damping `c` (N s): `T = EA ε + c ε̇`.
+    pub internal_damping_n_s: f64,
+    /// Drag on the stretched length (SPEC §6) or on the unstretched one (MoorDyn).
+    pub drag_on_stretched_length: bool,
+}
+
+/// The aerostat.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Aerostat {
+    /// Net buoyancy `F` (N).
+    pub net_buoyancy_n: f64,
+    /// Structural mass `m` (kg).
+    pub mass_kg: f64,
+    pub reference_area_m2: f64,
+    pub drag_coefficient: f64,
+    pub lift_coefficient: f64,
+    /// `C_a` on the displaced air mass.
+    pub added_mass_coefficient: f64,
+}
+
+impl Aerostat {
+    /// Displaced volume `V = (F + m g)/(ρ g)` (m³).
+    pub fn displaced_volume_m3(&self, air_density: f64, gravity: f64) -> f64 {
+        (self.net_buoyancy_n + self.mass_kg * gravity) / (air_density * gravity)
+    }
+}
+
+/// The unstretched length in time.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LengthSchedule {
+    Fixed(f64),
+    Profile(Profile),
+}
+
+impl LengthSchedule {
+    pub fn at(&self, t: f64) -> Length {
+        match self {
+            Self::Fixed(l) => Length {
+                length_m: *l,
+                rate_m_s: 0.0,
+                acceleration_m_s2: 0.0,
+            },
+            Self::Profile(p) => {
+                let k = p.kinematics(t);
+                Length {
+                    length_m: k.length_m,
+                    rate_m_s: k.rate_m_s,
+                    acceleration_m_s2: k.acceleration_m_s2,
+                }
+            }
+        }
+    }
+
+    /// The longest length over `[0, until]` (sampled; profiles are monotone between knots).
+    pub fn longest_m(&self, until_s: f64) -> f64 {
+        (0..=512)
+            .map(|i| self.at(until_s * i as f64 / 512.0).length_m)
+            .fold(0.0, f64::max)
+    }
+}
+
+/// One dynamic problem (SI).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DynamicsProblem {
+    pub tether: Tether,
+    pub aerostat: Aerostat,
+    /// The steady flow `U(z)`.
+    pub flow: WindProfile,
+    /// Uniform changes `ΔU(t)`, summed.
+    pub gusts: Vec<GustHistory>,
+    pub turbulence: Option<Turbulence>,
+    pub air_density_kg_m3: f64,
+    pub gravity_m_s2: f64,
+    pub length: LengthSchedule,
+}
+
+/// Discretisation, output and iteration settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DynamicsConfig {
+    pub segments: usize,
+    /// The step `h` (s). The default 0.1 s is set by accuracy on the
+    /// reference tether (`benches/dynamics.rs`, `step_study`): one hour of
+    /// von Kármán turbulence gives the peak winch tension within 0.03 % of
+    /// h = 0.0125 s (512.44 against 512.60 N; 0.004 % at 0.05 s, 0.17 % at
+    /// 0.2 s) and every 1 s sample within 4.1 N (0.8 % of the peak; 3.4 N
+    /// at 0.05 s); the gust case stays within the MoorDyn tolerance of
+    /// `tests/peer_moordyn.rs`.
+    pub time_step_s: f64,
+    pub duration_s: f64,
+    /// Spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`.
+    pub spectral_radius: f64,
+    /// Time between kept samples (s); every step is still checked for peaks and slack.
+    pub sample_interval_s: f64,
+    /// Times at which the shape is kept (s).
+    pub shape_times_s: Vec<f64>,
+    /// Newton stops when its estimated velocity error is below this (m/s):
+    /// the largest velocity correction, times `θ/(1 − θ)` with `θ` the
+    /// observed contraction (Hairer & Wanner; see the integrator), or the
+    /// correction itself; positions are then off by about `tol · β h/γ`.
+    pub newton_tolerance_m_s: f64,
+    pub max_newton_iterations: usize,
+    /// Sample spacing of a turbulence series (s).
+    pub turbulence_time_step_s: f64,
+    /// Level spacing of a turbulence field (m), at most.
+    pub turbulence_level_spacing_m: f64,
+}
+
+impl Default for DynamicsConfig {
+    fn default() -> Self {
+        Self {
+            segments: 50,
+            time_step_s: 0.1,
+            duration_s: 600.0,
+            spectral_radius: 0.8,
+            sample_interval_s: 1.0,
+            shape_times_s: vec![],
+            newton_tolerance_m_s: 1e-6,
+            max_newton_iterations: 30,
+            turbulence_time_step_s: 0.2,
+            turbulence_level_spacing_m: 50.0,
+        }
+    }
+}
+
+
+impl DynamicsProblem {
+    /// `ΔU(t)`, the sum of the gusts (m/s).
+    pub fn gust_change_m_s(&self, t: f64) -> f64 {
+        self.gusts.iter().map(|g| g.change_m_s(t)).sum()
+    }
+
+    /// Checks the problem (fields as named in the JSON contract).
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        let t = &self.tether;
+        require_positive("cable.mass_per_length_kg_m", t.mass_per_length_kg_m)?;
+        require_positive("cable.diameter_m", t.diameter_m)?;
+        require_non_negative(
+            "cable.normal_drag_coefficient_nondim",
+            t.normal_drag_coefficient,
+        )?;
+        require_non_negative(
+            "cable.tangential_drag_coefficient_nondim",
+            t.tangential_drag_coefficient,
+        )?;
+        require_positive("cable.axial_stiffness_n", t.axial_stiffness_n)?;
+        require_non_negative("cable.internal_damping_n_s", t.internal_damping_n_s)?;
+        let a = &self.aerostat;
+        require_positive("aerostat.net_buoyancy_n", a.net_buoyancy_n)?;
+        require_non_negative("aerostat.mass_kg", a.mass_kg)?;
+        require_positive("aerostat.reference_area_m2", a.reference_area_m2)?;
+        require_non_negative("aerostat.drag_coefficient_nondim", a.drag_coefficient)?;
+        if !a.lift_coefficient.is_finite() {
+            return Err(InvalidInput::new(
+                "aerostat.lift_coefficient_nondim",
+                "must be a finite number",
+            ));
+        }
+        require_non_negative(
+            "aerostat.added_mass_coefficient_nondim",
+            a.added_mass_coefficient,
+        )?;
+        require_positive("wind.air_density_kg_m3", self.air_density_kg_m3)?;
+        require_positive("gravity_m_s2", self.gravity_m_s2)?;
+        if let LengthSchedule::Fixed(l) = self.length {
+            require_positive("tether_length_m", l)?;
+        }
+        Ok(())
+    }
+
+    /// The discretised parameters.
+    pub fn parameters(&self, segments: usize) -> Parameters {
+        let rho = self.air_density_kg_m3;
+        let t = &self.tether;
+        let a = &self.aerostat;
+        let volume = a.displaced_volume_m3(rho, self.gravity_m_s2);
+        Parameters {
+            segments,
+            mass_per_length_kg_m: t.mass_per_length_kg_m,
+            gravity_m_s2: self.gravity_m_s2,
+            axial_stiffness_n: t.axial_stiffness_n,
+            damping_n_s: t.internal_damping_n_s,
+            normal_drag: 0.5 * rho * t.normal_drag_coefficient * t.diameter_m,
+            tangential_drag: 0.5
+                * rho
+                * t.tangential_drag_coefficient
+                * std::f64::consts::PI
+                * t.diameter_m,
+            drag_on_stretched_length: t.drag_on_stretched_length,
+            net_buoyancy_n: a.net_buoyancy_n,
+            aerostat_inertia_kg: a.mass_kg + a.added_mass_coefficient * rho * volume,
+            aerostat_drag: 0.5 * rho * a.drag_coefficient * a.reference_area_m2,
+            aerostat_lift: 0.5 * rho * a.lift_coefficient * a.reference_area_m2,
+        }
+    }
+
+    /// The §6 problem of the steady flow at length `length_m`.
+    pub fn static_problem(&self, length_m: f64) -> EquilibriumProblem {
+        EquilibriumProblem {
+            cable: Cable {
+                mass_per_length_kg_m: self.tether.mass_per_length_kg_m,
+                diameter_m: self.tether.diameter_m,
+                normal_drag_coefficient: self.tether.normal_drag_coefficient,
+                axial_stiffness_n: Some(self.tether.axial_stiffness_n),
+                breaking_strength_n: None,
+            },
+            body: Body {
+                net_buoyancy_n: self.aerostat.net_buoyancy_n,
+                drag_coefficient: self.aerostat.drag_coefficient,
+                lift_coefficient: self.aerostat.lift_coefficient,
+                reference_area_m2: self.aerostat.reference_area_m2,
+            },
+            wind: self.flow.clone(),
+            air_density_kg_m3: self.air_density_kg_m3,
+            tether_length_m: length_m,
+            gravity_m_s2: self.gravity_m_s2,
+        }
+    }
+}
+
+/// Why no run was made.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DynamicsError {
+    #[error(transparent)]
+    Invalid(#[from] InvalidInput),
+    /// The steady equilibrium is slack: the lumped model has no ground.
+    #[error("the tether is slack in the steady flow at the start (it rests on the ground)")]
+    SlackStart,
+    #[error("the static Newton iteration did not converge (residual {residual_n} N)")]
+    NoStaticEquilibrium { residual_n: f64 },
+}
+
+pub(super) fn validate_config(config: &DynamicsConfig) -> Result<(), InvalidInput> {
+    if !(MIN_SEGMENTS..=MAX_SEGMENTS).contains(&config.segments) {
+        return Err(InvalidInput::new(
+            "segments",
+            format!(
+                "must be between {MIN_SEGMENTS} and {MAX_SEGMENTS}, got {}",
+                config.segments
+            ),
+        ));
+    }
+    require_positive("time_step_s", config.time_step_s)?;
+    require_positive("duration_s", config.duration_s)?;
+    require_positive("sample_interval_s", config.sample_interval_s)?;
+    if !(0.0..=1.0).contains(&config.spectral_radius) {
+        return Err(InvalidInput::new(
+            "spectral_radius",
+            format!("must lie in [0, 1], got {}", config.spectral_radius),
+        ));
+    }
+    let steps = (config.duration_s / config.time_step_s).ceil();
+    if steps > MAX_STEPS as f64 || steps * config.segments as f64 > MAX_WORK {
+        return Err(InvalidInput::new(
+            "duration_s",
+            format!(
+                "needs {steps:.0} steps of {} segments: more than {MAX_STEPS} steps or {MAX_WORK:e} segment-steps",
+                config.segments
+            ),
+        ));
+    }
+    if config.duration_s / config.sample_interval_s > MAX_SAMPLES as f64 {
+        return Err(InvalidInput::new(
+            "sample_interval_s",
+            format!("would keep more than {MAX_SAMPLES} samples"),
+        ));
+    }
+    if config.shape_times_s.len() > MAX_SHAPES {
+        return Err(InvalidInput::new(
+            "shape_times_s",
+            format!("at most {MAX_SHAPES} shapes"),
+        ));
+    }
+    Ok(())
+}
