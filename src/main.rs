@@ -353,7 +353,7 @@ fn main() -> ExitCode {
                         transient::frequency_response_runs(r)
                     }
                     ge_charts::AnyFrequencyResponseRequest::Base(r) => {
-                        r.frequencies_rad_s.count + 1
+                        r.frequencies_rad_s.count() + 1
                     }
                 };
                 let bar = progress_bar(runs as u64, "frequencies");

@@ -228,27 +228,12 @@
     };
     // Cells: one pixel per (wind, length) in an offscreen image, scaled up;
     // infeasible cells washed out so the feasible region stands out.
-    const img = document.createElement("canvas");
-    img.width = nw;
-    img.height = nl;
-    const ictx = img.getContext("2d");
-    const data = ictx.createImageData(nw, nl);
-    for (let i = 0; i < nw; i++) {
-      for (let j = 0; j < nl; j++) {
-        const p = cell(i, j);
-        const s = scaled(p[q.key]);
-        let [r, g, b] = s == null ? [190, 190, 190] : colour(s);
-        if (!p.feasible) [r, g, b] = [r, g, b].map((c) => Math.round(c * 0.55 + 255 * 0.45));
-        const k = 4 * ((nl - 1 - j) * nw + i);
-        data.data[k] = r;
-        data.data[k + 1] = g;
-        data.data[k + 2] = b;
-        data.data[k + 3] = 255;
-      }
-    }
-    ictx.putImageData(data, 0, 0);
-    ctx.imageSmoothingEnabled = false;
-    ctx.drawImage(img, m.left, m.top, pw, ph);
+    S.heatCells(ctx, { m, pw, ph, columns: nw, rows: nl }, (i, j) => {
+      const p = cell(i, j);
+      const s = scaled(p[q.key]);
+      const rgb = s == null ? [190, 190, 190] : colour(s);
+      return p.feasible ? rgb : rgb.map((c) => Math.round(c * 0.55 + 255 * 0.45));
+    });
 
     // Axes: cell i spans [U_i − dU/2, U_i + dU/2] (likewise in length).
     const W = res.wind_speeds_m_s;
@@ -368,44 +353,16 @@
     ctx.strokeStyle = "#333";
     ctx.lineWidth = 1;
     ctx.strokeRect(m.left + 0.5, m.top + 0.5, pw - 1, ph - 1);
-    ctx.fillStyle = "#333";
-    ctx.font = "11px system-ui, sans-serif";
-    ctx.textAlign = "center";
-    ctx.textBaseline = "top";
-    for (const v of ticks(W[0], W[nw - 1], narrow ? 4 : 8)) {
-      const x = xOf(v);
-      if (x < m.left - 0.5 || x > m.left + pw + 0.5) continue;
-      ctx.fillRect(x, m.top + ph, 1, 4);
-      ctx.fillText(fmt(v), x, m.top + ph + 6);
-    }
-    ctx.fillText("Wind speed at the reference height (m/s)", m.left + pw / 2, m.top + ph + 22);
-    ctx.textAlign = "right";
-    ctx.textBaseline = "middle";
-    for (const v of ticks(L[0], L[nl - 1], 6)) {
-      const y = yOf(v);
-      if (y < m.top - 0.5 || y > m.top + ph + 0.5) continue;
-      ctx.fillRect(m.left - 4, y, 4, 1);
-      ctx.fillText(fmt(v, 4), m.left - 6, y);
-    }
-    ctx.save();
-    ctx.translate(12, m.top + ph / 2);
-    ctx.rotate(-Math.PI / 2);
-    ctx.textAlign = "center";
-    ctx.fillText("Tether length (m)", 0, 0);
-    ctx.restore();
+    S.heatFrame(ctx, {
+      m, pw, ph, xOf, yOf,
+      xTicks: ticks(W[0], W[nw - 1], narrow ? 4 : 8), yTicks: ticks(L[0], L[nl - 1], 6),
+      fmtX: (v) => fmt(v), fmtY: (v) => fmt(v, 4),
+      xLabel: "Wind speed at the reference height (m/s)", yLabel: "Tether length (m)", xLabelDy: 22,
+    });
 
     // Colour bar.
     const bx = m.left + pw + 10;
     const bw = 12;
-    for (let k = 0; k < ph; k++) {
-      const [r, g, b] = colour(1 - k / ph);
-      ctx.fillStyle = `rgb(${r},${g},${b})`;
-      ctx.fillRect(bx, m.top + k, bw, 1);
-    }
-    ctx.strokeStyle = "#333";
-    ctx.strokeRect(bx + 0.5, m.top + 0.5, bw - 1, ph - 1);
-    ctx.fillStyle = "#333";
-    ctx.textAlign = "left";
     // Log colour: 1, 2 and 5 × 10^k when the range spans few decades.
     const barTicks = logColour
       ? (() => {
@@ -414,11 +371,7 @@
           return out.filter((v) => v >= lo - 1e-9 && v <= hi + 1e-9);
         })()
       : ticks(lo, hi, 5);
-    for (const v of barTicks) {
-      const y = m.top + ph - ((v - lo) / (hi - lo)) * ph;
-      ctx.fillRect(bx + bw, y, 3, 1);
-      ctx.fillText(logColour ? fmt(10 ** v, 2) : fmt(v, 3), bx + bw + 5, Math.min(m.top + ph - 5, Math.max(m.top + 5, y)));
-    }
+    S.heatScale(ctx, { x: bx, top: m.top, w: bw, h: ph, lo, hi, ticks: barTicks, text: (v) => (logColour ? fmt(10 ** v, 2) : fmt(v, 3)) });
     ctx.textAlign = "center";
     ctx.textBaseline = "top";
     ctx.fillText(`(${q.unit})`, bx + bw / 2 + 10, m.top + ph + 22);

@@ -99,26 +99,10 @@
     const hi = logColour ? Math.log10(max) : max;
     const scaleOf = (v) => (logColour ? (v > 0 ? (Math.log10(v) - lo) / (hi - lo || 1) : 0) : v / max);
     // Cells: one pixel per (time, frequency) in an offscreen image, scaled up.
-    const img = document.createElement("canvas");
-    img.width = t.length;
-    img.height = w.length;
-    const ictx = img.getContext("2d");
-    const data = ictx.createImageData(t.length, w.length);
-    for (let i = 0; i < w.length; i++) {
-      const row = w.length - 1 - i; // ω increases upwards
-      for (let j = 0; j < t.length; j++) {
-        const v = E[i][j];
-        const [r, g, b] = Number.isFinite(v) ? colour(scaleOf(v)) : [200, 200, 200];
-        const k = 4 * (row * t.length + j);
-        data.data[k] = r;
-        data.data[k + 1] = g;
-        data.data[k + 2] = b;
-        data.data[k + 3] = 255;
-      }
-    }
-    ictx.putImageData(data, 0, 0);
-    ctx.imageSmoothingEnabled = false;
-    ctx.drawImage(img, m.left, m.top, pw, ph);
+    S.heatCells(ctx, { m, pw, ph, columns: t.length, rows: w.length }, (j, i) => {
+      const v = E[i][j];
+      return Number.isFinite(v) ? colour(scaleOf(v)) : [200, 200, 200];
+    });
     ctx.strokeStyle = "#333";
     ctx.lineWidth = 1;
     ctx.strokeRect(m.left + 0.5, m.top + 0.5, pw - 1, ph - 1);
@@ -131,51 +115,21 @@
     const xOf = (v) => m.left + ((v - t0) / (t1 - t0)) * pw;
     const yOf = (v) => m.top + ph - ((v - w0) / (w1 - w0)) * ph;
     heat.layout = { m, pw, ph, w, t, E, t0, t1, w0, w1, max };
-    ctx.fillStyle = "#333";
-    ctx.font = "11px system-ui, sans-serif";
-    ctx.textAlign = "center";
-    ctx.textBaseline = "top";
-    for (const v of ticks(Math.max(0, t[0]), t[t.length - 1], narrow ? 4 : 8)) {
-      const x = xOf(v);
-      if (x < m.left - 0.5 || x > m.left + pw + 0.5) continue;
-      ctx.fillRect(x, m.top + ph, 1, 4);
-      ctx.fillText(fmt(v), x, m.top + ph + 6);
-    }
-    ctx.fillText("Time t (s)", m.left + pw / 2, m.top + ph + 21);
-    ctx.textAlign = "right";
-    ctx.textBaseline = "middle";
-    for (const v of ticks(w[0], w[w.length - 1], 5)) {
-      const y = yOf(v);
-      if (y < m.top - 0.5 || y > m.top + ph + 0.5) continue;
-      ctx.fillRect(m.left - 4, y, 4, 1);
-      ctx.fillText(fmt(v), m.left - 6, y);
-    }
-    ctx.save();
-    ctx.translate(12, m.top + ph / 2);
-    ctx.rotate(-Math.PI / 2);
-    ctx.textAlign = "center";
-    ctx.fillText("ω (rad/s)", 0, 0);
-    ctx.restore();
+    S.heatFrame(ctx, {
+      m, pw, ph, xOf, yOf,
+      xTicks: ticks(Math.max(0, t[0]), t[t.length - 1], narrow ? 4 : 8), yTicks: ticks(w[0], w[w.length - 1], 5),
+      fmtX: (v) => fmt(v), fmtY: (v) => fmt(v),
+      xLabel: "Time t (s)", yLabel: "ω (rad/s)", xLabelDy: 21,
+    });
 
     // Colour bar.
     const bx = m.left + pw + 10;
     const bw = 12;
-    for (let k = 0; k < ph; k++) {
-      const [r, g, b] = colour(1 - k / ph);
-      ctx.fillStyle = `rgb(${r},${g},${b})`;
-      ctx.fillRect(bx, m.top + k, bw, 1);
-    }
-    ctx.strokeStyle = "#333";
-    ctx.strokeRect(bx + 0.5, m.top + 0.5, bw - 1, ph - 1);
-    ctx.fillStyle = "#333";
-    ctx.textAlign = "left";
-    for (const v of ticks(lo, hi, 5)) {
-      if (logColour && !Number.isInteger(v)) continue;
-      const y = m.top + ph - ((v - lo) / (hi - lo || 1)) * ph;
-      ctx.fillRect(bx + bw, y, 3, 1);
-      const text = logColour ? (v >= -2 && v <= 3 ? fmt(10 ** v, 2) : `1e${v}`) : fmt(v, 2);
-      ctx.fillText(text, bx + bw + 5, Math.min(m.top + ph - 5, Math.max(m.top + 5, y)));
-    }
+    S.heatScale(ctx, {
+      x: bx, top: m.top, w: bw, h: ph, lo, hi: hi === lo ? lo + 1 : hi,
+      ticks: ticks(lo, hi, 5).filter((v) => !logColour || Number.isInteger(v)),
+      text: (v) => (logColour ? (v >= -2 && v <= 3 ? fmt(10 ** v, 2) : `1e${v}`) : fmt(v, 2)),
+    });
     ctx.textAlign = "center";
     ctx.textBaseline = "top";
     ctx.fillText("|y| (m)", bx + bw / 2 + (narrow ? 14 : 18), m.top + ph + 21);

@@ -78,12 +78,26 @@
     return { kind: "rest" };
   }
 
-  // The aerostat as an aerodynamic body (AeroBodyInput).
+  // The aerostat as an aerodynamic body (AeroBodyInput): the sphere radius
+  // from this panel; the drag coefficient, reference area and air density
+  // from the system card (the numbers the plan and the envelope use).
+  const cardRoots = () => [$("#system-card"), $("#plan-form")];
+  // Where the API's `aero` fields are entered on the page.
+  const CARD_FIELDS = {
+    "aero.model.drag_coefficient_nondim": "aerostat.drag_coefficient_nondim",
+    "aero.model.reference_area_m2": "aerostat.reference_area_m2",
+    "aero.air_density_kg_m3": "wind.air_density_kg_m3",
+  };
   function readBody(errors) {
+    const fromCard = (name, opts) => S.readNumber(cardRoots(), name, errors, opts);
     const model = $("#tr-force-model").value === "drag"
-      ? { kind: "drag", drag_coefficient_nondim: num("aero.model.drag_coefficient_nondim", errors) }
+      ? S.compact({
+          kind: "drag",
+          drag_coefficient_nondim: fromCard("aerostat.drag_coefficient_nondim"),
+          reference_area_m2: fromCard("aerostat.reference_area_m2", { optional: true }),
+        })
       : { kind: "thesis" };
-    return { model, radius_m: num("aero.radius_m", errors), air_density_kg_m3: num("aero.air_density_kg_m3", errors) };
+    return { model, radius_m: num("aero.radius_m", errors), air_density_kg_m3: fromCard("wind.air_density_kg_m3") };
   }
 
   function readFlow(errors) {
@@ -131,7 +145,14 @@
   const clearErrors = () => S.clearErrors(SOURCE);
   // Renders an API error body next to its field (or in `fallback`); returns a summary.
   function renderApiError(status, body, fallback) {
-    const input = inputFor(body?.error?.field);
+    const field = body?.error?.field;
+    const onCard = field && Object.keys(CARD_FIELDS).find((k) => field === k || field.startsWith(`${k}.`));
+    if (onCard) {
+      body = { ...body, error: { ...body.error, field: CARD_FIELDS[onCard] } };
+      const text = S.renderApiError(cardRoots(), status, body, fallback, SOURCE);
+      return `Fix the highlighted field (in the system card above): ${text}`;
+    }
+    const input = inputFor(field);
     const text = S.renderApiError(roots, status, body, fallback, SOURCE);
     if (!input) return text;
     const where = input.closest("#transient") ? "" : input.closest("#chart-form") ? " (in the chart form above)" : " (in the system card above)";

@@ -118,8 +118,8 @@ async fn ge_bad_input_names_the_field() {
             "perturbation.hold_s",
         ),
         (
-            json!({"wind": {"profile": {"kind": "tabulated", "points": []}, "force_model": {"kind": "thesis"}}}),
-            "wind.profile.points",
+            json!({"wind": {"flow": {"kind": "tabulated", "points": []}, "force_model": {"kind": "thesis"}}}),
+            "wind.flow.points",
         ),
         (
             json!({"numerics": {"time_step_s": 0.0}}),

@@ -197,6 +197,89 @@ async fn the_plans_old_names_are_refused_naming_the_new_place() {
     assert_eq!(ta, tb);
 }
 
+#[tokio::test]
+async fn the_ge_charts_wind_is_the_systems_flow_and_its_old_form_is_refused() {
+    let (app, _) = common::app();
+    let mut ge: Value = serde_json::from_str(GE_MODEL).unwrap();
+    // the chart takes its stiffness ratios as a list
+    ge.as_object_mut().unwrap().remove("stiffness_ratio");
+    let chart = |wind: Value| {
+        let mut body = with(
+            system(),
+            json!({"model": ge, "stiffness_ratios": [1e5], "net_buoyancies_n": [1000.0],
+                   "rates_m_s": [40.0], "numerics": {"horizon_s": 20.0}}),
+        );
+        body["wind"] = wind;
+        body
+    };
+    // The system's calm wind: the still-air chart.
+    let (status, calm) = post(&app, "/api/v1/charts", &chart(system()["wind"].clone())).await;
+    assert_eq!(status, StatusCode::OK, "{calm}");
+    assert!(calm["series"][0]["wind_amplitude_nondim"].is_null(), "{calm}");
+    // A wind on `wind.flow`; a power law of exponent 0 is the same uniform wind.
+    let flow = |f: Value| json!({"air_density_kg_m3": 1.12, "flow": f, "amplitudes_nondim": [0.0]});
+    let (status, windy) = post(
+        &app,
+        "/api/v1/charts",
+        &chart(flow(json!({"kind": "uniform", "speed_m_s": 5.0}))),
+    )
+    .await;
+    assert_eq!(status, StatusCode::OK, "{windy}");
+    assert_eq!(windy["series"][0]["wind_amplitude_nondim"], 0.0, "{windy}");
+    let (status, power) = post(
+        &app,
+        "/api/v1/charts",
+        &chart(flow(json!({"kind": "power_law", "coefficient_m_s": 5.0, "exponent_nondim": 0.0,
+                           "reference_height_m": 10.0}))),
+    )
+    .await;
+    assert_eq!(status, StatusCode::OK, "{power}");
+    assert_eq!(power["series"], windy["series"]);
+    // The drag model takes the aerostat's coefficient: without one it is
+    // refused naming the aerostat's field.
+    let mut drag = chart(flow(json!({"kind": "uniform", "speed_m_s": 5.0})));
+    drag["wind"]["force_model"] = json!({"kind": "drag"});
+    let (status, a) = post(&app, "/api/v1/charts", &drag).await;
+    assert_eq!(status, StatusCode::OK, "{a}");
+    drag["aerostat"]
+        .as_object_mut()
+        .unwrap()
+        .remove("drag_coefficient_nondim");
+    let (status, b) = post(&app, "/api/v1/charts", &drag).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{b}");
+    assert_eq!(b["error"]["field"], "aerostat.drag_coefficient_nondim", "{b}");
+    // The old shape is refused naming the new place (also as a job).
+    for (old, wind, new) in [
+        (
+            "wind.profile",
+            json!({"profile": {"kind": "uniform", "speed_m_s": 5.0}, "force_model": {"kind": "thesis"}}),
+            "wind.flow",
+        ),
+        (
+            "wind.force_model.drag_coefficient",
+            json!({"flow": {"kind": "uniform", "speed_m_s": 5.0},
+                   "force_model": {"kind": "drag", "drag_coefficient": 0.5}}),
+            "aerostat.drag_coefficient_nondim",
+        ),
+        (
+            "wind.force_model.reference_area_m2",
+            json!({"flow": {"kind": "uniform", "speed_m_s": 5.0},
+                   "force_model": {"kind": "drag", "reference_area_m2": 2.0}}),
+            "aerostat.reference_area_m2",
+        ),
+    ] {
+        let body = chart(wind);
+        let (status, r) = post(&app, "/api/v1/charts", &body).await;
+        assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{old}: {r}");
+        assert_eq!(r["error"]["field"], old, "{r}");
+        let m = r["error"]["message"].as_str().unwrap();
+        assert!(m.contains(&format!("moved to {new}")), "{old}: {m}");
+        let (status, r) = post(&app, "/api/v1/jobs", &json!({"kind": "chart", "request": body})).await;
+        assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{old}: {r}");
+        assert_eq!(r["error"]["field"], format!("request.{old}"), "{r}");
+    }
+}
+
 fn json_of(text: &str) -> Value {
     serde_json::from_str(text).unwrap_or_else(|_| panic!("not JSON: {text}"))
 }

@@ -311,15 +311,17 @@ fn cases() -> Vec<Case> {
         flow(json!({"kind": "perturbed", "base": f,
                                         "amplitude_nondim": 0.5, "wavenumber_1_m": 0.01}))
     };
+    // The GE chart's wind: the §9 flow, the drag data on the aerostat.
     let ge_wind = |w: Value| {
-        let mut wind = json!({"profile": {"kind": "uniform", "speed_m_s": 5.0},
-            "force_model": {"kind": "drag", "drag_coefficient": 0.5, "reference_area_m2": 1.0},
+        let mut wind = json!({"flow": {"kind": "uniform", "speed_m_s": 5.0},
+            "force_model": {"kind": "drag"},
             "radius_m": 1.0, "air_density_kg_m3": 1.12, "amplitudes_nondim": [0.5],
             "wavenumber_1_m": 0.01});
-        if let Some(p) = w.get("profile") {
-            wind["profile"] = p.clone();
+        if let Some(p) = w.get("flow") {
+            wind["flow"] = p.clone();
         }
-        ge_chart(json!({ "wind": wind }))
+        ge_chart(json!({ "wind": wind,
+            "aerostat": {"drag_coefficient_nondim": 0.5, "reference_area_m2": 1.0} }))
     };
     // The tether kinds and the plan state most of their bounds as literals.
     let lit = |kind: &'static str, request: &Value, path: &'static str, min: f64, max: f64| {
@@ -1158,53 +1160,40 @@ fn cases() -> Vec<Case> {
             "numerics.growth_tolerance_1_s",
             RATE_1_S,
         ),
-        case(
+        lit("chart", &ge_wind(json!({})), "wind.flow.speed_m_s", -150.0, 150.0),
+        lit(
             "chart",
-            ge_wind(json!({})),
-            "wind.profile.speed_m_s",
-            WIND_SPEED_M_S,
+            &ge_wind(json!({"flow": {"kind": "power_law", "coefficient_m_s": 0.1, "exponent_nondim": 0.3}})),
+            "wind.flow.coefficient_m_s",
+            -150.0,
+            150.0,
         ),
-        case(
+        lit(
             "chart",
-            ge_wind(json!({"profile": {"kind": "power_law", "coefficient": 0.1, "exponent": 0.3}})),
-            "wind.profile.coefficient",
-            WIND_SPEED_M_S,
+            &ge_wind(json!({"flow": {"kind": "power_law", "coefficient_m_s": 0.1, "exponent_nondim": 0.3}})),
+            "wind.flow.exponent_nondim",
+            0.0,
+            2.0,
         ),
-        case(
+        lit(
             "chart",
-            ge_wind(json!({"profile": {"kind": "power_law", "coefficient": 0.1, "exponent": 0.3}})),
-            "wind.profile.exponent",
-            EXPONENT_NONDIM,
-        ),
-        case(
-            "chart",
-            ge_wind(
-                json!({"profile": {"kind": "tabulated", "points": [{"elevation_m": 0.0, "speed_m_s": 1.0},
+            &ge_wind(
+                json!({"flow": {"kind": "tabulated", "points": [{"elevation_m": 0.0, "speed_m_s": 1.0},
             {"elevation_m": 1e5, "speed_m_s": 4.0}]}}),
             ),
-            "wind.profile.points[0].elevation_m",
-            ELEVATION_M,
+            "wind.flow.points[0].elevation_m",
+            0.0,
+            1e5,
         ),
-        case(
+        lit(
             "chart",
-            ge_wind(
-                json!({"profile": {"kind": "tabulated", "points": [{"elevation_m": 0.0, "speed_m_s": 1.0},
+            &ge_wind(
+                json!({"flow": {"kind": "tabulated", "points": [{"elevation_m": 0.0, "speed_m_s": 1.0},
             {"elevation_m": 1e5, "speed_m_s": 4.0}]}}),
             ),
-            "wind.profile.points[1].speed_m_s",
-            WIND_SPEED_M_S,
-        ),
-        case(
-            "chart",
-            ge_wind(json!({})),
-            "wind.force_model.drag_coefficient",
-            DRAG_COEFFICIENT_NONDIM,
-        ),
-        case(
-            "chart",
-            ge_wind(json!({})),
-            "wind.force_model.reference_area_m2",
-            REFERENCE_AREA_M2,
+            "wind.flow.points[1].speed_m_s",
+            -150.0,
+            150.0,
         ),
         case("chart", ge_wind(json!({})), "wind.radius_m", RADIUS_M),
         case(

@@ -394,8 +394,8 @@ solve_path!(
     parse = |body| ge_charts::parse_frequency_response(body),
     |req, limits| {
         let count = match &req {
-            AnyFrequencyResponseRequest::Wind(r) => r.frequencies_rad_s.count,
-            AnyFrequencyResponseRequest::Base(r) => r.frequencies_rad_s.count,
+            AnyFrequencyResponseRequest::Wind(r) => r.frequencies_rad_s.count(),
+            AnyFrequencyResponseRequest::Base(r) => r.frequencies_rad_s.count(),
         };
         if count > MAX_SYNC_FREQUENCIES {
             return Err(ApiError::too_large(

@@ -63,6 +63,23 @@ pub fn parse_ge<T: serde::de::DeserializeOwned>(
     parse_value(&value)
 }
 
+/// [`parse_ge`] for an analysis with its own use for the top-level key
+/// `keep` (the GE chart's `wind`, which is not calm): that key stays in the
+/// body and is parsed with it.
+pub fn parse_ge_keeping<T: serde::de::DeserializeOwned>(
+    body: &[u8],
+    analysis: &str,
+    keep: &str,
+) -> Result<T, RequestError> {
+    let mut value = json_object(body)?;
+    let kept = value.as_object_mut().and_then(|o| o.remove(keep));
+    system::resolve::strip_calm_system(&mut value, analysis)?;
+    if let (Some(k), Some(o)) = (kept, value.as_object_mut()) {
+        o.insert(keep.to_string(), k);
+    }
+    parse_value(&value)
+}
+
 /// Parses a body that has no flattened parts (one pass, field paths kept).
 pub fn parse_plain<T: serde::de::DeserializeOwned>(body: &[u8]) -> Result<T, RequestError> {
     parse_value(&json_object(body)?)

@@ -8,13 +8,14 @@ use crate::contract::ge::simulate::{
     EndLoadInput, GeAerostatInput, GeModelInput, GeSimulateRequest, LoadTimeInput,
 };
 use crate::contract::ge_charts::{
-    self, GeBaseFrequencyResponseRequest, GeChartRequest, GeWindInput, WindProfileInput,
+    self, GeBaseFrequencyResponseRequest, GeChartRequest, GeWindInput,
 };
 use crate::contract::ge_critical::{GeCriticalRequest, GeStabilityRequest};
-use crate::contract::transient::simulate::{
-    AeroBodyInput, AirFlowInput, FlowPointInput, ForceModelInput, FrequencyResponseParams,
-    InitialStateInput, SimulateParams, SteadyFlowInput,
+use crate::contract::transient::aero::{
+    AeroBodyInput, AirFlowInput, FlowPointInput, ForceModelInput, SteadyFlowInput,
 };
+use crate::contract::transient::frequency::FrequencyResponseParams;
+use crate::contract::transient::simulate::{InitialStateInput, SimulateParams};
 use crate::numerics::params::ranges::*;
 use crate::numerics::params::{InvalidInput, Range, compact};
 
@@ -150,15 +151,21 @@ impl CheckRanges for SafeRateParams {
     }
 }
 
-fn check_rate_grid(grid: &RateGrid, prefix: &str) -> Checked {
+/// The plausible range of every value of a grid (`prefix[i]`, or
+/// `prefix.min` and `prefix.max`).
+fn check_grid(range: Range, grid: &crate::contract::system::GridInput, prefix: &str) -> Checked {
     use crate::contract::system::GridInput;
-    match &grid.0 {
+    match grid {
         GridInput::Range(r) => {
-            POSITIVE_RATE_M_S.check(&at(prefix, "min"), r.min)?;
-            POSITIVE_RATE_M_S.check(&at(prefix, "max"), r.max).map(drop)
+            range.check(&at(prefix, "min"), r.min)?;
+            range.check(&at(prefix, "max"), r.max).map(drop)
         }
-        GridInput::List(v) => each(POSITIVE_RATE_M_S, prefix, v),
+        GridInput::List(v) => each(range, prefix, v),
     }
+}
+
+fn check_rate_grid(grid: &RateGrid, prefix: &str) -> Checked {
+    check_grid(POSITIVE_RATE_M_S, grid, prefix)
 }
 
 impl CheckRanges for ChartParams {
@@ -324,10 +331,7 @@ impl CheckRanges for FrequencyResponseParams {
         check_initial(&self.initial, l0)?;
         check_body(&self.aero, "aero")?;
         WIND_SPEED_M_S.check("wind_amplitude_m_s", self.wind_amplitude_m_s)?;
-        FREQUENCY_RAD_S.check("frequencies_rad_s.min", self.frequencies_rad_s.min)?;
-        FREQUENCY_RAD_S
-            .check("frequencies_rad_s.max", self.frequencies_rad_s.max)
-            .map(drop)
+        check_grid(FREQUENCY_RAD_S, &self.frequencies_rad_s, "frequencies_rad_s")
     }
 }
 
@@ -437,41 +441,8 @@ impl GeSimulateRequest {
 }
 
 fn check_ge_wind(w: &GeWindInput) -> Checked {
-    match &w.profile {
-        WindProfileInput::Uniform { speed_m_s } => {
-            WIND_SPEED_M_S.check("wind.profile.speed_m_s", *speed_m_s)?;
-        }
-        WindProfileInput::PowerLaw {
-            coefficient,
-            exponent,
-        } => {
-            WIND_SPEED_M_S.check("wind.profile.coefficient", *coefficient)?;
-            EXPONENT_NONDIM.check("wind.profile.exponent", *exponent)?;
-        }
-        WindProfileInput::Tabulated { points } => {
-            for (i, p) in points.iter().enumerate() {
-                ELEVATION_M.check(
-                    &format!("wind.profile.points[{i}].elevation_m"),
-                    p.elevation_m,
-                )?;
-                WIND_SPEED_M_S
-                    .check(&format!("wind.profile.points[{i}].speed_m_s"), p.speed_m_s)?;
-            }
-        }
-        WindProfileInput::Illustrative {} => {}
-    }
-    if let ge_charts::ForceModelInput::Drag {
-        drag_coefficient,
-        reference_area_m2,
-    } = &w.force_model
-    {
-        DRAG_COEFFICIENT_NONDIM.check("wind.force_model.drag_coefficient", *drag_coefficient)?;
-        opt(
-            REFERENCE_AREA_M2,
-            "wind.force_model.reference_area_m2",
-            *reference_area_m2,
-        )?;
-    }
+    // the §9 flow's bounds, as every route that takes `wind.flow` checks them
+    w.flow.profile("wind.flow")?;
     RADIUS_M.check("wind.radius_m", w.radius_m)?;
     GAS_DENSITY_KG_M3.check("wind.air_density_kg_m3", w.air_density_kg_m3)?;
     each(
@@ -532,8 +503,7 @@ impl GeBaseFrequencyResponseRequest {
             p.check_ranges("profile")?;
         }
         BASE_AMPLITUDE_M.check("amplitude_m", self.amplitude_m)?;
-        FREQUENCY_RAD_S.check("frequencies_rad_s.min", self.frequencies_rad_s.min)?;
-        FREQUENCY_RAD_S.check("frequencies_rad_s.max", self.frequencies_rad_s.max)?;
+        check_grid(FREQUENCY_RAD_S, &self.frequencies_rad_s, "frequencies_rad_s")?;
         opt(
             FREQUENCY_RAD_S,
             "reference_frequency_rad_s",

@@ -400,7 +400,7 @@ impl JobKind for AnyFrequencyResponseRequest {
     fn estimate(&self) -> Estimate {
         match self {
             Self::Wind(r) => {
-                let f = r.params.frequencies_rad_s.count as f64;
+                let f = r.params.frequencies_rad_s.count() as f64;
                 let n = r.params.samples as f64;
                 E::bytes(
                     "frequencies_rad_s.count",
@@ -410,7 +410,7 @@ impl JobKind for AnyFrequencyResponseRequest {
             Self::Base(r) => E::bytes(
                 "frequencies_rad_s.count",
                 est::SIMULATE_BASE as f64
-                    + r.frequencies_rad_s.count as f64 * est::PER_BASE_POINT as f64,
+                    + r.frequencies_rad_s.count() as f64 * est::PER_BASE_POINT as f64,
             ),
         }
     }

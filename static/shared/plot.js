@@ -1,6 +1,7 @@
 // The page's plotting helpers, shared by every panel: number formats, legend
 // values, uPlot with the page's axes, decade ticks on log axes, round tick
-// values and the viridis colour map of the heat maps.
+// values, the viridis colour map, and the cells, frame and colour bar of the
+// heat maps (envelope, frequency response).
 "use strict";
 
 window.tetherplanShared = window.tetherplanShared || {};
@@ -99,5 +100,66 @@ window.tetherplanShared = window.tetherplanShared || {};
     }
   }
 
-  Object.assign(shared, { fixed, sig3, legendValue, plotSize, decadesOnly, makePlot, ticks, colour, colourBar });
+  // The frame of a heat map drawn on a canvas: ticks and values below and
+  // left of the plot area (m: margins, pw × ph: its size; xOf/yOf: value →
+  // pixel), the x label under them and the y label turned upright.
+  function heatFrame(ctx, { m, pw, ph, xOf, yOf, xTicks, yTicks, fmtX, fmtY, xLabel, yLabel, xLabelDy = 22 }) {
+    ctx.fillStyle = "#333";
+    ctx.font = "11px system-ui, sans-serif";
+    ctx.textAlign = "center";
+    ctx.textBaseline = "top";
+    for (const v of xTicks) {
+      const x = xOf(v);
+      if (x < m.left - 0.5 || x > m.left + pw + 0.5) continue;
+      ctx.fillRect(x, m.top + ph, 1, 4);
+      ctx.fillText(fmtX(v), x, m.top + ph + 6);
+    }
+    ctx.fillText(xLabel, m.left + pw / 2, m.top + ph + xLabelDy);
+    ctx.textAlign = "right";
+    ctx.textBaseline = "middle";
+    for (const v of yTicks) {
+      const y = yOf(v);
+      if (y < m.top - 0.5 || y > m.top + ph + 0.5) continue;
+      ctx.fillRect(m.left - 4, y, 4, 1);
+      ctx.fillText(fmtY(v), m.left - 6, y);
+    }
+    ctx.save();
+    ctx.translate(12, m.top + ph / 2);
+    ctx.rotate(-Math.PI / 2);
+    ctx.textAlign = "center";
+    ctx.fillText(yLabel, 0, 0);
+    ctx.restore();
+  }
+
+  // The cells of a heat map: one pixel per (column i, row j) in an
+  // offscreen image (row 0 at the bottom), scaled up to the plot area
+  // without smoothing; rgb(i, j) gives each cell's colour.
+  function heatCells(ctx, { m, pw, ph, columns, rows }, rgb) {
+    const img = document.createElement("canvas");
+    img.width = columns;
+    img.height = rows;
+    const ictx = img.getContext("2d");
+    const data = ictx.createImageData(columns, rows);
+    for (let i = 0; i < columns; i++) {
+      for (let j = 0; j < rows; j++) {
+        const [r, g, b] = rgb(i, j);
+        const k = 4 * ((rows - 1 - j) * columns + i);
+        data.data[k] = r;
+        data.data[k + 1] = g;
+        data.data[k + 2] = b;
+        data.data[k + 3] = 255;
+      }
+    }
+    ictx.putImageData(data, 0, 0);
+    ctx.imageSmoothingEnabled = false;
+    ctx.drawImage(img, m.left, m.top, pw, ph);
+  }
+
+  // A colour bar for values lo…hi (bottom to top) with a tick and `text(v)`
+  // at each of `ticks`.
+  function heatScale(ctx, { x, top, w, h, lo, hi, ticks: at, text }) {
+    colourBar(ctx, x, top, w, h, at.map((v) => [(v - lo) / (hi - lo || 1), text(v)]));
+  }
+
+  Object.assign(shared, { fixed, sig3, legendValue, plotSize, decadesOnly, makePlot, ticks, colour, colourBar, heatCells, heatFrame, heatScale });
 })(window.tetherplanShared);

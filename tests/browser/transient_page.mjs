@@ -118,7 +118,11 @@ try {
     const d = await transientData(page);
     check(d.request.aero?.flow?.kind === "sinusoidal" && d.request.aero.flow.amplitude_m_s === 10 && d.request.aero.flow.angular_frequency_rad_s === 2, "defaults: u = 10 sin(2t)");
     check(d.request.initial_length_m === 1 && d.request.profile.rate_m_s === 1 && d.request.duration_s === 60, "defaults: L0 = 1 m, 1 m/s, 60 s");
-    check(d.request.aero.radius_m === 0.5 && d.request.aero.air_density_kg_m3 === 1.205 && d.request.aero.model.kind === "thesis", "defaults: r = 0.5 m, air 1.205 kg/m³, thesis force model");
+    const cardAir = Number(await page.inputValue('#system-card [name="wind.air_density_kg_m3"], #plan-form [name="wind.air_density_kg_m3"]'));
+    check(d.request.aero.radius_m === 0.5 && d.request.aero.air_density_kg_m3 === cardAir && d.request.aero.model.kind === "thesis",
+      `defaults: r = 0.5 m, air density ${d.request.aero.air_density_kg_m3} kg/m³ = the system card's ${cardAir}, thesis force model`);
+    check((await page.locator('#transient [name="aero.air_density_kg_m3"], #transient [name="aero.model.drag_coefficient_nondim"]').count()) === 0,
+      "the transient panel has no air density or drag coefficient of its own");
     const [t, y, env] = d.tip.data;
     check(t.length === 1000 && y.length === 1000, `tip-deflection plot has ${y.length} points`);
     const maxAbs = Math.max(...y.map(Math.abs));
@@ -311,10 +315,26 @@ try {
   await page.selectOption("#tr-initial", "tip_force");
   await page.selectOption("#tr-wind", "power_law");
   await page.selectOption("#tr-force-model", "drag");
+  // The drag model's numbers come from the system card, entered once.
+  await page.fill('[name="aerostat.drag_coefficient_nondim"]', "0.45");
+  await page.fill('[name="aerostat.reference_area_m2"]', "3.5");
+  await page.fill('[name="wind.air_density_kg_m3"]', "1.1");
   if (await runDefaultTransient(page)) {
     const d = await transientData(page);
     check(d.request.profile.kind === "trapezoidal" && d.request.initial.kind === "tip_force" && d.request.aero.flow.kind === "power_law" && d.request.aero.model.kind === "drag", "trapezoidal profile, tip force, power-law wind, drag model accepted");
+    check(d.request.aero.model.drag_coefficient_nondim === 0.45 && d.request.aero.model.reference_area_m2 === 3.5 && d.request.aero.air_density_kg_m3 === 1.1,
+      `the transient run uses the system card's C_D ${d.request.aero.model.drag_coefficient_nondim}, area ${d.request.aero.model.reference_area_m2} m², air ${d.request.aero.air_density_kg_m3} kg/m³`);
+    const query = new URL(page.url()).searchParams;
+    check(query.get("transient.aero.model.kind") === "drag" && query.get("transient.profile.kind") === "trapezoidal" && query.get("transient.aero.flow.kind") === "power_law",
+      `the panel's choices are kept in the URL by their request paths (${[...query.keys()].filter((k) => k.startsWith("transient.")).join(", ")})`);
   }
+  // A refused card number is shown on the card, not on a panel input.
+  await page.fill('[name="wind.air_density_kg_m3"]', "500");
+  await page.click("#tr-run");
+  await page.waitForSelector('#tr-status[data-state="ready"], #tr-status[data-state="error"]', { timeout: 60_000 });
+  const airError = page.locator('.field-error[data-error-for="wind.air_density_kg_m3"]');
+  check((await airError.count()) === 1, `a refused air density is shown beside the card's input (${await page.textContent("#tr-status")})`);
+  await page.fill('[name="wind.air_density_kg_m3"]', "1.225");
   await context.close();
 
   // ---------- phone width ----------

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::dto::SystemInput;
+use crate::contract::system::grid::RateGridInput;
 
 /// `POST /api/v1/bands`: the deployment chart of one system under
 /// uncertain inputs, as 5/50/95 % bands with their sampling error.
@@ -38,7 +39,7 @@ pub struct BandsRequest {
 pub struct BandsParams {
     /// Rates of the chart (m/s): a list (1 to 1000 rates), or an evenly
     /// spaced grid `{min, max, count}`.
-    pub rates_m_s: RatesInput,
+    pub rates_m_s: RateGridInput,
     /// The uncertain inputs and the sampling.
     pub uncertainty: UncertaintyInput,
     /// Elevation to reach (m): each point then gives the probability that
@@ -46,30 +47,6 @@ pub struct BandsParams {
     #[serde(default)]
     #[schema(example = 1200.0, exclusive_minimum = 0.0)]
     pub target_elevation_m: Option<f64>,
-}
-
-/// Rates: a list, or a grid.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(untagged)]
-pub enum RatesInput {
-    /// The rates (m/s), each between 1e-6 and 1000.
-    List(Vec<f64>),
-    Grid(BandsRateGrid),
-}
-
-/// An evenly spaced grid of rates.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct BandsRateGrid {
-    /// Smallest rate (m/s).
-    #[schema(example = 1.0, minimum = 0.000001, maximum = 1000.0)]
-    pub min: f64,
-    /// Largest rate (m/s).
-    #[schema(example = 100.0, minimum = 0.000001, maximum = 1000.0)]
-    pub max: f64,
-    /// Number of rates.
-    #[schema(example = 100, minimum = 1, maximum = 1000)]
-    pub count: usize,
 }
 
 /// Monte Carlo over uncertain inputs.

@@ -24,6 +24,8 @@ use crate::contract::bands::common::{
 pub use crate::contract::bands::common::{MAX_OUT_OF_RANGE, MAX_SEED};
 use crate::contract::bands::dto::*;
 use crate::contract::dto::SystemInput;
+use crate::contract::system::GridInput;
+use crate::contract::system::grid::RateGridInput;
 use crate::contract::{Progress, RequestError, parse_value};
 use crate::numerics::chart::{self, Discretisation, Parallelism};
 use crate::numerics::params::{AerostatSystem, InvalidInput, ranges, require_positive};
@@ -185,11 +187,10 @@ pub struct Prepared {
 
 /// Chart points of the request: samples × rates (for admission limits).
 pub fn evaluations(req: &BandsRequest) -> usize {
-    let rates = match &req.params.rates_m_s {
-        RatesInput::List(v) => v.len(),
-        RatesInput::Grid(g) => g.count,
-    };
-    rates.saturating_mul(req.params.uncertainty.samples)
+    req.params
+        .rates_m_s
+        .count()
+        .saturating_mul(req.params.uncertainty.samples)
 }
 
 /// Every check that needs no solve.
@@ -199,34 +200,25 @@ pub fn prepare(req: &BandsRequest) -> Result<Prepared, RequestError> {
     let nominal = model.system;
     let base = RawSystem::of(&req.system);
     let p = &req.params;
-    let rates = match &p.rates_m_s {
-        RatesInput::List(list) => {
-            if list.is_empty() || list.len() > MAX_BAND_RATES {
-                return Err(InvalidInput::new(
-                    "rates_m_s",
-                    format!("must list 1 to {MAX_BAND_RATES} rates, got {}", list.len()),
-                )
-                .into());
-            }
-            for (i, &v) in list.iter().enumerate() {
-                // the chart grid's range: a far slower rate has no finite t*
-                ranges::POSITIVE_RATE_M_S.check(&format!("rates_m_s[{i}]"), v)?;
-            }
-            list.clone()
-        }
-        RatesInput::Grid(g) => {
-            if g.count == 0 || g.count > MAX_BAND_RATES {
-                return Err(InvalidInput::new(
-                    "rates_m_s.count",
-                    format!("must be between 1 and {MAX_BAND_RATES}, got {}", g.count),
-                )
-                .into());
-            }
-            ranges::POSITIVE_RATE_M_S.check("rates_m_s.min", g.min)?;
-            ranges::POSITIVE_RATE_M_S.check("rates_m_s.max", g.max)?;
-            chart::rate_grid(g.min, g.max, g.count)?
-        }
-    };
+    // The chart grid's range (a far slower rate has no finite t*), at most
+    // MAX_BAND_RATES rates, a list or {min, max, count} alike.
+    let grid = &p.rates_m_s;
+    let count = grid.count();
+    if count == 0 || count > MAX_BAND_RATES {
+        return Err(InvalidInput::new(
+            grid.count_field("rates_m_s"),
+            match &grid.0 {
+                GridInput::List(_) => format!("must list 1 to {MAX_BAND_RATES} rates, got {count}"),
+                GridInput::Range(_) => format!("must be between 1 and {MAX_BAND_RATES}, got {count}"),
+            },
+        )
+        .into());
+    }
+    if let GridInput::Range(g) = &grid.0 {
+        ranges::POSITIVE_RATE_M_S.check("rates_m_s.min", g.min)?;
+        ranges::POSITIVE_RATE_M_S.check("rates_m_s.max", g.max)?;
+    }
+    let rates = grid.rates("rates_m_s")?;
     let target = p
         .target_elevation_m
         .map(|t| require_positive("target_elevation_m", t))
@@ -609,23 +601,8 @@ pub fn parse_bands(body: &[u8]) -> Result<BandsRequest, RequestError> {
     let system: SystemInput = parse_value(&system_value)?;
     let known = serde_json::to_value(&system).expect("the system serialises");
     reject_unknown(&system_value, &known, "")?;
-    match params_part.get("rates_m_s") {
-        Some(Value::Array(_)) => {
-            parse_value::<Vec<f64>>(&params_part["rates_m_s"])
-                .map_err(|e| under("rates_m_s", e))?;
-        }
-        Some(Value::Object(_)) => {
-            parse_value::<BandsRateGrid>(&params_part["rates_m_s"])
-                .map_err(|e| under("rates_m_s", e))?;
-        }
-        Some(_) => {
-            return Err(InvalidInput::new(
-                "rates_m_s",
-                "must be a list of rates (m/s) or a grid {min, max, count}",
-            )
-            .into());
-        }
-        None => {}
+    if let Some(rates) = params_part.get("rates_m_s") {
+        parse_value::<RateGridInput>(rates).map_err(|e| under("rates_m_s", e))?;
     }
     let params: BandsParams = parse_value(&Value::Object(params_part))?;
     Ok(BandsRequest { system, params })
@@ -713,6 +690,23 @@ mod tests {
             .and_then(|r| prepare(&r).map(drop))
             .expect_err("invalid");
         err.body().error.field.unwrap()
+    }
+
+    #[test]
+    fn a_rate_list_and_a_rate_grid_give_the_same_bands() {
+        let run = |rates: Value| {
+            let req = parse_bands(&body(json!({"rates_m_s": rates}))).unwrap();
+            serde_json::to_string(&bands(&req, Parallelism::Serial, &NoProgress).unwrap()).unwrap()
+        };
+        let listed = run(json!([5.0, 7.5, 10.0]));
+        assert_eq!(listed, run(json!({"min": 5.0, "max": 10.0, "count": 3})));
+        assert!(listed.contains("7.5"), "{listed}");
+        // errors name the part at fault, as the other grids do
+        assert_eq!(field_of(body(json!({"rates_m_s": {"min": 5.0, "max": 10.0, "count": 1001}}))), "rates_m_s.count");
+        assert_eq!(field_of(body(json!({"rates_m_s": vec![5.0; 1001]}))), "rates_m_s");
+        assert_eq!(field_of(body(json!({"rates_m_s": [5.0, 0.0]}))), "rates_m_s[1]");
+        assert_eq!(field_of(body(json!({"rates_m_s": {"min": 0.0, "max": 10.0, "count": 3}}))), "rates_m_s.min");
+        assert_eq!(field_of(body(json!({"rates_m_s": {"min": 5.0, "max": 1.0, "count": 3}}))), "rates_m_s.max");
     }
 
     #[test]

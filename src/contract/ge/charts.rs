@@ -10,6 +10,8 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::dto::{CableInput, ProfileInput, RateGrid};
+use crate::contract::system::WindFlowInput;
+use crate::contract::system::grid::BaseFrequencyGridInput;
 use crate::contract::ge::{GeAerostatInput, GeModelInput, GeModelKind, NewtonInput};
 use crate::contract::ge::numerics::{
     self as ge_numerics, IntegratorOutput, StartStateInput, default_check, default_dt,
@@ -18,7 +20,7 @@ use crate::contract::ge::numerics::{
 pub use crate::contract::ge::numerics::{GeChartNumericsInput, GeOnsetKind};
 use crate::contract::{Progress, RequestError};
 use crate::numerics::aero::{AerostatBody, ForceModel, SteadyFlow};
-use crate::numerics::chart::{Parallelism, rate_grid};
+use crate::numerics::chart::Parallelism;
 use crate::numerics::ge::base::{self, BaseExcitationProblem};
 use crate::numerics::ge::chart::{
     self as ge_chart_core, GeChartRequest as CoreChart, GeChartSystem, GeChartWind,
@@ -30,6 +32,7 @@ use crate::numerics::ge::{GeModel, TipBody};
 use crate::numerics::ge_reduced;
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 use crate::numerics::profile::Profile;
+use crate::numerics::tether::wind::WindProfile;
 
 /// Largest `points × (horizon / Δt) × elements` of one GE chart.
 pub const MAX_CHART_WORK: f64 = 5e9;
@@ -93,41 +96,6 @@ fn default_hold() -> f64 {
     1.0
 }
 
-/// A point of a tabulated wind profile.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-#[schema(as = GeWindPointInput)]
-pub struct WindPointInput {
-    #[schema(example = 100.0, minimum = 0.0, maximum = 1e5)]
-    pub elevation_m: f64,
-    #[schema(example = 4.2, minimum = -200.0, maximum = 200.0)]
-    pub speed_m_s: f64,
-}
-
-/// Steady wind profile u0(z).
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-#[serde(deny_unknown_fields)]
-pub enum WindProfileInput {
-    Uniform {
-        #[schema(example = 5.0, minimum = -200.0, maximum = 200.0)]
-        speed_m_s: f64,
-    },
-    /// u = a z^p.
-    PowerLaw {
-        #[schema(example = 0.1, minimum = -200.0, maximum = 200.0)]
-        coefficient: f64,
-        #[schema(example = 0.333, minimum = 0.0, maximum = 2.0)]
-        exponent: f64,
-    },
-    /// Linear interpolation, constant beyond the ends (e.g. a measured
-    /// atmospheric profile).
-    Tabulated { points: Vec<WindPointInput> },
-    /// 0 → 8 m/s over 600 m, then uniform: the shape of the thesis's
-    /// Fig. 7.5(a), not its data.
-    Illustrative {},
-}
-
 /// How the flow loads the aerostat.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -136,30 +104,47 @@ pub enum WindProfileInput {
 pub enum ForceModelInput {
     /// Inviscid sphere (thesis (4.4)).
     Thesis {},
-    /// Quadratic drag plus added mass.
-    Drag {
-        #[schema(example = 0.5, minimum = 0.0, maximum = 100.0)]
-        drag_coefficient: f64,
-        /// Reference area (m²); default: the sphere's frontal area.
-        #[serde(default)]
-        #[schema(minimum = 1e-6, maximum = 1e6)]
-        reference_area_m2: Option<f64>,
-    },
+    /// Quadratic drag plus added mass, with the aerostat's
+    /// `drag_coefficient_nondim` and `reference_area_m2` (default: the
+    /// sphere's frontal area).
+    Drag {},
 }
 
-/// Wind on the aerostat (thesis ch. 7.5), one series per A0 of (7.4).
+impl Default for ForceModelInput {
+    fn default() -> Self {
+        Self::Thesis {}
+    }
+}
+
+/// Wind on the aerostat (thesis ch. 7.5), one series per A0 of (7.4):
+/// the steady profile u0(z) is the one system's `wind.flow` (SPEC §9:
+/// `uniform`, `power_law`, `tabulated`) in its `air_density_kg_m3`; the
+/// drag model takes the aerostat's drag data.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({
+    "flow": {"kind": "tabulated", "points": [
+        {"elevation_m": 0.0, "speed_m_s": 0.0}, {"elevation_m": 50.0, "speed_m_s": 3.0},
+        {"elevation_m": 100.0, "speed_m_s": 4.2}, {"elevation_m": 200.0, "speed_m_s": 5.6},
+        {"elevation_m": 400.0, "speed_m_s": 7.2}, {"elevation_m": 600.0, "speed_m_s": 8.0}]},
+    "air_density_kg_m3": 1.12, "force_model": {"kind": "thesis"}, "radius_m": 1.0,
+    "amplitudes_nondim": [0.0, 0.5]
+}))]
 pub struct GeWindInput {
-    pub profile: WindProfileInput,
+    /// The steady profile u0(z) (SPEC §9 `wind.flow`).
+    pub flow: WindFlowInput,
+    /// Air density (kg/m³), default 1.225 (ISA sea level; the thesis uses 1.12).
+    #[serde(default = "crate::contract::system::default_air_density")]
+    #[schema(example = 1.12, minimum = 1e-4, maximum = 100.0)]
+    pub air_density_kg_m3: f64,
+    /// Inviscid sphere (default) or drag with the aerostat's coefficient.
+    #[serde(default)]
     pub force_model: ForceModelInput,
-    /// Aerostat radius (m).
+    /// Aerostat radius (m): the sphere of the thesis force model and the
+    /// default drag area π r².
     #[serde(default = "default_radius")]
     #[schema(example = 1.0, minimum = 0.001, maximum = 1000.0)]
     pub radius_m: f64,
-    #[serde(default = "default_air_density")]
-    #[schema(example = 1.12, minimum = 1e-4, maximum = 100.0)]
-    pub air_density_kg_m3: f64,
     /// A0 of u0(1 + A0 sin(k z)), one series each; 0 is the steady profile.
     #[serde(default = "default_amplitudes")]
     #[schema(example = json!([0.0, 0.5, 1.0]), minimum = -10.0, maximum = 10.0)]
@@ -172,9 +157,6 @@ pub struct GeWindInput {
 
 fn default_radius() -> f64 {
     1.0
-}
-fn default_air_density() -> f64 {
-    1.12
 }
 fn default_amplitudes() -> Vec<f64> {
     vec![0.0]
@@ -273,22 +255,23 @@ pub struct GeChartResponse {
     pub start_state: StartStateInput,
 }
 
-fn wind(input: &GeWindInput, area_default: f64) -> Result<GeChartWind, InvalidInput> {
-    let base_flow = match &input.profile {
-        WindProfileInput::Uniform { speed_m_s } => SteadyFlow::uniform(*speed_m_s)?,
-        WindProfileInput::PowerLaw {
-            coefficient,
-            exponent,
-        } => SteadyFlow::power_law(*coefficient, *exponent)?,
-        WindProfileInput::Tabulated { points } => {
-            let pts: Vec<(f64, f64)> = points
-                .iter()
-                .map(|p| (p.elevation_m, p.speed_m_s))
-                .collect();
-            SteadyFlow::tabulated(&pts, "wind.profile.points")?
-        }
-        WindProfileInput::Illustrative {} => GeChartWind::illustrative(vec![]).base_flow,
-    };
+/// The thesis's steady profile u0(z) from the §9 flow (`at`: its field).
+fn steady_flow(flow: &WindFlowInput, at: &str) -> Result<SteadyFlow, InvalidInput> {
+    match flow.profile(at)? {
+        WindProfile::Flow(f) => Ok(f),
+        WindProfile::LogLaw { .. } => Err(InvalidInput::new(
+            format!("{at}.kind"),
+            "the GE chart takes a uniform, power_law or tabulated flow (give a log law as its tabulated points)",
+        )),
+    }
+}
+
+fn wind(
+    input: &GeWindInput,
+    aerostat: &GeAerostatInput,
+    area_default: f64,
+) -> Result<GeChartWind, InvalidInput> {
+    let base_flow = steady_flow(&input.flow, "wind.flow")?;
     let body = AerostatBody::new(
         require_positive("wind.radius_m", input.radius_m)?,
         require_positive("wind.air_density_kg_m3", input.air_density_kg_m3)?,
@@ -296,16 +279,18 @@ fn wind(input: &GeWindInput, area_default: f64) -> Result<GeChartWind, InvalidIn
     )?;
     let force_model = match &input.force_model {
         ForceModelInput::Thesis {} => ForceModel::Thesis,
-        ForceModelInput::Drag {
-            drag_coefficient,
-            reference_area_m2,
-        } => ForceModel::Drag {
-            drag_coefficient: require_non_negative(
-                "wind.force_model.drag_coefficient",
-                *drag_coefficient,
-            )?,
-            reference_area_m2: match reference_area_m2 {
-                Some(a) => require_positive("wind.force_model.reference_area_m2", *a)?,
+        ForceModelInput::Drag {} => ForceModel::Drag {
+            drag_coefficient: match aerostat.drag_coefficient_nondim {
+                Some(cd) => require_non_negative("aerostat.drag_coefficient_nondim", cd)?,
+                None => {
+                    return Err(InvalidInput::new(
+                        "aerostat.drag_coefficient_nondim",
+                        "is required by the drag force model (wind.force_model)",
+                    ));
+                }
+            },
+            reference_area_m2: match aerostat.reference_area_m2 {
+                Some(a) => require_positive("aerostat.reference_area_m2", a)?,
                 None => area_default * input.radius_m * input.radius_m,
             },
         },
@@ -323,6 +308,35 @@ fn wind(input: &GeWindInput, area_default: f64) -> Result<GeChartWind, InvalidIn
         amplitudes: input.amplitudes_nondim.clone(),
         wavenumber_1_m: input.wavenumber_1_m,
     })
+}
+
+/// The GE chart's wind before SPEC §9, refused naming the new place.
+fn refuse_old_wind(body: &[u8]) -> Result<(), RequestError> {
+    let value: serde_json::Value =
+        serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
+    let moved = [
+        (
+            "/wind/profile",
+            "wind.profile",
+            "wind.flow (SPEC §9: uniform speed_m_s; power_law coefficient_m_s, exponent_nondim, reference_height_m; tabulated points; the thesis's illustrative profile is the tabulated flow of its points)",
+        ),
+        (
+            "/wind/force_model/drag_coefficient",
+            "wind.force_model.drag_coefficient",
+            "aerostat.drag_coefficient_nondim",
+        ),
+        (
+            "/wind/force_model/reference_area_m2",
+            "wind.force_model.reference_area_m2",
+            "aerostat.reference_area_m2",
+        ),
+    ];
+    for (pointer, field, place) in moved {
+        if value.pointer(pointer).is_some() {
+            return Err(InvalidInput::new(field, format!("moved to {place}")).into());
+        }
+    }
+    Ok(())
 }
 
 /// The core request, checked (every field named) and bounded.
@@ -396,10 +410,13 @@ pub fn prepare_chart(req: &GeChartRequest) -> Result<CoreChart, InvalidInput> {
         perturbation_ramp_s: ramp,
         perturbation_hold_s: hold,
         net_buoyancies_n: buoyancies,
+        // A flow calm everywhere (the §9 system's still air) is the
+        // still-air chart: no wind loads.
         wind: req
             .wind
             .as_ref()
-            .map(|w| wind(w, std::f64::consts::PI))
+            .filter(|w| !w.flow.is_calm())
+            .map(|w| wind(w, &req.aerostat, std::f64::consts::PI))
             .transpose()?,
         config,
         start: req.start_state.into(),
@@ -562,20 +579,6 @@ pub enum ExcitationKind {
     Base,
 }
 
-/// A grid of forcing frequencies.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct FrequencyGridInput {
-    /// Lowest ω0 (rad/s).
-    #[schema(example = 11.3, exclusive_minimum = 0.0, maximum = 10000.0)]
-    pub min: f64,
-    /// Highest ω0 (rad/s).
-    #[schema(example = 792.6, minimum = 0.0, maximum = 10000.0)]
-    pub max: f64,
-    #[schema(example = 70, minimum = 1, maximum = 2000)]
-    pub count: usize,
-}
-
 /// `POST /api/v1/frequency-response` with `"excitation": "base"`: the GE
 /// cable on a platform shaken across the guide; amplitude gain (8.3)
 /// against ω0, with the two-DOF model's resonance bands (8.9).
@@ -601,7 +604,8 @@ pub struct GeBaseFrequencyResponseRequest {
     /// Platform amplitude R0 (m).
     #[schema(example = 0.001, minimum = 1e-9, maximum = 1000.0)]
     pub amplitude_m: f64,
-    pub frequencies_rad_s: FrequencyGridInput,
+    /// ω0 (rad/s): a list, or `{min, max, count}` evenly spaced.
+    pub frequencies_rad_s: BaseFrequencyGridInput,
     /// The normalising run's ω (rad/s); default ω̄ = 0.01 as in (8.3).
     #[serde(default)]
     #[schema(minimum = 0.0, maximum = 10000.0)]
@@ -689,20 +693,9 @@ pub fn ge_base_frequency_response(
     };
     let model = GeModel::new(section, m.elements(), tip, g)?;
     let scale = section.time_scale_s(l0);
-    let grid = &req.frequencies_rad_s;
-    let omegas = rate_grid(grid.min, grid.max, grid.count).map_err(|e| {
-        InvalidInput::new(
-            e.field.replacen("rates_m_s", "frequencies_rad_s", 1),
-            e.reason,
-        )
-    })?;
-    if omegas.len() > base::MAX_FREQUENCIES {
-        return Err(InvalidInput::new(
-            "frequencies_rad_s.count",
-            format!("must be at most {}", base::MAX_FREQUENCIES),
-        )
-        .into());
-    }
+    let omegas = req
+        .frequencies_rad_s
+        .values("frequencies_rad_s", BaseFrequencyGridInput::BOUNDS)?;
     let duration = require_positive("duration_s", req.duration_s)?;
     let dt = require_positive("time_step_s", req.time_step_s)?;
     let steps = duration / dt;
@@ -841,7 +834,9 @@ pub fn parse_chart(body: &[u8]) -> Result<AnyChartRequest, RequestError> {
     let value: serde_json::Value =
         serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
     if value.pointer("/model/kind").and_then(|k| k.as_str()) == Some("geometrically_exact") {
-        let req: Box<GeChartRequest> = crate::contract::parse_ge(body, "the GE chart")?;
+        refuse_old_wind(body)?;
+        let req: Box<GeChartRequest> =
+            crate::contract::parse::parse_ge_keeping(body, "the GE chart", "wind")?;
         req.check_ranges()?;
         Ok(AnyChartRequest::GeometricallyExact(req))
     } else {

@@ -334,3 +334,29 @@ bounded_grid!(
         unit: "m/s",
     }
 );
+
+bounded_grid!(
+    /// Forcing frequencies of the wind frequency response (rad/s).
+    FrequencyGridInput,
+    "Forcing frequencies ω (rad/s): a list, or {min, max, count} evenly spaced.",
+    GridBounds {
+        min: 0.0,
+        exclusive_min: false,
+        max: 1e4,
+        max_count: crate::numerics::string::transient::MAX_FREQUENCIES,
+        unit: "rad/s",
+    }
+);
+
+bounded_grid!(
+    /// Platform frequencies of the GE base-excitation response (rad/s).
+    BaseFrequencyGridInput,
+    "Platform frequencies ω0 (rad/s): a list, or {min, max, count} evenly spaced.",
+    GridBounds {
+        min: 0.0,
+        exclusive_min: true,
+        max: 1e4,
+        max_count: crate::numerics::ge::base::MAX_FREQUENCIES,
+        unit: "rad/s",
+    }
+);

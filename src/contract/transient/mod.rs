@@ -1,10 +1,15 @@
-//! Transient runs and frequency responses (SPEC §2).
+//! Transient runs and frequency responses (SPEC §2): the linear string's
+//! transient run ([`simulate`]) and wind frequency response
+//! ([`frequency`]), the wind on the aerostat they share ([`aero`]), and the
+//! dispatch of `simulate` on `model.kind` ([`any`]).
 
+pub mod aero;
 pub mod any;
+pub mod frequency;
 pub mod simulate;
 
-pub use simulate::{
+pub use frequency::{
     FrequencyResponseParams, FrequencyResponseRequest, FrequencyResponseResponse,
-    SimulateParams, SimulateRequest, SimulateResponse, frequency_response,
-    frequency_response_runs, simulate,
+    frequency_response, frequency_response_runs,
 };
+pub use simulate::{SimulateParams, SimulateRequest, SimulateResponse, simulate};

@@ -1,41 +1,25 @@
-//! Transient runs and frequency responses (SPEC §2): the JSON contract of
-//! `POST /api/v1/simulate` and `POST /api/v1/frequency-response` (and the
-//! CLI subcommands and job kinds that share it), its validation, and the
-//! conversion to and from [`crate::numerics::string::transient`].
+//! Transient runs of the linear string (SPEC §2): the JSON contract of
+//! `POST /api/v1/simulate` (and the CLI subcommand and job kind that share
+//! it), its validation, and the conversion to and from
+//! [`crate::numerics::string::transient`]; the wind on the aerostat is
+//! [`super::aero`]'s.
 
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use super::aero::AeroInput;
 use crate::contract::dto::{EigenvalueOutput, Groups, ProfileInput, SystemInput};
 use crate::contract::run::{Progress, RequestError, groups};
-use crate::numerics::aero::{Aerodynamics, AerostatBody, AirFlow, ForceModel, SteadyFlow};
-use crate::numerics::chart::Parallelism;
-use crate::numerics::params::{
-    AerostatSystem, InvalidInput, require_finite, require_non_negative, require_positive,
-};
+use crate::numerics::aero::Aerodynamics;
+use crate::numerics::params::{AerostatSystem, InvalidInput, require_finite};
 use crate::numerics::reduced::ReducedModel;
 use crate::numerics::string::transient::{
-    self, EigenTracking, InitialState, MAGNITUDE_CAP_LENGTHS, MAX_FREQUENCIES, Observer,
+    self, EigenTracking, InitialState, MAGNITUDE_CAP_LENGTHS, Observer,
     RunOutcome, TransientConfig, TransientError, TransientRun,
 };
 
-/// Most numbers (frequencies × samples) one frequency response returns.
-pub const MAX_RESPONSE_VALUES: usize = 2_000_000;
-
 fn default_samples() -> usize {
     1000
-}
-
-fn default_response_samples() -> usize {
-    200
-}
-
-fn default_air_density() -> f64 {
-    1.205
-}
-
-fn default_wavenumber() -> f64 {
-    0.01
 }
 
 fn default_eigen_count() -> usize {
@@ -74,155 +58,6 @@ pub enum InitialStateInput {
 impl Default for InitialStateInput {
     fn default() -> Self {
         Self::Rest {}
-    }
-}
-
-/// A steady wind profile u(z) (z = elevation of the aerostat).
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-#[serde(deny_unknown_fields)]
-pub enum SteadyFlowInput {
-    /// u = U.
-    Uniform {
-        #[schema(example = 5.0, minimum = -200.0, maximum = 200.0)]
-        speed_m_s: f64,
-    },
-    /// u = a z^p; a is the speed at z = 1 m.
-    PowerLaw {
-        #[schema(example = 0.1, minimum = -200.0, maximum = 200.0)]
-        coefficient_m_s: f64,
-        #[schema(example = 0.3333, minimum = 0.0, maximum = 2.0)]
-        exponent_nondim: f64,
-    },
-    /// Linear interpolation in (z, u), constant beyond the ends.
-    Tabulated { points: Vec<FlowPointInput> },
-}
-
-/// One point of a tabulated wind profile.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct FlowPointInput {
-    #[schema(example = 100.0, minimum = 0.0, maximum = 1e5)]
-    pub elevation_m: f64,
-    #[schema(example = 4.0, minimum = -200.0, maximum = 200.0)]
-    pub speed_m_s: f64,
-}
-
-/// The horizontal air flow on the aerostat.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-#[serde(deny_unknown_fields)]
-pub enum AirFlowInput {
-    /// u = U.
-    Uniform {
-        #[schema(example = 5.0, minimum = -200.0, maximum = 200.0)]
-        speed_m_s: f64,
-    },
-    /// u = a z^p; a is the speed at z = 1 m (thesis: 0.1 z^(1/3), z^(1/2)).
-    PowerLaw {
-        #[schema(example = 0.1, minimum = -200.0, maximum = 200.0)]
-        coefficient_m_s: f64,
-        #[schema(example = 0.3333, minimum = 0.0, maximum = 2.0)]
-        exponent_nondim: f64,
-    },
-    /// Uniform in space, u = U0 sin(ω t).
-    Sinusoidal {
-        #[schema(example = 10.0, minimum = -200.0, maximum = 200.0)]
-        amplitude_m_s: f64,
-        #[schema(example = 2.0, minimum = 0.0, maximum = 10000.0)]
-        angular_frequency_rad_s: f64,
-    },
-    /// Linear interpolation in (z, u), constant beyond the ends.
-    Tabulated { points: Vec<FlowPointInput> },
-    /// A steady profile with the perturbation of thesis (7.4):
-    /// u = u0(z) (1 + A0 sin(k z)).
-    Perturbed {
-        base: SteadyFlowInput,
-        /// A0.
-        #[schema(example = 0.5, minimum = -10.0, maximum = 10.0)]
-        amplitude_nondim: f64,
-        /// k (1/m); the thesis uses 0.01.
-        #[serde(default = "default_wavenumber")]
-        #[schema(example = 0.01, minimum = 0.0, maximum = 1000.0)]
-        wavenumber_1_m: f64,
-    },
-}
-
-/// Aerodynamic force model of the aerostat.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-#[serde(deny_unknown_fields)]
-pub enum ForceModelInput {
-    /// Inviscid sphere (thesis (4.3)–(4.4)): m_f (u_t + u u_z) + ½ m_f (u_t − ÿ).
-    Thesis {},
-    /// Quadratic drag ½ ρ_air C_D A |u − ẏ|(u − ẏ) plus the added mass ½ m_f (u_t − ÿ).
-    Drag {
-        #[schema(example = 0.5, minimum = 0.0, maximum = 100.0)]
-        drag_coefficient_nondim: f64,
-        /// Reference area (m²); default π r².
-        #[serde(default)]
-        #[schema(minimum = 1e-6, maximum = 1e6)]
-        reference_area_m2: Option<f64>,
-    },
-}
-
-impl Default for ForceModelInput {
-    fn default() -> Self {
-        Self::Thesis {}
-    }
-}
-
-/// The aerostat as an aerodynamic body (a sphere).
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct AeroBodyInput {
-    #[serde(default)]
-    pub model: ForceModelInput,
-    /// Sphere radius r (m): volume, displaced air, default drag area.
-    #[schema(example = 0.5, minimum = 0.001, maximum = 1000.0)]
-    pub radius_m: f64,
-    /// Air density (kg/m³).
-    #[serde(default = "default_air_density")]
-    #[schema(example = 1.205, minimum = 1e-4, maximum = 100.0)]
-    pub air_density_kg_m3: f64,
-    /// Lifting-gas density (kg/m³). When given, the displaced air mass is
-    /// m ρ_air/ρ_gas (the thesis's ρ̃ in (4.5)); otherwise ρ_air 4/3 π r³.
-    #[serde(default)]
-    #[schema(minimum = 1e-4, maximum = 100.0)]
-    pub gas_density_kg_m3: Option<f64>,
-}
-
-/// Wind on the aerostat: flow and body.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct AeroInput {
-    pub flow: AirFlowInput,
-    /// The force model (the fields below are those of [`AeroBodyInput`],
-    /// written out so that unknown fields can be refused).
-    #[serde(default)]
-    pub model: ForceModelInput,
-    /// Sphere radius r (m): volume, displaced air, default drag area.
-    #[schema(example = 0.5, minimum = 0.001, maximum = 1000.0)]
-    pub radius_m: f64,
-    /// Air density (kg/m³).
-    #[serde(default = "default_air_density")]
-    #[schema(example = 1.205, minimum = 1e-4, maximum = 100.0)]
-    pub air_density_kg_m3: f64,
-    /// Lifting-gas density (kg/m³); see [`AeroBodyInput`].
-    #[serde(default)]
-    #[schema(minimum = 1e-4, maximum = 100.0)]
-    pub gas_density_kg_m3: Option<f64>,
-}
-
-impl AeroInput {
-    /// The body part.
-    pub fn body(&self) -> AeroBodyInput {
-        AeroBodyInput {
-            model: self.model.clone(),
-            radius_m: self.radius_m,
-            air_density_kg_m3: self.air_density_kg_m3,
-            gas_density_kg_m3: self.gas_density_kg_m3,
-        }
     }
 }
 
@@ -370,85 +205,6 @@ pub struct SimulateResponse {
     pub elements: usize,
 }
 
-/// An evenly spaced grid of forcing frequencies.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct FrequencyGrid {
-    #[schema(example = 0.25, minimum = 0.0, maximum = 10000.0)]
-    pub min: f64,
-    #[schema(example = 8.0, minimum = 0.0, maximum = 10000.0)]
-    pub max: f64,
-    #[schema(example = 64, minimum = 1, maximum = 1024)]
-    pub count: usize,
-}
-
-/// `POST /api/v1/frequency-response`: one run per frequency of a uniform
-/// wind u = U0 sin(ω t) on the aerostat; tip envelope against ω and time.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-pub struct FrequencyResponseRequest {
-    #[serde(flatten)]
-    pub system: SystemInput,
-    #[serde(flatten)]
-    pub params: FrequencyResponseParams,
-}
-
-impl std::ops::Deref for FrequencyResponseRequest {
-    type Target = FrequencyResponseParams;
-    fn deref(&self) -> &FrequencyResponseParams {
-        &self.params
-    }
-}
-
-impl std::ops::DerefMut for FrequencyResponseRequest {
-    fn deref_mut(&mut self) -> &mut FrequencyResponseParams {
-        &mut self.params
-    }
-}
-
-/// The fields of a frequency response request besides the system.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct FrequencyResponseParams {
-    pub profile: ProfileInput,
-    #[schema(example = 60.0, minimum = 1e-6, maximum = 1e7)]
-    pub duration_s: f64,
-    /// Time step (s), shared by all runs; default set by the highest frequency.
-    #[serde(default)]
-    #[schema(minimum = 1e-9, maximum = 1000.0)]
-    pub time_step_s: Option<f64>,
-    /// Samples of the envelope in time (2..=100000).
-    #[serde(default = "default_response_samples")]
-    #[schema(example = 200, minimum = 2, maximum = 100000)]
-    pub samples: usize,
-    #[serde(default)]
-    pub initial: InitialStateInput,
-    /// The aerostat as an aerodynamic body.
-    pub aero: AeroBodyInput,
-    /// U0 (m/s).
-    #[schema(example = 10.0, minimum = -200.0, maximum = 200.0)]
-    pub wind_amplitude_m_s: f64,
-    /// ω grid (rad/s).
-    pub frequencies_rad_s: FrequencyGrid,
-}
-
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
-pub struct FrequencyResponseResponse {
-    pub frequencies_rad_s: Vec<f64>,
-    pub time_s: Vec<f64>,
-    /// `envelope_m[i][j]`: max |tip deflection| for frequency i over the
-    /// window ending at time_s[j] (m).
-    pub envelope_m: Vec<Vec<f64>>,
-    /// Largest tip deflection of each run (m) and when (s).
-    pub peak_amplitude_m: Vec<f64>,
-    pub peak_time_s: Vec<f64>,
-    /// Outcome of each run (`completed`, `diverged`, `length_collapsed`).
-    pub outcomes: Vec<String>,
-    pub time_step_s: f64,
-    pub steps_per_run: usize,
-    pub groups: Groups,
-    pub elements: usize,
-}
-
 impl InitialStateInput {
     pub fn initial_state(&self) -> InitialState {
         match *self {
@@ -472,121 +228,8 @@ impl InitialStateInput {
     }
 }
 
-fn flow_points(points: &[FlowPointInput], field: &str) -> Result<SteadyFlow, InvalidInput> {
-    let table: Vec<(f64, f64)> = points
-        .iter()
-        .map(|p| (p.elevation_m, p.speed_m_s))
-        .collect();
-    SteadyFlow::tabulated(&table, field)
-}
-
-fn rename(e: InvalidInput, from: &str, to: &str) -> InvalidInput {
-    InvalidInput::new(e.field.replacen(from, to, 1), e.reason)
-}
-
-impl SteadyFlowInput {
-    pub fn flow(&self, field: &str) -> Result<SteadyFlow, InvalidInput> {
-        match self {
-            Self::Uniform { speed_m_s } => {
-                SteadyFlow::uniform(*speed_m_s).map_err(|e| rename(e, "aero.flow", field))
-            }
-            Self::PowerLaw {
-                coefficient_m_s,
-                exponent_nondim,
-            } => SteadyFlow::power_law(*coefficient_m_s, *exponent_nondim).map_err(|e| {
-                rename(
-                    rename(
-                        e,
-                        "aero.flow.coefficient",
-                        &format!("{field}.coefficient_m_s"),
-                    ),
-                    "aero.flow.exponent",
-                    &format!("{field}.exponent_nondim"),
-                )
-            }),
-            Self::Tabulated { points } => flow_points(points, &format!("{field}.points")),
-        }
-    }
-}
-
-impl AirFlowInput {
-    pub fn flow(&self) -> Result<AirFlow, InvalidInput> {
-        Ok(match self {
-            Self::Uniform { speed_m_s } => AirFlow::Steady(
-                SteadyFlowInput::Uniform {
-                    speed_m_s: *speed_m_s,
-                }
-                .flow("aero.flow")?,
-            ),
-            Self::PowerLaw {
-                coefficient_m_s,
-                exponent_nondim,
-            } => AirFlow::Steady(
-                SteadyFlowInput::PowerLaw {
-                    coefficient_m_s: *coefficient_m_s,
-                    exponent_nondim: *exponent_nondim,
-                }
-                .flow("aero.flow")?,
-            ),
-            Self::Sinusoidal {
-                amplitude_m_s,
-                angular_frequency_rad_s,
-            } => AirFlow::sinusoidal(*amplitude_m_s, *angular_frequency_rad_s)?,
-            Self::Tabulated { points } => AirFlow::Steady(flow_points(points, "aero.flow.points")?),
-            Self::Perturbed {
-                base,
-                amplitude_nondim,
-                wavenumber_1_m,
-            } => AirFlow::perturbed(
-                base.flow("aero.flow.base")?,
-                *amplitude_nondim,
-                *wavenumber_1_m,
-            )?,
-        })
-    }
-}
-
-impl AeroBodyInput {
-    /// The aerodynamics with a given flow, for an aerostat of mass `mass_kg`.
-    pub fn aerodynamics(
-        &self,
-        flow: AirFlow,
-        mass_kg: f64,
-        prefix: &str,
-    ) -> Result<Aerodynamics, InvalidInput> {
-        let fix = |e: InvalidInput| rename(e, "aero", prefix);
-        let body = AerostatBody::new(
-            self.radius_m,
-            self.air_density_kg_m3,
-            self.gas_density_kg_m3,
-        )
-        .map_err(fix)?;
-        let model = match self.model {
-            ForceModelInput::Thesis {} => ForceModel::Thesis,
-            ForceModelInput::Drag {
-                drag_coefficient_nondim,
-                reference_area_m2,
-            } => {
-                require_non_negative(
-                    &format!("{prefix}.model.drag_coefficient_nondim"),
-                    drag_coefficient_nondim,
-                )?;
-                let area = match reference_area_m2 {
-                    Some(a) => require_positive(&format!("{prefix}.model.reference_area_m2"), a)?,
-                    None => body.frontal_area_m2(),
-                };
-                ForceModel::Drag {
-                    drag_coefficient: drag_coefficient_nondim,
-                    reference_area_m2: area,
-                }
-            }
-        };
-        Aerodynamics::new(flow, model, body, mass_kg).map_err(fix)
-    }
-}
-
 /// Progress of the contract seen as a numerics observer.
-struct ProgressObserver<'a>(&'a dyn Progress);
+pub(super) struct ProgressObserver<'a>(pub(super) &'a dyn Progress);
 
 impl Observer for ProgressObserver<'_> {
     fn report(&self, done: usize, total: usize) {
@@ -597,14 +240,14 @@ impl Observer for ProgressObserver<'_> {
     }
 }
 
-fn from_transient(e: TransientError) -> RequestError {
+pub(super) fn from_transient(e: TransientError) -> RequestError {
     match e {
         TransientError::Invalid(e) => RequestError::Invalid(e),
         TransientError::Qep(e) => RequestError::Numerical(e),
     }
 }
 
-fn outcome_name(o: RunOutcome) -> (&'static str, Option<f64>) {
+pub(super) fn outcome_name(o: RunOutcome) -> (&'static str, Option<f64>) {
     match o {
         RunOutcome::Completed => ("completed", None),
         RunOutcome::Diverged { time_s } => ("diverged", Some(time_s)),
@@ -624,7 +267,7 @@ fn eigen_output(sys: &AerostatSystem, re_1_s: f64, im_1_s: f64) -> EigenvalueOut
     }
 }
 
-fn config_from(
+pub(super) fn config_from(
     duration_s: f64,
     time_step_s: Option<f64>,
     samples: usize,
@@ -861,116 +504,6 @@ fn reduced_output(
     Ok(out)
 }
 
-/// Number of runs a frequency-response request asks for (admission limits).
-pub fn frequency_response_runs(req: &FrequencyResponseRequest) -> usize {
-    req.frequencies_rad_s.count
-}
-
-/// Runs a [`FrequencyResponseRequest`]: the runs fan out on rayon when
-/// `parallelism` says so (results identical to serial). Progress counts
-/// finished runs.
-pub fn frequency_response(
-    req: &FrequencyResponseRequest,
-    parallelism: Parallelism,
-    progress: &dyn Progress,
-) -> Result<FrequencyResponseResponse, RequestError> {
-    let model = req.system.model()?;
-    let sys = model.system;
-    let profile = req.profile.profile(sys.initial_length_m)?;
-    let grid = &req.frequencies_rad_s;
-    require_non_negative("frequencies_rad_s.min", grid.min)?;
-    require_non_negative("frequencies_rad_s.max", grid.max)?;
-    if grid.max < grid.min {
-        return Err(InvalidInput::new(
-            "frequencies_rad_s.max",
-            format!("must be at least frequencies_rad_s.min = {}", grid.min),
-        )
-        .into());
-    }
-    if grid.max > 1e4 {
-        return Err(InvalidInput::new(
-            "frequencies_rad_s.max",
-            format!("must be at most 1e4 rad/s, got {}", grid.max),
-        )
-        .into());
-    }
-    if grid.count == 0 || grid.count > MAX_FREQUENCIES {
-        return Err(InvalidInput::new(
-            "frequencies_rad_s.count",
-            format!(
-                "must be between 1 and {MAX_FREQUENCIES}, got {}",
-                grid.count
-            ),
-        )
-        .into());
-    }
-    if grid.count.saturating_mul(req.samples) > MAX_RESPONSE_VALUES {
-        return Err(InvalidInput::new(
-            "samples",
-            format!(
-                "{} frequencies × {} samples exceed the limit of {MAX_RESPONSE_VALUES} values",
-                grid.count, req.samples
-            ),
-        )
-        .into());
-    }
-    require_finite("wind_amplitude_m_s", req.wind_amplitude_m_s)?;
-    let frequencies: Vec<f64> = if grid.count == 1 {
-        vec![grid.min]
-    } else {
-        (0..grid.count)
-            .map(|i| grid.min + (grid.max - grid.min) * i as f64 / (grid.count - 1) as f64)
-            .collect()
-    };
-    let aero = req.aero.aerodynamics(
-        AirFlow::sinusoidal(req.wind_amplitude_m_s, grid.max)?,
-        sys.aerostat_mass_kg,
-        "aero",
-    )?;
-    let config = config_from(
-        req.duration_s,
-        req.time_step_s,
-        req.samples,
-        &req.initial,
-        Some(aero),
-        None,
-    )?;
-    let fr = transient::frequency_response(
-        &model,
-        &profile,
-        &config,
-        req.wind_amplitude_m_s,
-        &frequencies,
-        parallelism,
-        &ProgressObserver(progress),
-    )
-    .map_err(from_transient)?;
-    if progress.cancelled()
-        || fr
-            .outcomes
-            .iter()
-            .any(|o| matches!(o, RunOutcome::Cancelled { .. }))
-    {
-        return Err(RequestError::Cancelled);
-    }
-    Ok(FrequencyResponseResponse {
-        frequencies_rad_s: fr.frequencies_rad_s,
-        time_s: fr.time_s,
-        envelope_m: fr.envelope_m,
-        peak_amplitude_m: fr.peak_m,
-        peak_time_s: fr.peak_time_s,
-        outcomes: fr
-            .outcomes
-            .iter()
-            .map(|o| outcome_name(*o).0.to_string())
-            .collect(),
-        time_step_s: fr.time_step_s,
-        steps_per_run: fr.steps,
-        groups: groups(&sys),
-        elements: model.elements(),
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1063,31 +596,6 @@ mod tests {
                 r#""duration_s": 10, "initial": {"kind": "mode", "mode": 0, "tip_deflection_m": 0.1}"#
             ),
             "initial.mode"
-        );
-    }
-
-    #[test]
-    fn frequency_response_runs_and_validates() {
-        let body = format!(
-            r#"{{ {SYSTEM}, "profile": {{"kind": "constant_rate", "rate_m_s": 1}}, "duration_s": 10, "samples": 20,
-                "aero": {{"radius_m": 0.5}}, "wind_amplitude_m_s": 10,
-                "frequencies_rad_s": {{"min": 1, "max": 4, "count": 4}} }}"#
-        );
-        let req: FrequencyResponseRequest = parse(body.as_bytes()).unwrap();
-        let resp = frequency_response(&req, Parallelism::Rayon, &NoProgress).unwrap();
-        assert_eq!(resp.frequencies_rad_s, vec![1.0, 2.0, 3.0, 4.0]);
-        assert_eq!(resp.envelope_m.len(), 4);
-        assert!(resp.envelope_m.iter().all(|e| e.len() == 20));
-        assert!(resp.outcomes.iter().all(|o| o == "completed"));
-        let mut bad = req.clone();
-        bad.frequencies_rad_s.count = MAX_FREQUENCIES + 1;
-        assert!(
-            matches!(frequency_response(&bad, Parallelism::Serial, &NoProgress), Err(RequestError::Invalid(e)) if e.field == "frequencies_rad_s.count")
-        );
-        let mut bad = req;
-        bad.frequencies_rad_s.max = 0.5;
-        assert!(
-            matches!(frequency_response(&bad, Parallelism::Serial, &NoProgress), Err(RequestError::Invalid(e)) if e.field == "frequencies_rad_s.max")
         );
     }
 
