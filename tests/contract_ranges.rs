@@ -1240,12 +1240,13 @@ fn cases() -> Vec<Case> {
             "frequencies_rad_s.min",
             FREQUENCY_RAD_S,
         )),
-        case(
+        // and every value of it, its end too
+        exclusive(case(
             "frequency_response",
             ge_base(json!({"frequencies_rad_s": {"min": 0.5}})),
             "frequencies_rad_s.max",
             FREQUENCY_RAD_S,
-        ),
+        )),
         case(
             "frequency_response",
             ge_base(json!({})),

@@ -329,6 +329,7 @@ try {
       `the panel's choices are kept in the URL by their request paths (${[...query.keys()].filter((k) => k.startsWith("transient.")).join(", ")})`);
   }
   // A refused card number is shown on the card, not on a panel input.
+  phase = "invalid";
   await page.fill('[name="wind.air_density_kg_m3"]', "500");
   await page.click("#tr-run");
   await page.waitForSelector('#tr-status[data-state="ready"], #tr-status[data-state="error"]', { timeout: 60_000 });

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::dto::SystemInput;
-use crate::contract::system::grid::RateGridInput;
+use crate::contract::system::grid::BandsRateGridInput;
 
 /// `POST /api/v1/bands`: the deployment chart of one system under
 /// uncertain inputs, as 5/50/95 % bands with their sampling error.
@@ -39,7 +39,7 @@ pub struct BandsRequest {
 pub struct BandsParams {
     /// Rates of the chart (m/s): a list (1 to 1000 rates), or an evenly
     /// spaced grid `{min, max, count}`.
-    pub rates_m_s: RateGridInput,
+    pub rates_m_s: BandsRateGridInput,
     /// The uncertain inputs and the sampling.
     pub uncertainty: UncertaintyInput,
     /// Elevation to reach (m): each point then gives the probability that

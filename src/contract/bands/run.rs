@@ -25,7 +25,7 @@ pub use crate::contract::bands::common::{MAX_OUT_OF_RANGE, MAX_SEED};
 use crate::contract::bands::dto::*;
 use crate::contract::dto::SystemInput;
 use crate::contract::system::GridInput;
-use crate::contract::system::grid::RateGridInput;
+use crate::contract::system::grid::BandsRateGridInput;
 use crate::contract::{Progress, RequestError, parse_value};
 use crate::numerics::chart::{self, Discretisation, Parallelism};
 use crate::numerics::params::{AerostatSystem, InvalidInput, ranges, require_positive};
@@ -35,7 +35,7 @@ use crate::numerics::string::operators::StringOperators;
 use crate::numerics::uncertainty::{self, Ensemble, Summariser};
 
 /// Most rates of one banded chart.
-pub const MAX_BAND_RATES: usize = 1000;
+pub const MAX_BAND_RATES: usize = BandsRateGridInput::BOUNDS.max_count;
 /// Most chart points (samples × rates) of one bands request (a job).
 pub const MAX_BAND_EVALUATIONS: usize = 2_000_000;
 /// The keys of the parameters; every other top-level key belongs to the
@@ -602,7 +602,7 @@ pub fn parse_bands(body: &[u8]) -> Result<BandsRequest, RequestError> {
     let known = serde_json::to_value(&system).expect("the system serialises");
     reject_unknown(&system_value, &known, "")?;
     if let Some(rates) = params_part.get("rates_m_s") {
-        parse_value::<RateGridInput>(rates).map_err(|e| under("rates_m_s", e))?;
+        parse_value::<BandsRateGridInput>(rates).map_err(|e| under("rates_m_s", e))?;
     }
     let params: BandsParams = parse_value(&Value::Object(params_part))?;
     Ok(BandsRequest { system, params })

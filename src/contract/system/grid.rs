@@ -360,3 +360,17 @@ bounded_grid!(
         unit: "rad/s",
     }
 );
+
+bounded_grid!(
+    /// Winch rates of uncertainty bands (m/s): at most 1000 rates, each a
+    /// Monte-Carlo ensemble.
+    BandsRateGridInput,
+    "Rates (m/s): a list, or {min, max, count} evenly spaced (at most 1000).",
+    GridBounds {
+        min: 1e-6,
+        exclusive_min: false,
+        max: 1000.0,
+        max_count: 1000,
+        unit: "m/s",
+    }
+);
