@@ -239,6 +239,7 @@ fn numeric_fields_name_their_unit() {
     const UNITLESS: &[&str] = &[
         "elements",
         "check_elements",
+        "finest_elements",
         "modes",
         "count",
         "id",
