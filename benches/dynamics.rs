@@ -97,7 +97,12 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.sampling_mode(SamplingMode::Flat);
     let hour = hour();
-    timed(&mut g, "hour_of_turbulence_50_segments", &reference::turbulence_case(7), &hour);
+    timed(
+        &mut g,
+        "hour_of_turbulence_50_segments",
+        &reference::turbulence_case(7),
+        &hour,
+    );
     let gust = reference::gust_case();
     let gust_config = reference::gust_case_config();
     timed(&mut g, "gust_case_300s", &gust, &gust_config);
@@ -125,7 +130,12 @@ fn bench(c: &mut Criterion) {
             pool.install(|| {
                 seeds
                     .par_iter()
-                    .map(|p| dynamics::simulate(p, &hour).unwrap().peak_winch_tension.value)
+                    .map(|p| {
+                        dynamics::simulate(p, &hour)
+                            .unwrap()
+                            .peak_winch_tension
+                            .value
+                    })
                     .collect::<Vec<_>>()
             })
         })
@@ -187,7 +197,9 @@ fn main() {
                 },
             ),
             "turbulence_hour" => dynamics::simulate(&reference::turbulence_case(7), &hour()),
-            "gust_300s" => dynamics::simulate(&reference::gust_case(), &reference::gust_case_config()),
+            "gust_300s" => {
+                dynamics::simulate(&reference::gust_case(), &reference::gust_case_config())
+            }
             _ => panic!("unknown case {case}"),
         }
         .unwrap();

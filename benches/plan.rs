@@ -82,7 +82,10 @@ fn bench(c: &mut Criterion) {
     conv["stability"] = json!({"method": "quasi_static_ge"});
     let conv: PlanRequest = serde_json::from_value(conv).unwrap();
     let out = plan(&conv, &NoProgress).unwrap();
-    assert!(out.ge_stability.as_ref().is_some_and(|g| g.converged), "{out:?}");
+    assert!(
+        out.ge_stability.as_ref().is_some_and(|g| g.converged),
+        "{out:?}"
+    );
     group.bench_function(
         "plan_request_1000m_log_law_wind_jerk_rated_quasi_static_ge_converged",
         |b| b.iter(|| plan(std::hint::black_box(&conv), &NoProgress).unwrap()),

@@ -104,7 +104,10 @@ async fn quasi_static_without_elements_is_converged_with_its_error() {
     let safe = c["max_elevation_m"].as_f64().unwrap();
     let est = c["max_elevation_estimate_m"].as_f64().unwrap();
     let err = c["max_elevation_error_m"].as_f64().unwrap();
-    println!("converged h* {est:.3} ± {err:.3} m, safe {safe:.3} m: {}", c["explanation"]);
+    println!(
+        "converged h* {est:.3} ± {err:.3} m, safe {safe:.3} m: {}",
+        c["explanation"]
+    );
     assert!(err >= 0.0 && err <= 1e-3 * est, "{c}");
     assert!((safe - (est - err)).abs() <= 1e-9 * est);
     let t = c["critical_time_s"].as_f64().unwrap();
@@ -121,7 +124,10 @@ async fn quasi_static_without_elements_is_converged_with_its_error() {
         let h = o["max_elevation_m"].as_f64().unwrap();
         assert_eq!(l["elements"], n);
         let level = l["max_elevation_m"].as_f64().unwrap();
-        assert!((level - h).abs() <= 1e-5 * h, "{n}: level {level} vs answer {h}");
+        assert!(
+            (level - h).abs() <= 1e-5 * h,
+            "{n}: level {level} vs answer {h}"
+        );
         assert!(safe < h, "{n}: safe {safe} not below {h}");
     }
     // nearly flexible: the string's closed form
@@ -133,7 +139,10 @@ async fn quasi_static_without_elements_is_converged_with_its_error() {
     assert_eq!(s, StatusCode::OK, "{f}");
     let want = (1000.0 / 0.078 - 100.0) / 9.81;
     let got = f["max_elevation_m"].as_f64().unwrap();
-    println!("EI = 0.01 N m²: converged safe h* {got:.3} m, closed form {want:.3} m, {}", f["explanation"]);
+    println!(
+        "EI = 0.01 N m²: converged safe h* {got:.3} m, closed form {want:.3} m, {}",
+        f["explanation"]
+    );
     assert!((got / want - 1.0).abs() <= 2e-3, "{got} vs {want}");
     assert!(got <= f["max_elevation_estimate_m"].as_f64().unwrap());
 }

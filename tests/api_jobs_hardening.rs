@@ -625,7 +625,12 @@ async fn the_store_quota_is_per_token_and_answers_429() {
         assert_eq!(a.status, StatusCode::ACCEPTED, "{}", a.text);
     }
     let refused = send(&app, "POST", "/api/v1/jobs", &alpha, Some(&job)).await;
-    assert_eq!(refused.status, StatusCode::TOO_MANY_REQUESTS, "{}", refused.text);
+    assert_eq!(
+        refused.status,
+        StatusCode::TOO_MANY_REQUESTS,
+        "{}",
+        refused.text
+    );
     let e = refused.error();
     assert_eq!(e.code, "store_quota_full");
     assert!(
@@ -647,25 +652,44 @@ async fn the_store_quota_is_per_token_and_answers_429() {
         .await
         .unwrap();
     assert_eq!(ran.status, JobStatus::Done);
-    let answer = send(&app, "GET", &format!("/api/v1/jobs/{}", ran.id), &alpha, None).await;
+    let answer = send(
+        &app,
+        "GET",
+        &format!("/api/v1/jobs/{}", ran.id),
+        &alpha,
+        None,
+    )
+    .await;
     let answer_len = serde_json::to_vec(&answer.json()["result"]).unwrap().len() as u64;
-    assert!(req + answer_len < SMALL_ANSWER / 2, "{answer_len} bytes of answer");
+    assert!(
+        req + answer_len < SMALL_ANSWER / 2,
+        "{answer_len} bytes of answer"
+    );
     let a = send(&app, "POST", "/api/v1/jobs", &alpha, Some(&job)).await;
     assert_eq!(a.status, StatusCode::ACCEPTED, "{}", a.text);
     let refused = send(&app, "POST", "/api/v1/jobs", &alpha, Some(&job)).await;
-    assert_eq!(refused.status, StatusCode::TOO_MANY_REQUESTS, "{}", refused.text);
+    assert_eq!(
+        refused.status,
+        StatusCode::TOO_MANY_REQUESTS,
+        "{}",
+        refused.text
+    );
     let retry: u32 = refused.headers[header::RETRY_AFTER]
         .to_str()
         .unwrap()
         .parse()
         .unwrap();
-    assert!((590..=600).contains(&retry), "Retry-After {retry} (retention 600 s)");
+    assert!(
+        (590..=600).contains(&retry),
+        "Retry-After {retry} (retention 600 s)"
+    );
 }
 
 /// Named systems count against the same quota.
 #[tokio::test]
 async fn named_systems_count_against_the_store_quota() {
-    let system = json!({"aerostat": {"net_buoyancy_n": 1000.0}, "cable": {"mass_per_length_kg_m": 0.078}});
+    let system =
+        json!({"aerostat": {"net_buoyancy_n": 1000.0}, "cable": {"mass_per_length_kg_m": 0.078}});
     let size = serde_json::to_vec(&system).unwrap().len() as u64;
     let limits = Limits {
         max_stored_bytes_per_token: size + size / 2,

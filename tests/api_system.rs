@@ -215,7 +215,10 @@ async fn the_ge_charts_wind_is_the_systems_flow_and_its_old_form_is_refused() {
     // The system's calm wind: the still-air chart.
     let (status, calm) = post(&app, "/api/v1/charts", &chart(system()["wind"].clone())).await;
     assert_eq!(status, StatusCode::OK, "{calm}");
-    assert!(calm["series"][0]["wind_amplitude_nondim"].is_null(), "{calm}");
+    assert!(
+        calm["series"][0]["wind_amplitude_nondim"].is_null(),
+        "{calm}"
+    );
     // A wind on `wind.flow`; a power law of exponent 0 is the same uniform wind.
     let flow = |f: Value| json!({"air_density_kg_m3": 1.12, "flow": f, "amplitudes_nondim": [0.0]});
     let (status, windy) = post(
@@ -229,8 +232,10 @@ async fn the_ge_charts_wind_is_the_systems_flow_and_its_old_form_is_refused() {
     let (status, power) = post(
         &app,
         "/api/v1/charts",
-        &chart(flow(json!({"kind": "power_law", "coefficient_m_s": 5.0, "exponent_nondim": 0.0,
-                           "reference_height_m": 10.0}))),
+        &chart(flow(
+            json!({"kind": "power_law", "coefficient_m_s": 5.0, "exponent_nondim": 0.0,
+                           "reference_height_m": 10.0}),
+        )),
     )
     .await;
     assert_eq!(status, StatusCode::OK, "{power}");
@@ -247,7 +252,10 @@ async fn the_ge_charts_wind_is_the_systems_flow_and_its_old_form_is_refused() {
         .remove("drag_coefficient_nondim");
     let (status, b) = post(&app, "/api/v1/charts", &drag).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{b}");
-    assert_eq!(b["error"]["field"], "aerostat.drag_coefficient_nondim", "{b}");
+    assert_eq!(
+        b["error"]["field"], "aerostat.drag_coefficient_nondim",
+        "{b}"
+    );
     // The old shape is refused naming the new place (also as a job).
     for (old, wind, new) in [
         (
@@ -274,7 +282,12 @@ async fn the_ge_charts_wind_is_the_systems_flow_and_its_old_form_is_refused() {
         assert_eq!(r["error"]["field"], old, "{r}");
         let m = r["error"]["message"].as_str().unwrap();
         assert!(m.contains(&format!("moved to {new}")), "{old}: {m}");
-        let (status, r) = post(&app, "/api/v1/jobs", &json!({"kind": "chart", "request": body})).await;
+        let (status, r) = post(
+            &app,
+            "/api/v1/jobs",
+            &json!({"kind": "chart", "request": body}),
+        )
+        .await;
         assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{old}: {r}");
         assert_eq!(r["error"]["field"], format!("request.{old}"), "{r}");
     }

@@ -33,7 +33,11 @@ use common::http::{connect, exchange};
 /// The store the processes share.
 enum Store {
     Sqlite(PathBuf),
-    Pg { admin: String, name: String, url: String },
+    Pg {
+        admin: String,
+        name: String,
+        url: String,
+    },
 }
 
 /// A chunk row: index, status, attempts, lease owner.
@@ -96,7 +100,8 @@ impl Store {
                             Ok(match r.get_ref(i)? {
                                 rusqlite::types::ValueRef::Null => None,
                                 rusqlite::types::ValueRef::Integer(v) => Some(v.to_string()),
-                                rusqlite::types::ValueRef::Text(t) | rusqlite::types::ValueRef::Blob(t) => {
+                                rusqlite::types::ValueRef::Text(t)
+                                | rusqlite::types::ValueRef::Blob(t) => {
                                     Some(String::from_utf8_lossy(t).into_owned())
                                 }
                                 rusqlite::types::ValueRef::Real(v) => Some(v.to_string()),
@@ -113,7 +118,11 @@ impl Store {
                 c.query(sql, &[&id])
                     .unwrap()
                     .iter()
-                    .map(|r| (0..r.len()).map(|i| r.get::<_, Option<String>>(i)).collect())
+                    .map(|r| {
+                        (0..r.len())
+                            .map(|i| r.get::<_, Option<String>>(i))
+                            .collect()
+                    })
                     .collect()
             }
         }
@@ -232,7 +241,10 @@ impl Proc {
             Some("application/json"),
             &body,
         );
-        (reply.status, serde_json::from_str(&reply.body).unwrap_or(Value::Null))
+        (
+            reply.status,
+            serde_json::from_str(&reply.body).unwrap_or(Value::Null),
+        )
     }
 }
 
@@ -275,7 +287,10 @@ fn survive_coordinator_deaths(store: &Store) {
     let mut last_coordinator: Option<String> = None;
     let start = Instant::now();
     loop {
-        assert!(start.elapsed() < Duration::from_secs(400), "the job never ended");
+        assert!(
+            start.elapsed() < Duration::from_secs(400),
+            "the job never ended"
+        );
         let (status, _, owner) = store.job(id);
         if status != "running" && status != "queued" {
             break;
@@ -306,7 +321,11 @@ fn survive_coordinator_deaths(store: &Store) {
         let victim = if rows.is_empty() || left < 3 || status != "running" {
             None
         } else if chunk_turn {
-            chunk_worker().or_else(|| (coordinator_kills < COORDINATOR_KILLS).then(coordinator).flatten())
+            chunk_worker().or_else(|| {
+                (coordinator_kills < COORDINATOR_KILLS)
+                    .then(coordinator)
+                    .flatten()
+            })
         } else if coordinator_kills < COORDINATOR_KILLS {
             coordinator()
         } else {
@@ -335,7 +354,11 @@ fn survive_coordinator_deaths(store: &Store) {
             }
             eprintln!(
                 "killed {who} ({}) with {left} chunks left",
-                if is_coordinator { "coordinator" } else { "chunk worker" }
+                if is_coordinator {
+                    "coordinator"
+                } else {
+                    "chunk worker"
+                }
             );
             continue;
         }
@@ -346,7 +369,9 @@ fn survive_coordinator_deaths(store: &Store) {
     eprintln!(
         "job {status} after {coordinator_kills} coordinator and {chunk_kills} chunk kills, \
          {attempts} starts, chunks (index, status, attempts): {:?}",
-        rows.iter().map(|r| (r.0, r.1.as_str(), r.2)).collect::<Vec<_>>()
+        rows.iter()
+            .map(|r| (r.0, r.1.as_str(), r.2))
+            .collect::<Vec<_>>()
     );
     assert_eq!(
         coordinator_kills, COORDINATOR_KILLS,
@@ -364,8 +389,8 @@ fn survive_coordinator_deaths(store: &Store) {
     );
     assert!(rows.iter().any(|r| r.2 >= 2), "a killed chunk ran again");
     // the answer is the single-process one
-    let sub = JobSubmission::parse(&serde_json::to_vec(&body).unwrap(), &Limits::default())
-        .unwrap();
+    let sub =
+        JobSubmission::parse(&serde_json::to_vec(&body).unwrap(), &Limits::default()).unwrap();
     let single: Value = serde_json::from_str(&sub.run(&NoProgress).unwrap()).unwrap();
     assert_eq!(view["result"], single);
     drop(workers);

@@ -1160,17 +1160,27 @@ fn cases() -> Vec<Case> {
             "numerics.growth_tolerance_1_s",
             RATE_1_S,
         ),
-        lit("chart", &ge_wind(json!({})), "wind.flow.speed_m_s", -150.0, 150.0),
         lit(
             "chart",
-            &ge_wind(json!({"flow": {"kind": "power_law", "coefficient_m_s": 0.1, "exponent_nondim": 0.3}})),
+            &ge_wind(json!({})),
+            "wind.flow.speed_m_s",
+            -150.0,
+            150.0,
+        ),
+        lit(
+            "chart",
+            &ge_wind(
+                json!({"flow": {"kind": "power_law", "coefficient_m_s": 0.1, "exponent_nondim": 0.3}}),
+            ),
             "wind.flow.coefficient_m_s",
             -150.0,
             150.0,
         ),
         lit(
             "chart",
-            &ge_wind(json!({"flow": {"kind": "power_law", "coefficient_m_s": 0.1, "exponent_nondim": 0.3}})),
+            &ge_wind(
+                json!({"flow": {"kind": "power_law", "coefficient_m_s": 0.1, "exponent_nondim": 0.3}}),
+            ),
             "wind.flow.exponent_nondim",
             0.0,
             2.0,

@@ -350,10 +350,7 @@ fn run_with_a_killed_worker(db: &TestDb, job: &Value) -> String {
     // The one stored answer is the one the API serves.
     let (status, text) = api.request_text("GET", &format!("/api/v1/jobs/{id}"), None);
     assert_eq!(status, 200);
-    let stored: String = pg
-        .query_one(STORED_ANSWER, &[&id])
-        .unwrap()
-        .get(0);
+    let stored: String = pg.query_one(STORED_ANSWER, &[&id]).unwrap().get(0);
     assert!(text.contains(&stored));
     stored
 }
@@ -541,10 +538,7 @@ fn envelope_bands_on_two_workers_equal_the_sqlite_run() {
         let finishers: std::collections::BTreeSet<_> =
             rows.iter().filter_map(|r| r.4.clone()).collect();
         eprintln!("{kind}: {n} chunks done by {finishers:?}");
-        let stored: String = pg
-            .query_one(STORED_ANSWER, &[&id])
-            .unwrap()
-            .get(0);
+        let stored: String = pg.query_one(STORED_ANSWER, &[&id]).unwrap().get(0);
         assert_eq!(stored, sqlite_answer(&submission), "{kind}");
     }
     drop(workers);

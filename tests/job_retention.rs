@@ -15,8 +15,7 @@ use std::time::Duration;
 use tetherplan::jobs::postgres::PgStore;
 use tetherplan::jobs::sqlite::JobStore;
 use tetherplan::jobs::store::{
-    ANSWER_PAGE_BYTES, ClaimPolicy, InsertError, Inserted, JobBackend, JobStatus, NewJob,
-    PutSystem,
+    ANSWER_PAGE_BYTES, ClaimPolicy, InsertError, Inserted, JobBackend, JobStatus, NewJob, PutSystem,
 };
 
 fn insert(store: &dyn JobBackend) -> i64 {
@@ -202,7 +201,10 @@ fn quota(store: &dyn JobBackend) {
     }
     assert_eq!(store.answer_page(a, 3).unwrap(), None);
     assert_eq!(joined, answer.as_bytes());
-    assert_eq!(store.get(a).unwrap().unwrap().result.as_deref(), Some(answer.as_str()));
+    assert_eq!(
+        store.get(a).unwrap().unwrap().result.as_deref(),
+        Some(answer.as_str())
+    );
     assert!(store.get_head(a, Some("bob")).unwrap().is_none());
 
     // past the quota: refused, and the oldest finished job is named
@@ -227,12 +229,16 @@ fn quota(store: &dyn JobBackend) {
     assert_eq!(store.stored_bytes(None).unwrap(), 6000);
     // named systems count too, for the owner ("" without tokens)
     assert_eq!(
-        store.put_system("", "s", &"y".repeat(9000), 100, limit).unwrap(),
+        store
+            .put_system("", "s", &"y".repeat(9000), 100, limit)
+            .unwrap(),
         PutSystem::Created
     );
     assert_eq!(store.stored_bytes(None).unwrap(), 15_000);
     assert_eq!(
-        store.put_system("", "t", &"y".repeat(6000), 100, limit).unwrap(),
+        store
+            .put_system("", "t", &"y".repeat(6000), 100, limit)
+            .unwrap(),
         PutSystem::StoreFull {
             stored: 15_000,
             limit,
@@ -241,13 +247,18 @@ fn quota(store: &dyn JobBackend) {
     );
     // a replacement counts its new body only
     assert_eq!(
-        store.put_system("", "s", &"y".repeat(14_000), 100, limit).unwrap(),
+        store
+            .put_system("", "s", &"y".repeat(14_000), 100, limit)
+            .unwrap(),
         PutSystem::Updated
     );
     assert_eq!(store.stored_bytes(None).unwrap(), 20_000);
     assert!(matches!(
         store.insert(&job("{}", None, 0, limit)),
-        Err(InsertError::StoreFull { oldest_finished_s: None, .. })
+        Err(InsertError::StoreFull {
+            oldest_finished_s: None,
+            ..
+        })
     ));
     assert!(store.delete_system("", "s").unwrap());
     insert_job(store, &job("{}", None, 0, limit)).unwrap();
@@ -272,7 +283,10 @@ fn coordinator_deaths(store: &dyn JobBackend) {
     assert!(store.create_chunks(&first.lease, 3).unwrap());
     for n in 2..=6 {
         die();
-        let again = store.claim(&DYING).unwrap().expect("taken over, not failed");
+        let again = store
+            .claim(&DYING)
+            .unwrap()
+            .expect("taken over, not failed");
         assert_eq!((again.id, again.attempts), (id, n));
     }
     // chunk 0's worker dies twice: its own attempts count
@@ -312,6 +326,9 @@ fn coordinator_deaths(store: &dyn JobBackend) {
     assert!(!store.finish_chunk(&running.lease, "[1]").unwrap());
     assert_eq!(store.chunk_state(id3).unwrap().done, 0);
     assert!(store.claim_chunk(None, &POLICY).unwrap().is_none());
-    assert!(!store.renew_chunk(&running.lease, Duration::from_secs(1)).unwrap());
+    assert!(
+        !store
+            .renew_chunk(&running.lease, Duration::from_secs(1))
+            .unwrap()
+    );
 }
-

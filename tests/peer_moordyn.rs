@@ -66,13 +66,14 @@ fn gust_time_histories_agree_with_moordyn() {
     );
     println!(
         "peak winch tension: tetherplan {:.2} N, MoorDyn {peak_winch:.2} N; CPU: MoorDyn {:.2} s (dtM 1 ms, RK2), tetherplan {ours_s:.3} s wall (h = {} s)",
-        run.peak_winch_tension.value,
-        md.cpu_s,
-        cfg.time_step_s
+        run.peak_winch_tension.value, md.cpu_s, cfg.time_step_s
     );
     // Every kept sample on MoorDyn's 0.05 s grid is compared.
     let kept = (cfg.duration_s / cfg.sample_interval_s.max(cfg.time_step_s)).round() as usize;
-    assert!(compared >= kept.min(md_time.len() - 1), "{compared} of {kept}");
+    assert!(
+        compared >= kept.min(md_time.len() - 1),
+        "{compared} of {kept}"
+    );
     assert!(dw <= 0.02 * peak_winch, "winch {dw} N");
     assert!(dt <= 0.02 * peak_top, "top {dt} N");
     assert!(dx <= 5.0 && dz <= 5.0, "position {dx} m, {dz} m");

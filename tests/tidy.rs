@@ -229,7 +229,9 @@ fn import_graph(root: &Path, crate_path: &str) -> (Vec<String>, Vec<Vec<usize>>)
     let resolve = |path: &[String]| -> Option<usize> {
         let mut path = path.to_vec();
         for _ in 0..32 {
-            let k = (0..=path.len()).rev().find(|&k| index.contains_key(&path[..k]))?;
+            let k = (0..=path.len())
+                .rev()
+                .find(|&k| index.contains_key(&path[..k]))?;
             match path.get(k).and_then(|_| aliases.get(&path[..=k])) {
                 Some(target) => path = [target.clone(), path[k + 1..].to_vec()].concat(),
                 None => return Some(index[&path[..k]]),
@@ -337,7 +339,10 @@ fn contract_files_import_each_other_without_cycles() {
     let (names, edges) = import_graph(&root, "contract");
     assert!(names.len() >= 30, "found {} files", names.len());
     let arrows: usize = edges.iter().map(Vec::len).sum();
-    assert!(arrows >= 40, "found only {arrows} imports: is the parser blind?");
+    assert!(
+        arrows >= 40,
+        "found only {arrows} imports: is the parser blind?"
+    );
     let found = cycles(&names, &edges);
     assert!(
         found.is_empty(),
@@ -376,7 +381,10 @@ fn jobs_do_not_import_config() {
     // config.rs sits above jobs/: it builds the job store and limits from
     // the flags; the jobs take what they need as their own types.
     let mut files = Vec::new();
-    rust_files(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src/jobs"), &mut files);
+    rust_files(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("src/jobs"),
+        &mut files,
+    );
     assert!(files.len() >= 5, "found {} files", files.len());
     for file in files {
         let text = std::fs::read_to_string(&file).unwrap();

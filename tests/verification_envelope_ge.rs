@@ -337,7 +337,10 @@ fn critical_length_and_rate_in_wind_match_scans() {
             // +12 % in calm air) and -10 %.
             "during" if u > 0.0 => {
                 let r = w.critical_rate_m_s.unwrap();
-                assert!(r > 0.9 * v_string && r < 1.25 * v_string, "{r} vs {v_string}");
+                assert!(
+                    r > 0.9 * v_string && r < 1.25 * v_string,
+                    "{r} vs {v_string}"
+                );
             }
             "during" => {
                 let r = w.critical_rate_m_s.unwrap();
@@ -372,7 +375,11 @@ fn converged_without_elements() {
     assert!(ge.converged);
     assert_eq!(ge.relative_tolerance_nondim, Some(1e-3));
     let ei_default = 25e9 * std::f64::consts::PI * 0.0036f64.powi(4) / 64.0 / 12.0;
-    assert!((ge.bending_stiffness_n_m2 / ei_default - 1.0).abs() < 0.5, "{}", ge.bending_stiffness_n_m2);
+    assert!(
+        (ge.bending_stiffness_n_m2 / ei_default - 1.0).abs() < 0.5,
+        "{}",
+        ge.bending_stiffness_n_m2
+    );
     assert!((ge.rotary_inertia_kg_m - 0.078 * 0.0036 * 0.0036 / 16.0).abs() < 1e-15);
     let w = &ge.per_wind[0];
     let (l, est, err) = (

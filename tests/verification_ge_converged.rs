@@ -281,7 +281,10 @@ fn continued_det_root(
     };
     let sign = |l: f64, start: &[f64]| -> Option<(i8, Vec<f64>)> {
         let eq = wind_equilibrium(&m, kin(l), load, air, &QsConfig::default(), Some(start)).ok()?;
-        Some((stiffness_determinant_sign(&m, kin(l), load, air, &eq.q), eq.q))
+        Some((
+            stiffness_determinant_sign(&m, kin(l), load, air, &eq.q),
+            eq.q,
+        ))
     };
     let first = wind_equilibrium(&m, kin(lo), load, air, &QsConfig::default(), None).unwrap();
     let s0 = stiffness_determinant_sign(&m, kin(lo), load, air, &first.q);
@@ -360,7 +363,11 @@ fn wind_keeps_the_safe_side() {
     let ConvergedOutcome::During(o) = c.outcome else {
         panic!("{:?}", c.outcome)
     };
-    assert!(o.levels[0].1 > 300.0, "the spurious 142 m root is back: {:?}", o.levels);
+    assert!(
+        o.levels[0].1 > 300.0,
+        "the spurious 142 m root is back: {:?}",
+        o.levels
+    );
     if o.converged {
         let k = o.levels.len();
         let (d1, d2) = (

@@ -345,8 +345,11 @@ mod tests {
         assert_eq!(e.path, "k");
         assert!(e.value.is_nan());
         // integer keys are named by their number
-        let e = find_non_finite(&std::collections::BTreeMap::from([(7u32, [0.0, f64::NEG_INFINITY])]))
-            .unwrap_err();
+        let e = find_non_finite(&std::collections::BTreeMap::from([(
+            7u32,
+            [0.0, f64::NEG_INFINITY],
+        )]))
+        .unwrap_err();
         assert_eq!(e.path, "7[1]");
         // serde_json would have written `null` where a number belongs
         assert_eq!(

@@ -98,4 +98,3 @@ fn json_object(body: &[u8]) -> Result<serde_json::Value, RequestError> {
     system::refuse_moved(&value)?;
     Ok(value)
 }
-

@@ -331,7 +331,11 @@ impl CheckRanges for FrequencyResponseParams {
         check_initial(&self.initial, l0)?;
         check_body(&self.aero, "aero")?;
         WIND_SPEED_M_S.check("wind_amplitude_m_s", self.wind_amplitude_m_s)?;
-        check_grid(FREQUENCY_RAD_S, &self.frequencies_rad_s, "frequencies_rad_s")
+        check_grid(
+            FREQUENCY_RAD_S,
+            &self.frequencies_rad_s,
+            "frequencies_rad_s",
+        )
     }
 }
 
@@ -503,7 +507,11 @@ impl GeBaseFrequencyResponseRequest {
             p.check_ranges("profile")?;
         }
         BASE_AMPLITUDE_M.check("amplitude_m", self.amplitude_m)?;
-        check_grid(FREQUENCY_RAD_S, &self.frequencies_rad_s, "frequencies_rad_s")?;
+        check_grid(
+            FREQUENCY_RAD_S,
+            &self.frequencies_rad_s,
+            "frequencies_rad_s",
+        )?;
         opt(
             FREQUENCY_RAD_S,
             "reference_frequency_rad_s",

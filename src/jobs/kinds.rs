@@ -15,7 +15,6 @@ use serde_json::Value;
 use serde_json::value::RawValue;
 use utoipa::ToSchema;
 
-use crate::limits::Limits;
 use crate::contract::dto::*;
 use crate::contract::ge_charts::{self, AnyChartRequest, AnyFrequencyResponseRequest};
 use crate::contract::ge_critical::{self, AnyCriticalRequest, AnyStabilityRequest};
@@ -23,6 +22,7 @@ use crate::contract::run::{self, MAX_MODES};
 use crate::contract::simulate::{self, AnySimulateRequest};
 use crate::contract::transient::{self, FrequencyResponseRequest};
 use crate::contract::{self, Progress, RequestError};
+use crate::limits::Limits;
 use crate::numerics::chart::{self, MAX_CHART_POINTS, Parallelism};
 use crate::numerics::params::{InvalidInput, require_finite, require_positive};
 

@@ -33,9 +33,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 
-use crate::limits::Limits;
 use crate::contract::dto::ErrorBody;
 use crate::contract::{Progress, RequestError};
+use crate::limits::Limits;
 use kinds::JobSubmission;
 use store::{
     ClaimPolicy, InsertError, Inserted, JobBackend, JobRecord, JobStatus, Lease, NewJob, StoreError,

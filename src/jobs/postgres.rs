@@ -136,7 +136,8 @@ const UNFINISHED_CHUNKS: &str =
     "EXISTS (SELECT 1 FROM job_chunks c WHERE c.job_id = jobs.id AND c.status <> 'done')";
 
 /// The chunks of a finished job left running go back to pending.
-const RELEASE_ENDED_CHUNKS: &str = "UPDATE job_chunks SET status = 'pending', lease_expires_ms = NULL
+const RELEASE_ENDED_CHUNKS: &str =
+    "UPDATE job_chunks SET status = 'pending', lease_expires_ms = NULL
     WHERE status = 'running'
       AND job_id IN (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled'))";
 

@@ -128,7 +128,8 @@ const UNFINISHED_CHUNKS: &str =
 /// The chunks of a finished (failed, cancelled) job that were left
 /// running go back to pending: never claimed again (their job is not
 /// running), and none is left `running`.
-const RELEASE_ENDED_CHUNKS: &str = "UPDATE job_chunks SET status = 'pending', lease_expires_ms = NULL
+const RELEASE_ENDED_CHUNKS: &str =
+    "UPDATE job_chunks SET status = 'pending', lease_expires_ms = NULL
     WHERE status = 'running'
       AND job_id IN (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled'))";
 
@@ -516,12 +517,7 @@ impl JobBackend for JobStore {
                     stored_bytes = octet_length(request) + ?4
                  WHERE {FENCE}"
             ),
-            params![
-                lease.job_id,
-                lease.owner,
-                lease.epoch,
-                result.len() as i64
-            ],
+            params![lease.job_id, lease.owner, lease.epoch, result.len() as i64],
         )?;
         if n != 1 {
             return Ok(false);

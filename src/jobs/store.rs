@@ -167,7 +167,8 @@ pub fn join_pages(id: i64, pages: Vec<Vec<u8>>) -> Result<String, StoreError> {
     for p in pages {
         buf.extend_from_slice(&p);
     }
-    String::from_utf8(buf).map_err(|e| StoreError(format!("the answer of job {id} is not UTF-8: {e}")))
+    String::from_utf8(buf)
+        .map_err(|e| StoreError(format!("the answer of job {id} is not UTF-8: {e}")))
 }
 
 /// What an insert did.
@@ -427,9 +428,7 @@ impl StoreConfig {
     }
 
     /// Opens (and migrates) the store.
-    pub fn open(
-        &self,
-    ) -> Result<Box<dyn JobBackend>, StoreError> {
+    pub fn open(&self) -> Result<Box<dyn JobBackend>, StoreError> {
         Ok(match self {
             Self::Sqlite(p) => Box::new(JobStore::open(p)?),
             Self::Postgres(u) => Box::new(super::postgres::PgStore::open(u)?),

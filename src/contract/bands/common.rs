@@ -374,9 +374,7 @@ pub fn rejected_output<F: UncertainField>(
 
 /// The 5/50/95 % band of `values` (sorted in place).
 pub fn band_of(values: &mut [f64]) -> PercentileBand {
-    percentile_band(
-        uncertainty::Summariser::new(values.len()).band(values),
-    )
+    percentile_band(uncertainty::Summariser::new(values.len()).band(values))
 }
 
 /// Splits a JSON body into the request part and the `uncertainty` part.

@@ -209,7 +209,9 @@ pub fn prepare(req: &BandsRequest) -> Result<Prepared, RequestError> {
             grid.count_field("rates_m_s"),
             match &grid.0 {
                 GridInput::List(_) => format!("must list 1 to {MAX_BAND_RATES} rates, got {count}"),
-                GridInput::Range(_) => format!("must be between 1 and {MAX_BAND_RATES}, got {count}"),
+                GridInput::Range(_) => {
+                    format!("must be between 1 and {MAX_BAND_RATES}, got {count}")
+                }
             },
         )
         .into());
@@ -702,11 +704,32 @@ mod tests {
         assert_eq!(listed, run(json!({"min": 5.0, "max": 10.0, "count": 3})));
         assert!(listed.contains("7.5"), "{listed}");
         // errors name the part at fault, as the other grids do
-        assert_eq!(field_of(body(json!({"rates_m_s": {"min": 5.0, "max": 10.0, "count": 1001}}))), "rates_m_s.count");
-        assert_eq!(field_of(body(json!({"rates_m_s": vec![5.0; 1001]}))), "rates_m_s");
-        assert_eq!(field_of(body(json!({"rates_m_s": [5.0, 0.0]}))), "rates_m_s[1]");
-        assert_eq!(field_of(body(json!({"rates_m_s": {"min": 0.0, "max": 10.0, "count": 3}}))), "rates_m_s.min");
-        assert_eq!(field_of(body(json!({"rates_m_s": {"min": 5.0, "max": 1.0, "count": 3}}))), "rates_m_s.max");
+        assert_eq!(
+            field_of(body(
+                json!({"rates_m_s": {"min": 5.0, "max": 10.0, "count": 1001}})
+            )),
+            "rates_m_s.count"
+        );
+        assert_eq!(
+            field_of(body(json!({"rates_m_s": vec![5.0; 1001]}))),
+            "rates_m_s"
+        );
+        assert_eq!(
+            field_of(body(json!({"rates_m_s": [5.0, 0.0]}))),
+            "rates_m_s[1]"
+        );
+        assert_eq!(
+            field_of(body(
+                json!({"rates_m_s": {"min": 0.0, "max": 10.0, "count": 3}})
+            )),
+            "rates_m_s.min"
+        );
+        assert_eq!(
+            field_of(body(
+                json!({"rates_m_s": {"min": 5.0, "max": 1.0, "count": 3}})
+            )),
+            "rates_m_s.max"
+        );
     }
 
     #[test]

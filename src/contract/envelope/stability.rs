@@ -96,8 +96,7 @@ impl EnvelopeStabilityInput {
                 format!("must be between 2 and {MAX_ELEMENTS}, got {n}"),
             ));
         }
-        let converge =
-            ConvergenceConfig::requested(elements.is_some(), relative_tolerance_nondim)?;
+        let converge = ConvergenceConfig::requested(elements.is_some(), relative_tolerance_nondim)?;
         let at = match critical_rate_length_m {
             Some(l) => require_range("stability.critical_rate_length_m", l, 0.0, true, 1e5)?,
             None => longest_length_m,
@@ -183,7 +182,9 @@ pub struct GeStabilityOutput {
 }
 
 /// `(estimate, error, converged, finest elements)` of a converged search.
-fn converged_fields(c: Option<&ConvergedSearch>) -> (Option<f64>, Option<f64>, Option<bool>, usize) {
+fn converged_fields(
+    c: Option<&ConvergedSearch>,
+) -> (Option<f64>, Option<f64>, Option<bool>, usize) {
     match c.map(|c| (&c.outcome, c.flutter.is_some())) {
         Some((ConvergedOutcome::During(o), false)) => (
             Some(o.value),

@@ -10,14 +10,14 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::dto::{CableInput, ProfileInput, RateGrid};
-use crate::contract::system::WindFlowInput;
-use crate::contract::system::grid::BaseFrequencyGridInput;
-use crate::contract::ge::{GeAerostatInput, GeModelInput, GeModelKind, NewtonInput};
 use crate::contract::ge::numerics::{
     self as ge_numerics, IntegratorOutput, StartStateInput, default_check, default_dt,
     default_growth, default_horizon, newton_config,
 };
 pub use crate::contract::ge::numerics::{GeChartNumericsInput, GeOnsetKind};
+use crate::contract::ge::{GeAerostatInput, GeModelInput, GeModelKind, NewtonInput};
+use crate::contract::system::WindFlowInput;
+use crate::contract::system::grid::BaseFrequencyGridInput;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::aero::{AerostatBody, ForceModel, SteadyFlow};
 use crate::numerics::chart::Parallelism;

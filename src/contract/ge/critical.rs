@@ -23,14 +23,12 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::contract::dto::{
-    CableInput, CriticalRequest, CriticalResponse, ProfileInput,
-};
-use crate::contract::ge::{GeAerostatInput, GeModelInput, NewtonInput};
+use crate::contract::dto::{CableInput, CriticalRequest, CriticalResponse, ProfileInput};
 use crate::contract::ge::numerics::{
     self as ge_numerics, GeChartNumericsInput, GeOnsetKind, IntegratorOutput, StartStateInput,
     newton_config,
 };
+use crate::contract::ge::{GeAerostatInput, GeModelInput, NewtonInput};
 use crate::contract::{Progress, RequestError, run};
 use crate::numerics::ge::air_load::AirLoads;
 use crate::numerics::ge::chart::closed_form_verdict;
@@ -39,8 +37,7 @@ use crate::numerics::ge::critical::{
 };
 use crate::numerics::ge::extensible::ExtensibleString;
 use crate::numerics::ge::qs_converged::{
-    ConvergedOnset, ConvergedOutcome, ConvergedSearch, ConvergenceConfig,
-    converged_critical_length,
+    ConvergedOnset, ConvergedOutcome, ConvergedSearch, ConvergenceConfig, converged_critical_length,
 };
 use crate::numerics::ge::qs_critical::{
     QsOnset, QsSearch, QsSearchConfig, critical_length, lift_limit_length_m,
@@ -416,9 +413,7 @@ pub fn ge_critical(
 ) -> Result<GeCriticalResponse, RequestError> {
     let (model, problem, config) = prepare_critical(req)?;
     if req.method == GeCriticalMethod::QuasiStatic {
-        return quasi_static_critical(
-            req, &model, &problem, progress,
-        );
+        return quasi_static_critical(req, &model, &problem, progress);
     }
     let cancel = || progress.cancelled();
     let r = critical_time(&model, &problem, &config, &cancel)?;
@@ -713,7 +708,11 @@ pub fn quasi_static_critical(
                     c.error_estimate,
                     c.levels.first().map_or(0, |l| l.0),
                     c.levels.last().map_or(0, |l| l.0),
-                    if c.converged { "" } else { ", tolerance not met: the finest mesh was reached" }
+                    if c.converged {
+                        ""
+                    } else {
+                        ", tolerance not met: the finest mesh was reached"
+                    }
                 ),
                 None => format!(
                     "quasi-static: stable until the cable is {at:.2} m long (t* = {:.3} s at {v} m/s){}",
@@ -771,9 +770,7 @@ pub fn quasi_static_critical(
         critical_time_nondim: t.map(|t| t / scale),
         max_elevation_m: h,
         ended_at_s: ended,
-        string_closed_form_elevation_m: (v > 0.0)
-            .then(|| closed(f64::INFINITY))
-            .and_then(finite),
+        string_closed_form_elevation_m: (v > 0.0).then(|| closed(f64::INFINITY)).and_then(finite),
         extensible_closed_form_elevation_m: (v > 0.0)
             .then(|| closed(model.section.axial_stiffness_n))
             .and_then(finite),

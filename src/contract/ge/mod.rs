@@ -11,6 +11,6 @@ pub mod simulate;
 pub mod stability;
 
 pub use simulate::{
-    GeAerostatInput, GeModelInput, GeModelKind, GeSimulateRequest, GeSimulateResponse,
-    NewtonInput, simulate_ge,
+    GeAerostatInput, GeModelInput, GeModelKind, GeSimulateRequest, GeSimulateResponse, NewtonInput,
+    simulate_ge,
 };

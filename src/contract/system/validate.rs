@@ -175,8 +175,14 @@ impl CableInput {
     /// either a value or a diameter.
     pub fn bending_stiffness(&self, at: &str) -> Result<Option<f64>, InvalidInput> {
         if let Some(e) = self.bending_stiffness_n_m2 {
-            return require_range(&Self::field(at, "bending_stiffness_n_m2"), e, 1e-6, false, 1e12)
-                .map(Some);
+            return require_range(
+                &Self::field(at, "bending_stiffness_n_m2"),
+                e,
+                1e-6,
+                false,
+                1e12,
+            )
+            .map(Some);
         }
         let Some(d) = self.diameter_m else {
             return Ok(None);

@@ -9,10 +9,12 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::aero::AeroBodyInput;
-use super::simulate::{InitialStateInput, ProgressObserver, config_from, from_transient, outcome_name};
+use super::simulate::{
+    InitialStateInput, ProgressObserver, config_from, from_transient, outcome_name,
+};
 use crate::contract::dto::{Groups, ProfileInput, SystemInput};
-use crate::contract::system::grid::FrequencyGridInput;
 use crate::contract::run::{Progress, RequestError, groups};
+use crate::contract::system::grid::FrequencyGridInput;
 use crate::numerics::aero::AirFlow;
 use crate::numerics::chart::Parallelism;
 use crate::numerics::params::{InvalidInput, require_finite};
@@ -205,14 +207,32 @@ mod tests {
             }
         };
         let max = crate::numerics::string::transient::MAX_FREQUENCIES;
-        assert_eq!(refused(serde_json::json!({"min": 1, "max": 4, "count": max + 1})), "frequencies_rad_s.count");
-        assert_eq!(refused(serde_json::json!({"min": 1, "max": 0.5, "count": 4})), "frequencies_rad_s.max");
-        assert_eq!(refused(serde_json::json!({"min": -1, "max": 4, "count": 4})), "frequencies_rad_s.min");
-        assert_eq!(refused(serde_json::json!([1, 2, 20000])), "frequencies_rad_s[2]");
-        assert_eq!(refused(serde_json::json!(vec![1.0; max + 1])), "frequencies_rad_s");
+        assert_eq!(
+            refused(serde_json::json!({"min": 1, "max": 4, "count": max + 1})),
+            "frequencies_rad_s.count"
+        );
+        assert_eq!(
+            refused(serde_json::json!({"min": 1, "max": 0.5, "count": 4})),
+            "frequencies_rad_s.max"
+        );
+        assert_eq!(
+            refused(serde_json::json!({"min": -1, "max": 4, "count": 4})),
+            "frequencies_rad_s.min"
+        );
+        assert_eq!(
+            refused(serde_json::json!([1, 2, 20000])),
+            "frequencies_rad_s[2]"
+        );
+        assert_eq!(
+            refused(serde_json::json!(vec![1.0; max + 1])),
+            "frequencies_rad_s"
+        );
         // The list of the grid's values gives the same answer, bit for bit.
         let mut listed = req.clone();
         listed.frequencies_rad_s = grid(serde_json::json!([1.0, 2.0, 3.0, 4.0]));
-        assert_eq!(frequency_response(&listed, Parallelism::Serial, &NoProgress).unwrap(), resp);
+        assert_eq!(
+            frequency_response(&listed, Parallelism::Serial, &NoProgress).unwrap(),
+            resp
+        );
     }
 }

@@ -14,8 +14,8 @@ use crate::numerics::aero::Aerodynamics;
 use crate::numerics::params::{AerostatSystem, InvalidInput, require_finite};
 use crate::numerics::reduced::ReducedModel;
 use crate::numerics::string::transient::{
-    self, EigenTracking, InitialState, MAGNITUDE_CAP_LENGTHS, Observer,
-    RunOutcome, TransientConfig, TransientError, TransientRun,
+    self, EigenTracking, InitialState, MAGNITUDE_CAP_LENGTHS, Observer, RunOutcome,
+    TransientConfig, TransientError, TransientRun,
 };
 
 fn default_samples() -> usize {

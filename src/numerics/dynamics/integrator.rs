@@ -8,12 +8,12 @@
 //! ([`model::IterationMatrix`]); one block-tridiagonal solve. No work array
 //! is allocated after the start.
 
+use super::MAX_HALVINGS;
 use super::blocks::{V2, add_identity};
 use super::model::{self, Evaluation, IterationMatrix, NoJacobian, Parameters, evaluate_with};
 use super::problem::LengthSchedule;
 use super::run::Statistics;
 use super::wind::{GustHistory, TurbulenceField};
-use super::MAX_HALVINGS;
 use crate::numerics::tether::wind::WindProfile;
 
 /// The integrator's constants.
@@ -259,7 +259,8 @@ impl<'a> Stepper<'a> {
             if converged {
                 let (ha, hn) = (h * h * (0.5 - beta), h * h * beta);
                 let (ga, gn) = (h * (1.0 - gamma), h * gamma);
-                for (((x, v), a), an) in x.iter_mut().zip(v.iter_mut()).zip(a.iter()).zip(an.iter()) {
+                for (((x, v), a), an) in x.iter_mut().zip(v.iter_mut()).zip(a.iter()).zip(an.iter())
+                {
                     for c in 0..2 {
                         x[c] += h * v[c] + ha * a[c] + hn * an[c];
                         v[c] += ga * a[c] + gn * an[c];

@@ -57,7 +57,9 @@ pub use outputs::{Extreme, Sample, Shape, ShapeNode, SlackEvent};
 pub use problem::{
     Aerostat, DynamicsConfig, DynamicsError, DynamicsProblem, LengthSchedule, Tether,
 };
-pub use run::{Outcome, Run, State, Statistics, StepView, aerostat, magnitude, simulate, simulate_from};
+pub use run::{
+    Outcome, Run, State, Statistics, StepView, aerostat, magnitude, simulate, simulate_from,
+};
 pub use start::{StaticStart, static_start};
 pub use wind::{GustHistory, SpectrumModel, Turbulence, TurbulenceField};
 
@@ -118,4 +120,3 @@ mod tests {
         );
     }
 }
-

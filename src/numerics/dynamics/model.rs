@@ -279,14 +279,23 @@ fn tether_drag(p: &Parameters, q: V2, lam: f64, ur: V2, jac: bool) -> (V2, B2) {
     let kt = p.tangential_drag * lam;
     let an = kn * un.abs();
     let at = kt * ut.abs();
-    let f = [an * un * n[0] + at * ut * q[0], an * un * n[1] + at * ut * q[1]];
+    let f = [
+        an * un * n[0] + at * ut * q[0],
+        an * un * n[1] + at * ut * q[1],
+    ];
     let mut d = ZERO;
     if jac {
         // −(2 k_n |u_n| n nᵀ + 2 k_t |u_t| q qᵀ).
         let (a, b) = (-2.0 * an, -2.0 * at);
         d = [
-            [a * n[0] * n[0] + b * q[0] * q[0], a * n[0] * n[1] + b * q[0] * q[1]],
-            [a * n[1] * n[0] + b * q[1] * q[0], a * n[1] * n[1] + b * q[1] * q[1]],
+            [
+                a * n[0] * n[0] + b * q[0] * q[0],
+                a * n[0] * n[1] + b * q[0] * q[1],
+            ],
+            [
+                a * n[1] * n[0] + b * q[1] * q[0],
+                a * n[1] * n[1] + b * q[1] * q[1],
+            ],
         ];
     }
     (f, d)
@@ -386,7 +395,10 @@ pub fn evaluate_with<W: Fn(f64, f64) -> f64 + ?Sized, J: JacobianSink>(
             [0.0, 1.0]
         };
         let strain = ell * inv_l - 1.0;
-        let strain_rate = dot(t, sub(out.material_velocity[j], out.material_velocity[j - 1])) * inv_l;
+        let strain_rate = dot(
+            t,
+            sub(out.material_velocity[j], out.material_velocity[j - 1]),
+        ) * inv_l;
         let raw = p.axial_stiffness_n * strain + p.damping_n_s * strain_rate;
         let active = strain > 0.0 && raw > 0.0;
         let tension = if active { raw } else { 0.0 };
@@ -412,13 +424,19 @@ pub fn evaluate_with<W: Fn(f64, f64) -> f64 + ?Sized, J: JacobianSink>(
     let mut tether_drag_sum = [0.0; 2];
     for i in 1..n {
         let k = i - 1;
-        let (below, above) = (scale(out.tension[k], out.tangent[k]), scale(out.tension[i], out.tangent[i]));
+        let (below, above) = (
+            scale(out.tension[k], out.tangent[k]),
+            scale(out.tension[i], out.tangent[i]),
+        );
         let mut f = sub(above, below);
         f[1] -= weight;
         if any_drag {
             let r = pos[k];
             let q = unit(sub(node(i + 1), node(i - 1)));
-            let ur = [wind(r[0], r[1]) - out.material_velocity[i][0], -out.material_velocity[i][1]];
+            let ur = [
+                wind(r[0], r[1]) - out.material_velocity[i][0],
+                -out.material_velocity[i][1],
+            ];
             let (fd, d) = tether_drag(p, q, 0.5 * (lam(i) + lam(i + 1)), ur, J::WANTED);
             if J::WANTED {
                 jac.velocity_diagonal(k, &d);
@@ -433,7 +451,10 @@ pub fn evaluate_with<W: Fn(f64, f64) -> f64 + ?Sized, J: JacobianSink>(
         let k = n - 1;
         let r = pos[k];
         let top = scale(out.tension[k], out.tangent[k]);
-        let ur = [wind(r[0], r[1]) - out.material_velocity[n][0], -out.material_velocity[n][1]];
+        let ur = [
+            wind(r[0], r[1]) - out.material_velocity[n][0],
+            -out.material_velocity[n][1],
+        ];
         let fd = if any_drag {
             let (fd, d) = tether_drag(p, out.tangent[k], 0.5 * lam(n), ur, J::WANTED);
             if J::WANTED {

@@ -149,7 +149,6 @@ impl Default for DynamicsConfig {
     }
 }
 
-
 impl DynamicsProblem {
     /// `ΔU(t)`, the sum of the gusts (m/s).
     pub fn gust_change_m_s(&self, t: f64) -> f64 {

@@ -295,9 +295,9 @@ impl<K: Fn(f64) -> Kinematics> Level<'_, K> {
         if let Some(x) = self.seen.iter().find(|x| x.0 == p) {
             return x.1;
         }
-        let x = self
-            .equilibrium(p)
-            .and_then(|q| divergence_indicator(&self.model, (self.kin)(p), self.load, self.air, &q));
+        let x = self.equilibrium(p).and_then(|q| {
+            divergence_indicator(&self.model, (self.kin)(p), self.load, self.air, &q)
+        });
         self.seen.push((p, x));
         x
     }
@@ -540,11 +540,7 @@ pub fn converged_onset(
         let (r, e) = level.root((lo, hi), c_base, hint(&roots), rtol, cancel);
         equilibria += e;
         match r {
-            LevelRoot::Root {
-                at,
-                known: k,
-                c_lo,
-            } => {
+            LevelRoot::Root { at, known: k, c_lo } => {
                 c_base = Some(c_lo);
                 roots.push((n, at));
                 known = k.iter().map(|(p, q)| (*p, prolong(q, n))).collect();

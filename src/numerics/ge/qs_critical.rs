@@ -278,7 +278,11 @@ pub fn along_rate(length_m: f64) -> impl Fn(f64) -> Kinematics {
 pub(super) enum Scan {
     /// `(last point like the lower end, first point not like it)`;
     /// `failed`: the second point had no state at all.
-    Bracket { a: f64, b: f64, failed: bool },
+    Bracket {
+        a: f64,
+        b: f64,
+        failed: bool,
+    },
     /// Like the lower end up to `hi`.
     Unchanged,
     Cancelled,
@@ -677,7 +681,11 @@ fn inertia_only<K: Fn(f64) -> Kinematics>(
             return finish(out, s);
         }
     };
-    let i_a = if a == lo { Some(c0) } else { state(s, a).map(|x| x.0) };
+    let i_a = if a == lo {
+        Some(c0)
+    } else {
+        state(s, a).map(|x| x.0)
+    };
     let i_b = last.map(|x| x.0);
     let (a, b) = refine_root(
         (a, b),
