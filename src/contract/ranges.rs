@@ -391,16 +391,18 @@ fn check_ge_system(
 }
 
 fn check_ge_model(m: &GeModelInput) -> Checked {
-    BENDING_STIFFNESS_N_M2.check("model.bending_stiffness_n_m2", m.bending_stiffness_n_m2)?;
-    STIFFNESS_RATIO.check("model.stiffness_ratio", m.stiffness_ratio)?;
+    opt(
+        BENDING_STIFFNESS_N_M2,
+        "model.bending_stiffness_n_m2",
+        m.bending_stiffness_n_m2,
+    )?;
+    opt(STIFFNESS_RATIO, "model.stiffness_ratio", m.stiffness_ratio)?;
     opt(
         STIFFNESS_RATIO,
         "model.shear_stiffness_ratio",
         m.shear_stiffness_ratio,
     )?;
-    INERTIA_RATIO
-        .check("model.inertia_ratio", m.inertia_ratio)
-        .map(drop)
+    opt(INERTIA_RATIO, "model.inertia_ratio", m.inertia_ratio).map(drop)
 }
 
 fn check_end_load(e: &EndLoadInput) -> Checked {

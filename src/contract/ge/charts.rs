@@ -673,11 +673,14 @@ pub fn ge_base_frequency_response(
     parallelism: Parallelism,
     progress: &dyn Progress,
 ) -> Result<GeBaseFrequencyResponseResponse, RequestError> {
-    let rho_a = req.cable.mass_per_length()?;
     let l0 = require_positive("initial_length_m", req.initial_length_m)?;
     let g = require_non_negative("gravity_m_s2", req.gravity_m_s2)?;
     let m = &req.model;
-    let section = m.section(rho_a, l0)?;
+    let buoyancy = match &req.aerostat {
+        Some(a) => Some(a.net_buoyancy_ge("aerostat")?),
+        None => None,
+    };
+    let section = m.section(&req.cable, l0, buoyancy)?;
     let (tip, steady) = match &req.aerostat {
         None => (TipBody::default(), TipLoad::default()),
         Some(a) => (
@@ -773,8 +776,9 @@ pub fn ge_base_frequency_response(
         return Err(RequestError::Cancelled);
     }
     let rate_nondim = rate.map(|v| v * scale / l0);
+    let stiffness_ratio = crate::contract::ge::simulate::stiffness_ratio_of(&section, l0);
     let bands = rate_nondim.and_then(|v| {
-        ge_reduced::resonance_bands(m.stiffness_ratio, epsilon, v, duration / scale).map(|b| {
+        ge_reduced::resonance_bands(stiffness_ratio, epsilon, v, duration / scale).map(|b| {
             b.iter()
                 .map(|b| ResonanceBandOutput {
                     low_rad_s: b.low / scale,
@@ -801,7 +805,7 @@ pub fn ge_base_frequency_response(
             .map(|i| r.points[i].frequency_rad_s)
             .collect(),
         time_scale_s: scale,
-        stiffness_ratio: m.stiffness_ratio,
+        stiffness_ratio,
         rate_nondim,
         elements: m.elements(),
     })

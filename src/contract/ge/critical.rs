@@ -28,6 +28,7 @@ use crate::contract::ge::numerics::{
     self as ge_numerics, GeChartNumericsInput, GeOnsetKind, IntegratorOutput, StartStateInput,
     newton_config,
 };
+use crate::contract::ge::simulate::stiffness_ratio_of;
 use crate::contract::ge::{GeAerostatInput, GeModelInput, NewtonInput};
 use crate::contract::{Progress, RequestError, run};
 use crate::numerics::ge::air_load::AirLoads;
@@ -256,7 +257,6 @@ pub(super) fn prepare(
     gravity_m_s2: f64,
     model: &GeModelInput,
 ) -> Result<Prepared, InvalidInput> {
-    let rho_a = cable.mass_per_length()?;
     let l0 = require_positive("initial_length_m", initial_length_m)?;
     let g = require_non_negative("gravity_m_s2", gravity_m_s2)?;
     let buoyancy = aerostat.net_buoyancy("aerostat")?;
@@ -269,7 +269,7 @@ pub(super) fn prepare(
             ),
         ));
     }
-    let section = model.section(rho_a, l0)?;
+    let section = model.section(cable, l0, Some(buoyancy))?;
     let tip = TipBody {
         mass_kg: aerostat.mass("aerostat")?,
         link_length_m: aerostat.link_length("aerostat")?,
@@ -499,7 +499,7 @@ pub fn ge_critical(
         step_cuts: r.step_cuts,
         integrator: IntegratorOutput::new(config.scheme, config.max_step_cuts),
         start_state: req.start_state,
-        stiffness_ratio: req.model.stiffness_ratio,
+        stiffness_ratio: stiffness_ratio_of(&model.section, req.initial_length_m),
         elements: model.elements,
         time_scale_s: scale,
         wave_speed_m_s: (problem.net_buoyancy_n / rho_a).sqrt(),
@@ -786,7 +786,7 @@ pub fn quasi_static_critical(
         step_cuts: 0,
         integrator: IntegratorOutput::new(defaults.scheme, defaults.max_step_cuts),
         start_state: req.start_state,
-        stiffness_ratio: req.model.stiffness_ratio,
+        stiffness_ratio: stiffness_ratio_of(&model.section, req.initial_length_m),
         elements: model.elements,
         time_scale_s: scale,
         wave_speed_m_s: (f / rho_a).sqrt(),

@@ -223,7 +223,10 @@ pub fn ge_stability(req: &GeStabilityRequest) -> Result<GeStabilityResponse, Req
                 .critical_length_m(v)
                 .unwrap_or(0.0),
         ),
-        stiffness_ratio: req.model.stiffness_ratio,
+        stiffness_ratio: crate::contract::ge::simulate::stiffness_ratio_of(
+            &model.section,
+            req.initial_length_m,
+        ),
         elements: model.elements,
         time_scale_s: scale,
         wave_speed_m_s: (p.net_buoyancy_n / rho_a).sqrt(),
