@@ -1,11 +1,12 @@
-//! The geometrically exact (GE) model's requests: the transient run and
-//! the model inputs every GE request shares ([`simulate`]), the critical
+//! The geometrically exact (GE) model's requests: the model input every
+//! GE request shares ([`model`]), the transient run ([`simulate`]), the critical
 //! time ([`critical`], both methods), the stability query ([`stability`]),
 //! the deployment chart and the base-excitation frequency response
 //! ([`charts`]), and the numerics settings they share ([`numerics`]).
 
 pub mod charts;
 pub mod critical;
+pub mod model;
 pub mod numerics;
 pub mod simulate;
 pub mod stability;
