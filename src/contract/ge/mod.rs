@@ -1,9 +1,11 @@
 //! The geometrically exact (GE) model's requests: the model input every
 //! GE request shares ([`model`]), the transient run ([`simulate`]), the critical
 //! time ([`critical`], both methods), the stability query ([`stability`]),
-//! the deployment chart and the base-excitation frequency response
-//! ([`charts`]), and the numerics settings they share ([`numerics`]).
+//! the deployment chart ([`charts`]), the base-excitation frequency
+//! response ([`base_response`]), and the numerics settings they share
+//! ([`numerics`]).
 
+pub mod base_response;
 pub mod charts;
 pub mod critical;
 pub mod model;

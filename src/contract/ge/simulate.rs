@@ -14,7 +14,7 @@ use crate::numerics::ge::solver::{
     self, BaseMotion, Damping, Drive, EndLoads, LengthHistory, LoadShape, NewtonConfig, RunConfig,
     RunOutcome, State,
 };
-use crate::numerics::ge::{GeModel, Section, TipBody};
+use crate::numerics::ge::{GeModel, TipBody};
 
 pub use super::model::{DEFAULT_GE_ELEMENTS, GeModelInput, GeModelKind, stiffness_ratio_of};
 use crate::numerics::params::{
