@@ -135,15 +135,16 @@ fn bench_quasi_static(c: &mut Criterion) {
     // rotary inertia and EI = 1000 and 1 N m², calm air; and in a 10 m/s
     // wind (divergence by det K, one base-mesh QEP).
     //
-    // Measured 2026-12-02 with six helpers sharing 2 cores (criterion
-    // [low median high], --warm-up-time 1 --measurement-time 3, 10
-    // samples; the spread is the load): EI = 1000 [13.1 ms 496 ms 1.32 s],
-    // EI = 1 [26.0 61.0 115] ms, wind [136 220 326] ms; the unconverged
-    // 20-element searches above ran at 22.4 / 22.2 / 93.1 ms medians
-    // (13–14 ms on a quiet machine last session, so the load is ≥ 1.7×).
-    // Before this change (quiet machine) the calm EI = 1000 search took
-    // 68 ms. Target not met: the levels go to 320 elements (uniform
-    // meshes; see qs_converged's docs), about ten states per level.
+    // Measured 2026-12-02 (criterion [low median high], --warm-up-time 1
+    // --measurement-time 3, 10 samples, 2 cores shared with another helper
+    // and the lead, load average 4–6): uniform meshes (to 320 elements)
+    // EI = 1000 [6.20 6.46 6.79] ms, EI = 1 [11.1 12.0 12.6] ms, wind
+    // [32.9 33.9 34.6] ms; calm air on graded meshes (issue 21: 20/40/80
+    // elements, the closed form's root as the first guess) EI = 1000
+    // [1.00 1.08 1.18] ms, EI = 1 [1.27 1.38 1.48] ms (target ≤ 5 ms met);
+    // the wind path is unchanged (uniform), [42.1 45.1 48.7] ms under a
+    // heavier load. Instructions (callgrind, one EI = 1000 search):
+    // 136 M uniform → 21.4 M graded.
     use tetherplan::numerics::ge::qs_converged::{ConvergenceConfig, converged_critical_length};
     let tether = |ei: f64| {
         let s = Section::new(1e6, 1e6, ei, 0.078, 0.078 * 0.005 * 0.005 / 16.0).unwrap();

@@ -179,6 +179,16 @@ pub struct GeCriticalResponse {
     /// Constant rate only: the quasi-static bound of an extensible string of
     /// this axial stiffness (m), clipped at 0.
     pub extensible_closed_form_elevation_m: Option<f64>,
+    /// Quasi-static constant-rate payout in calm air: the closed form of the
+    /// GE onset (m), the string's bound lifted by the bending layer at the
+    /// guide, `F − ρA g L − ρA v² = a₁ (EI_eff b²)^(1/3)` with `a₁` the first
+    /// zero of Airy's Ai, `b = ρA g + 2ρA v²/L`, `EI_eff = EI − I_ρ v²`
+    /// (neglected: shear flexibility, extensibility, the curvature of the
+    /// tension over the layer); the converged answer's continuum limit
+    /// meets it within `max_elevation_error_m`. Null for other methods and
+    /// profiles, or without a bending layer (`EI_eff ≤ 0`).
+    #[serde(default)]
+    pub bending_closed_form_elevation_m: Option<f64>,
     /// Whether the closed forms describe this onset: false without a
     /// closed form (profiles other than a constant rate), with a tip
     /// perturbation still acting at t*, or when the onset is a start-up
@@ -239,6 +249,11 @@ pub struct GeCriticalResponse {
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
 pub struct GeMeshLevelOutput {
     pub elements: usize,
+    /// Length of the element at the guide at this root (m): `h*/elements`
+    /// on a uniform mesh; less in calm air, where the meshes are graded
+    /// toward the guide (geometrically growing elements, each level the
+    /// last with every element bisected).
+    pub first_element_m: f64,
     /// The divergence root on this mesh (m).
     pub max_elevation_m: f64,
 }
@@ -490,6 +505,7 @@ pub fn ge_critical(
         string_closed_form_elevation_m: rate.and_then(|v| finite(closed(f64::INFINITY, v))),
         extensible_closed_form_elevation_m: rate
             .and_then(|v| finite(closed(model.section.axial_stiffness_n, v))),
+        bending_closed_form_elevation_m: None,
         closed_form_applies: applies,
         closed_form_note: note,
         onset_root_axial_force_n: r.onset_root_axial_force_n,
@@ -774,6 +790,12 @@ pub fn quasi_static_critical(
         extensible_closed_form_elevation_m: (v > 0.0)
             .then(|| closed(model.section.axial_stiffness_n))
             .and_then(finite),
+        bending_closed_form_elevation_m: (v > 0.0)
+            .then(|| {
+                crate::numerics::ge::airy_onset::AiryOnset::of_model(model, f).critical_length_m(v)
+            })
+            .flatten()
+            .and_then(finite),
         closed_form_applies: v > 0.0,
         closed_form_note: (v <= 0.0).then(|| "no closed form for a retrieval".to_string()),
         onset_root_axial_force_n: match r.onset {
@@ -802,8 +824,10 @@ pub fn quasi_static_critical(
         mesh_levels: converged.as_ref().map(|c| {
             c.levels
                 .iter()
-                .map(|&(elements, h)| GeMeshLevelOutput {
+                .zip(c.first_elements.iter().chain(std::iter::repeat(&f64::NAN)))
+                .map(|(&(elements, h), &first)| GeMeshLevelOutput {
                     elements,
+                    first_element_m: first * h,
                     max_elevation_m: h,
                 })
                 .collect()

@@ -130,14 +130,14 @@ impl AirLoads {
             return out;
         }
         let l = length_m;
-        let h = model.ops.h;
-        let dn = [-1.0 / h, 1.0 / h];
         let c = 0.5
             * self.air_density_kg_m3
             * self.cable_normal_drag_coefficient
             * self.cable_diameter_m;
         if c > 0.0 {
             for e in 0..model.elements {
+                let h = model.ops.len(e);
+                let dn = [-1.0 / h, 1.0 / h];
                 let (qa, qb) = (node(q, e), node(q, e + 1));
                 let (va, vb) = (node(v, e), node(v, e + 1));
                 // element force (u1, u2 of both nodes) and derivatives
@@ -147,7 +147,7 @@ impl AirLoads {
                 for &(xi, wf) in &GAUSS2 {
                     let wgt = wf * h * l;
                     let nn = [1.0 - xi, xi];
-                    let zeta = (e as f64 + xi) * h;
+                    let zeta = model.ops.point(e, xi);
                     let a = [
                         l + dn[0] * qa[0] + dn[1] * qb[0],
                         dn[0] * qa[1] + dn[1] * qb[1],

@@ -364,7 +364,7 @@ fn growth(
 /// position `ζ = h/2`), where the reduced rule evaluates it:
 /// `Γ1 = (cos θ (L + u1_ζ) + sin θ u2_ζ)/L − 1`.
 pub fn root_axial_force_n(model: &GeModel, length_m: f64, q: &[f64]) -> f64 {
-    let h = 1.0 / model.elements as f64;
+    let h = model.ops.len(0);
     let (u1, u2, th) = (
         q[GeModel::dof(1, 0)],
         q[GeModel::dof(1, 1)],

@@ -41,12 +41,12 @@ fn for_points(
     v: &[f64],
     mut f: impl FnMut(f64, [f64; 2], [f64; 2], f64),
 ) {
-    let h = model.ops.h;
     let (l, ld) = (kin.length_m, kin.rate_m_s);
     for e in 0..model.elements {
+        let h = model.ops.len(e);
         let (qa, qb, va, vb) = (node(q, e), node(q, e + 1), node(v, e), node(v, e + 1));
         for &(xi, wf) in &G2 {
-            let z = (e as f64 + xi) * h;
+            let z = model.ops.point(e, xi);
             let c = (1.0 - z) * ld / l;
             let mut d = [0.0; 3];
             let mut u = [0.0; 3];

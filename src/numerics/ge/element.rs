@@ -31,24 +31,47 @@ const GAUSS2: [(f64, f64); 2] = [
     (0.5 + 0.288_675_134_594_812_9, 0.5),
 ];
 
-/// The constant element integrals `R`, `P_e`, `Q_e` of one mesh.
+/// The mesh on `ζ ∈ [0, 1]` and the constant element integrals `R_e`,
+/// `P_e`, `Q_e` of it. Uniform meshes ([`Self::new`]) keep `h = 1/n` and
+/// `ζ = (e + ξ) h` exactly as before graded meshes existed, so their
+/// answers are unchanged bit for bit; graded ones ([`Self::graded`]) take
+/// their node positions.
 #[derive(Clone, Debug)]
 pub struct InertiaOperators {
-    pub h: f64,
-    pub r: [[f64; 2]; 2],
+    /// Element length on `ζ` of a uniform mesh; `None` when graded.
+    pub h: Option<f64>,
+    /// Element lengths on `ζ`.
+    pub lengths: Vec<f64>,
+    /// `ζ` of each element's first node.
+    pub starts: Vec<f64>,
+    pub r: Vec<[[f64; 2]; 2]>,
     pub p: Vec<[[f64; 2]; 2]>,
     pub q: Vec<[[f64; 2]; 2]>,
 }
 
 impl InertiaOperators {
+    /// A uniform mesh of `elements` elements.
     pub fn new(elements: usize) -> Self {
         let h = 1.0 / elements as f64;
-        let dn = [-1.0 / h, 1.0 / h];
-        let mut r = [[0.0; 2]; 2];
+        let starts = (0..elements).map(|e| e as f64 * h).collect();
+        Self::build(Some(h), vec![h; elements], starts)
+    }
+
+    /// A mesh with nodes at `nodes` (`0 = ζ₀ < ζ₁ < … < ζ_n = 1`).
+    pub fn graded(nodes: &[f64]) -> Self {
+        let lengths = nodes.windows(2).map(|w| w[1] - w[0]).collect();
+        let starts = nodes[..nodes.len() - 1].to_vec();
+        Self::build(None, lengths, starts)
+    }
+
+    fn build(h: Option<f64>, lengths: Vec<f64>, starts: Vec<f64>) -> Self {
+        let elements = lengths.len();
+        let mut r = vec![[[0.0; 2]; 2]; elements];
         let mut p = vec![[[0.0; 2]; 2]; elements];
         let mut q = vec![[[0.0; 2]; 2]; elements];
         for e in 0..elements {
-            let za = e as f64 * h;
+            let (za, h) = (starts[e], lengths[e]);
+            let dn = [-1.0 / h, 1.0 / h];
             for &(xi, wf) in &GAUSS2 {
                 let z = za + xi * h;
                 let w = wf * h;
@@ -56,16 +79,45 @@ impl InertiaOperators {
                 let s = 1.0 - z;
                 for i in 0..2 {
                     for j in 0..2 {
-                        if e == 0 {
-                            r[i][j] += w * n[i] * n[j];
-                        }
+                        r[e][i][j] += w * n[i] * n[j];
                         p[e][i][j] += w * s * n[i] * dn[j];
                         q[e][i][j] += w * s * s * dn[i] * dn[j];
                     }
                 }
             }
         }
-        Self { h, r, p, q }
+        Self {
+            h,
+            lengths,
+            starts,
+            r,
+            p,
+            q,
+        }
+    }
+
+    /// Length of element `e` on `ζ`.
+    #[inline]
+    pub fn len(&self, e: usize) -> f64 {
+        self.lengths[e]
+    }
+
+    /// `ζ` of the point at fraction `xi` along element `e`.
+    #[inline]
+    pub fn point(&self, e: usize, xi: f64) -> f64 {
+        match self.h {
+            Some(h) => (e as f64 + xi) * h,
+            None => self.starts[e] + xi * self.lengths[e],
+        }
+    }
+
+    /// `ζ` of node `k`.
+    pub fn node_position(&self, k: usize) -> f64 {
+        match self.h {
+            Some(h) => k as f64 * h,
+            None if k < self.starts.len() => self.starts[k],
+            None => 1.0,
+        }
     }
 }
 
@@ -94,8 +146,8 @@ fn element_linear(model: &GeModel, e: usize, kin: Kinematics, damping: f64) -> [
     let mut out = [[[0.0; 2]; 2]; 3];
     for i in 0..2 {
         for j in 0..2 {
-            out[0][i][j] = l * ops.r[i][j];
-            out[1][i][j] = 2.0 * ld * ops.p[e][i][j] + damping * l * ops.r[i][j];
+            out[0][i][j] = l * ops.r[e][i][j];
+            out[1][i][j] = 2.0 * ld * ops.p[e][i][j] + damping * l * ops.r[e][i][j];
             out[2][i][j] = -(ld * ld / l) * ops.q[e][i][j] + (ldd + damping * ld) * ops.p[e][i][j];
         }
     }
@@ -218,16 +270,16 @@ pub fn internal_forces(
     mut tangent: Option<&mut Band>,
     mut root: Option<&mut [f64; 3]>,
 ) {
-    let h = model.ops.h;
     let sec = &model.section;
     let (ea, ga, ei) = (
         sec.axial_stiffness_n,
         sec.shear_stiffness_n,
         sec.bending_stiffness_n_m2,
     );
-    let dn = [-1.0 / h, 1.0 / h];
     let points = stiffness_points(model.rule);
     for e in 0..model.elements {
+        let h = model.ops.len(e);
+        let dn = [-1.0 / h, 1.0 / h];
         let ua = node(q, e);
         let ub = node(q, e + 1);
         let mut fe = [0.0; 6];
@@ -324,10 +376,10 @@ pub fn internal_forces(
 /// Strain energy (6.24), `½ ∫₀ᴸ (EA γ1² + GA γ2² + EI κ²) dX`, with the
 /// rule of the internal forces (so they are its exact gradient).
 pub fn strain_energy(model: &GeModel, length: f64, q: &[f64]) -> f64 {
-    let h = model.ops.h;
     let s = &model.section;
     let mut total = 0.0;
     for e in 0..model.elements {
+        let h = model.ops.len(e);
         let (ua, ub) = (node(q, e), node(q, e + 1));
         for &(xi, wf) in stiffness_points(model.rule) {
             let p = point_state(model, length, ua, ub, xi, h);
@@ -345,9 +397,9 @@ pub fn strain_energy(model: &GeModel, length: f64, q: &[f64]) -> f64 {
 
 /// Stress resultants at the middle of every element: `(f1, f2, m)`.
 pub fn element_resultants(model: &GeModel, length: f64, q: &[f64]) -> Vec<[f64; 3]> {
-    let h = model.ops.h;
     (0..model.elements)
         .map(|e| {
+            let h = model.ops.len(e);
             let p = point_state(model, length, node(q, e), node(q, e + 1), 0.5, h);
             [p.f[0], p.f[1], p.m]
         })
@@ -363,15 +415,14 @@ pub fn body_forces(
     f: &mut [f64],
     root: &mut [f64; 3],
 ) {
-    let h = model.ops.h;
-    let per_node = factor
+    let per_half = factor
         * kin.length_m
         * model.section.mass_per_length_kg_m
         * (-model.gravity_m_s2 - kin.acceleration_m_s2)
-        * 0.5
-        * h;
-    root[0] += per_node;
+        * 0.5;
+    root[0] += per_half * model.ops.len(0);
     for e in 0..model.elements {
+        let per_node = per_half * model.ops.len(e);
         for k in [e, e + 1] {
             if k > 0 {
                 f[GeModel::dof(k, 0)] += per_node;
@@ -463,7 +514,7 @@ mod tests {
         // 2P = ∫(1-ζ)(N N_ζᵀ − N_ζ Nᵀ) + ∫ N Nᵀ, assembled over the whole mesh.
         let n = 7;
         let ops = InertiaOperators::new(n);
-        let h = ops.h;
+        let h = ops.len(0);
         let mut worst: f64 = 0.0;
         // Assembled: wᵀ(2P)u == wᵀ(skew + R)u for all w, u.
         let nodes = n + 1;

@@ -42,6 +42,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod air_load;
+pub mod airy_onset;
 pub mod banded;
 pub mod base;
 pub mod chart;
@@ -203,6 +204,23 @@ impl GeModel {
         let mut m = Self::new(self.section, elements, self.tip, self.gravity_m_s2)?;
         m.rule = self.rule;
         m.slow_spectrum = self.slow_spectrum;
+        Ok(m)
+    }
+
+    /// The same model on a graded mesh with nodes at `nodes` on `ζ`
+    /// (`0 = ζ₀ < ζ₁ < … < ζ_n = 1`; section, tip, gravity, rule and
+    /// spectrum solve kept).
+    pub fn with_nodes(&self, nodes: &[f64]) -> Result<Self, InvalidInput> {
+        let elements = nodes.len().saturating_sub(1);
+        let mut m = self.with_elements(elements.max(1))?;
+        let increasing = nodes.windows(2).all(|w| w[1] > w[0]);
+        if nodes.len() < 2 || nodes[0] != 0.0 || nodes[elements] != 1.0 || !increasing {
+            return Err(InvalidInput::new(
+                "model.nodes",
+                "must increase from 0 to 1 with at least two nodes",
+            ));
+        }
+        m.ops = element::InertiaOperators::graded(nodes);
         Ok(m)
     }
 

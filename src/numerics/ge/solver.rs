@@ -330,11 +330,16 @@ fn residual_with(
     let mut body = vec![0.0; n];
     element::body_forces(model, kin, 1.0, &mut body, &mut [0.0; 3]);
     if base_m_s2 != 0.0 {
-        let per_element =
-            -model.section.mass_per_length_kg_m * kin.length_m * base_m_s2 * model.ops.h;
+        let per_length = -model.section.mass_per_length_kg_m * kin.length_m * base_m_s2;
         for k in 1..=model.elements {
-            let share = if k == model.elements { 0.5 } else { 1.0 };
-            body[GeModel::dof(k, 1)] += share * per_element;
+            // the node's share of its elements: h on a uniform mesh
+            // (the top node: h/2)
+            let share = if k == model.elements {
+                0.5 * model.ops.len(k - 1)
+            } else {
+                0.5 * (model.ops.len(k - 1) + model.ops.len(k))
+            };
+            body[GeModel::dof(k, 1)] += per_length * share;
         }
     }
     let top = model.elements;
