@@ -86,6 +86,7 @@ use super::qs_critical::{
     OnsetState, QsOnset, QsSearchConfig, Scan, along_length, along_rate, nearest, onset_state,
     refine_root, scan_change, search_onset_from,
 };
+use super::qs_wind::{branch_equilibrium, continuum_start};
 use super::quasi_static::{QsConfig, divergence_indicator, wind_equilibrium, wind_stability};
 use super::stability::StateMotion;
 use crate::numerics::params::{InvalidInput, Kinematics, require_finite, require_positive};
@@ -293,17 +294,30 @@ impl<K: Fn(f64) -> Kinematics> Level<'_, K> {
         let start = nearest(&self.known, p)
             .filter(|k| calm || (k.0 - p).abs() <= NEAR * p.abs().max(k.0.abs()))
             .map(|k| k.1.clone());
-        let eq = wind_equilibrium(
-            &self.model,
-            (self.kin)(p),
-            self.load,
-            self.air,
-            &QsConfig::default(),
-            start.as_deref(),
-        )
-        .ok()?;
-        self.known.push((p, eq.q.clone()));
-        Some(eq.q)
+        // In wind: only the branch reached by paying out (`qs_wind`).
+        let q = if calm {
+            wind_equilibrium(
+                &self.model,
+                (self.kin)(p),
+                self.load,
+                self.air,
+                &QsConfig::default(),
+                start.as_deref(),
+            )
+            .ok()?
+            .q
+        } else {
+            branch_equilibrium(
+                &self.model,
+                (self.kin)(p),
+                self.load,
+                self.air,
+                &QsConfig::default(),
+                start.as_deref(),
+            )?
+        };
+        self.known.push((p, q.clone()));
+        Some(q)
     }
 
     fn count(&mut self, p: f64) -> Option<usize> {
@@ -727,7 +741,10 @@ pub fn converged_onset(
             _ => lo,
         };
         let k = kin(probe);
-        let start_q = start.filter(|q| q.len() == base.dofs());
+        let branch = continuum_start(&base, air, net_buoyancy_n, k.length_m).map(|s| s.0);
+        let start_q = start
+            .filter(|q| q.len() == base.dofs())
+            .or(branch.as_deref());
         let ok = match wind_stability(
             &base,
             k,

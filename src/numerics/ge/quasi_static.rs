@@ -90,6 +90,7 @@ fn newton(
     air: &AirLoads,
     q: &mut [f64],
     config: NewtonConfig,
+    limit: Option<StepLimit>,
 ) -> Result<usize, NewtonFailure> {
     let n = q.len();
     let zero = vec![0.0; n];
@@ -116,6 +117,24 @@ fn newton(
         let lu = s.factor().ok_or(fail)?;
         let mut dq: Vec<f64> = total.iter().map(|x| -x).collect();
         lu.solve_in_place(&mut dq);
+        if let Some(lim) = limit {
+            // scale the step so that no rotation turns more than
+            // `rotation_rad` and no node moves more than `displacement_m`
+            let mut f: f64 = 1.0;
+            for (i, d) in dq.iter().enumerate() {
+                let cap = if i % 3 == 2 {
+                    lim.rotation_rad
+                } else {
+                    lim.displacement_m
+                };
+                if d.abs() > cap {
+                    f = f.min(cap / d.abs());
+                }
+            }
+            if f < 1.0 {
+                dq.iter_mut().for_each(|d| *d *= f);
+            }
+        }
         for (qi, di) in q.iter_mut().zip(&dq) {
             *qi += di;
         }
@@ -127,6 +146,38 @@ fn newton(
             return Ok(iterations);
         }
     }
+}
+
+/// Largest Newton step of [`newton_from`]: the step is scaled down so that
+/// no rotation changes by more than `rotation_rad` and no displacement by
+/// more than `displacement_m` (a Newton that stays near its start).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepLimit {
+    pub rotation_rad: f64,
+    pub displacement_m: f64,
+}
+
+/// Newton alone on the equilibrium at `kin` from `q` (no continuation),
+/// its steps limited by `limit`: the iterations taken; `q` is the
+/// equilibrium on success.
+pub fn newton_from(
+    model: &GeModel,
+    kin: Kinematics,
+    load: TipLoad,
+    air: &AirLoads,
+    config: &QsConfig,
+    q: &mut [f64],
+    limit: Option<StepLimit>,
+) -> Result<usize, NewtonFailure> {
+    let newton_config = match limit {
+        // a limited step converges more slowly from far
+        Some(_) => NewtonConfig {
+            max_iterations: config.newton.max_iterations.max(60),
+            ..config.newton
+        },
+        None => config.newton,
+    };
+    newton(model, kin, load, air, q, newton_config, limit)
 }
 
 /// The blown-down equilibrium at `kin` under the tip `load`, gravity and `air`.
@@ -142,7 +193,7 @@ pub fn wind_equilibrium(
         && s.len() == model.dofs()
     {
         let mut q = s.to_vec();
-        if let Ok(it) = newton(model, kin, load, air, &mut q, config.newton) {
+        if let Ok(it) = newton(model, kin, load, air, &mut q, config.newton, None) {
             return Ok(WindEquilibrium {
                 q,
                 continuation_steps: 0,
@@ -179,6 +230,7 @@ pub fn wind_equilibrium(
             &air.scaled(target),
             &mut trial,
             config.newton,
+            None,
         ) {
             Ok(it) => {
                 iterations += it;

@@ -61,6 +61,7 @@ use crate::numerics::ge::qs_converged::{
     ConvergedOutcome, ConvergenceConfig, converged_critical_length, converged_critical_rate,
 };
 use crate::numerics::ge::qs_critical::lift_limit_length_m;
+use crate::numerics::ge::qs_wind::{airborne_length_m, branch_equilibrium, continuum_start};
 use crate::numerics::ge::quasi_static::{
     QsConfig, stiffness_negative_count, wind_equilibrium, wind_stability,
 };
@@ -260,17 +261,31 @@ pub const BISECTIONS: usize = 16;
 pub fn judge(gm: &GePlanModel, kin: Kinematics) -> (bool, f64, f64) {
     let load = gm.load();
     // Divergence on the fine mesh: equilibrium and the inertia of K (O(n)).
-    let Ok(eq) = wind_equilibrium(&gm.model, kin, load, &gm.air, &QsConfig::default(), None) else {
+    // In wind: the branch reached by paying out (`qs_wind`), not a
+    // wrapped equilibrium of the straight tether's continuation.
+    let q = if gm.air.is_calm() {
+        wind_equilibrium(&gm.model, kin, load, &gm.air, &QsConfig::default(), None)
+            .ok()
+            .map(|e| e.q)
+    } else {
+        branch_equilibrium(&gm.model, kin, load, &gm.air, &QsConfig::default(), None)
+    };
+    let Some(q) = q else {
         return (false, f64::NAN, 0.0);
     };
-    let count = stiffness_negative_count(&gm.model, kin, load, &gm.air, &eq.q);
+    let count = stiffness_negative_count(&gm.model, kin, load, &gm.air, &q);
     if count != Some(0) {
         return (false, f64::NAN, 0.0);
     }
     let Some(check) = &gm.check_model else {
         return (true, f64::NAN, 0.0);
     };
-    // Flutter on the check mesh: the QEP.
+    // Flutter on the check mesh: the QEP (in wind from the branch's start).
+    let start = if gm.air.is_calm() {
+        None
+    } else {
+        continuum_start(check, &gm.air, gm.reserve_buoyancy_n, kin.length_m).map(|s| s.0)
+    };
     let Ok(w) = wind_stability(
         check,
         kin,
@@ -278,7 +293,7 @@ pub fn judge(gm: &GePlanModel, kin: Kinematics) -> (bool, f64, f64) {
         &gm.air,
         StateMotion::AtRest,
         &QsConfig::default(),
-        None,
+        start.as_deref(),
     ) else {
         return (false, f64::NAN, 0.0);
     };
@@ -451,11 +466,10 @@ fn build(
         .0
     };
     let never = || false;
-    // In wind the levels' divergence roots do not converge (issue 21:
-    // several blown-down equilibria, `wind_keeps_the_safe_side` in
-    // tests/verification_ge_converged.rs) and a search ran to 1280
-    // elements per row (minutes per plan): three levels there, the safe
-    // side below each.
+    // In wind every level follows the branch reached by paying out
+    // (`qs_wind`) and the length search ends at the continuum tether's
+    // ground contact; the rate rows' levels are not yet reliable in wind
+    // (issue 21): three levels there, the safe side below each.
     let conv = options.converge.map(|c| ConvergenceConfig {
         base_elements: options.elements,
         max_elements: if gm.air.is_calm() {
@@ -466,6 +480,11 @@ fn build(
         qep_in_wind: false,
         ..c
     });
+    let search_hi = if conv.is_some() && !gm.air.is_calm() {
+        airborne_length_m(&gm.model, &gm.air, b, (lo, search_hi))
+    } else {
+        search_hi
+    };
     // The maximum safe length: at rest.
     let mut max_len_error = None;
     let max_len = match &conv {

@@ -39,7 +39,10 @@
 //! **Converged** (issue 21, [`GeStabilitySpec::converge`]): the critical
 //! length and rate of each wind speed are the converged, conservative
 //! onsets of [`crate::numerics::ge::qs_converged`] (nested meshes,
-//! Richardson, safe side), the maximum safe altitude the blown-down
+//! Richardson, safe side; in wind every level on the branch reached by
+//! paying out, [`crate::numerics::ge::qs_wind`], and the length search
+//! ends at the continuum tether's ground contact, where the cells turn
+//! `slack`), the maximum safe altitude the blown-down
 //! altitude at the safe length on the finest mesh. A cell longer than the
 //! safe critical length of its wind is unstable; when the base mesh's QEP
 //! search confirms that the onset along the length is a divergence, every
@@ -62,6 +65,7 @@ use crate::numerics::ge::qs_critical::{
     OnsetState, QsOnset, QsSearch, QsSearchConfig, critical_length, critical_rate_from,
     lift_limit_length_m,
 };
+use crate::numerics::ge::qs_wind::airborne_length_m;
 use crate::numerics::ge::quasi_static::{QsConfig, WindStateStability, wind_stability};
 use crate::numerics::ge::stability::{GeStateFailure, StateMotion};
 use crate::numerics::ge::tether_system::{GeTetherOptions, GeTetherSystem, ge_tether_system};
@@ -301,9 +305,17 @@ pub fn wind_limits(
         .copied()
         .fold(f64::INFINITY, f64::min);
     let lmax = problem.tether_lengths_m.iter().copied().fold(0.0, f64::max);
-    let length_search_max_m = lift_limit_length_m(&sys.model, sys.net_buoyancy_n, &sys.air)
+    let lift_max = lift_limit_length_m(&sys.model, sys.net_buoyancy_n, &sys.air)
         .max(lmax)
         .max(lmin);
+    // In wind the GE model has no ground: past the continuum tether's
+    // ground contact (the `slack` limit) its states are not the tether's
+    // (`qs_wind`), so the length search stops there.
+    let length_search_max_m = if sys.air.is_calm() {
+        lift_max
+    } else {
+        airborne_length_m(&sys.model, &sys.air, sys.net_buoyancy_n, (lmin, lift_max))
+    };
     let rate_search_max_m_s = rate_search_max(
         &sys.model,
         &sys.air,
@@ -311,8 +323,10 @@ pub fn wind_limits(
         spec.critical_rate_length_m,
     );
     if let Some(cfg) = &spec.converge {
-        // In wind the levels do not converge (issue 21, see
-        // `ge_stability`'s plan table): three levels, the safe side below each.
+        // In wind every level follows the branch reached by paying out
+        // (`qs_wind`); the rate search still moves the quasi-static shape
+        // far from the continuum start and its levels are not yet
+        // reliable (issue 21): three levels, the safe side below each.
         let cfg = &if sys.air.is_calm() {
             *cfg
         } else {
