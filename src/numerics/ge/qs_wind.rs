@@ -315,7 +315,6 @@ mod tests {
             let force = (crate::numerics::ge::critical::root_axial_force_n(&m, l, &q)
                 - reference.winch_tension_n)
                 .abs();
-            eprintln!("{n}: tip {tip:.4} m, guide force {force:.4} N");
             if let Some((t0, f0)) = last {
                 assert!(tip < t0 / 3.0 || tip < 2e-3, "{n}: tip {tip} after {t0}");
                 assert!(force < 0.6 * f0, "{n}: force {force} after {f0}");
