@@ -392,15 +392,9 @@ pub(crate) fn envelope_of(
             reference_area_m2: b.reference_area_m2,
         },
         integration_steps: config.steps,
-        quasi_static_ge: spec.zip(ge.as_ref()).map(|(spec, ge)| {
-            stability::ge_output(
-                spec,
-                problem.base.cable.mass_per_length_kg_m,
-                problem.base.cable.diameter_m,
-                &problem.wind_speeds_m_s,
-                ge,
-            )
-        }),
+        quasi_static_ge: spec
+            .zip(ge.as_ref())
+            .map(|(spec, ge)| stability::ge_output(spec, &problem, &config, ge)),
     })
 }
 

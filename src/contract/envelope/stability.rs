@@ -8,12 +8,17 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::equilibrium::require_range;
+use crate::numerics::ge::airy_onset::AiryOnset;
 use crate::numerics::ge::qs_converged::{ConvergedOutcome, ConvergedSearch, ConvergenceConfig};
 use crate::numerics::ge::qs_critical::{QsOnset, QsSearch};
 use crate::numerics::params::InvalidInput;
+use crate::numerics::tether::envelope::EnvelopeProblem;
 use crate::numerics::tether::envelope_ge::{
-    DEFAULT_ELEMENTS, GeEnvelope, GeStabilitySpec, MAX_ELEMENTS,
+    DEFAULT_ELEMENTS, GeEnvelope, GeStabilitySpec, MAX_ELEMENTS, ge_system,
 };
+use crate::numerics::tether::equilibrium::EquilibriumConfig;
+use crate::numerics::tether::string_onset::{self, StringLengthOnset};
+use rayon::prelude::*;
 
 /// How stability is judged (needs `payout_rate_m_s`).
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
@@ -137,7 +142,9 @@ pub struct GeWindLimitOutput {
     pub critical_altitude_m: Option<f64>,
     /// Its downwind distance at the onset (m).
     pub critical_downwind_m: Option<f64>,
-    /// Upper end of the length search (m): the static lift limit or the longest grid length.
+    /// Upper end of the length search (m): the static lift limit or the
+    /// longest grid length; in wind at most the continuum tether's ground
+    /// contact (past it the tether touches the ground: `slack`).
     pub length_search_max_m: f64,
     /// With `never`: altitude of the blown-down aerostat at `length_search_max_m` (m),
     /// stable up to there.
@@ -157,6 +164,76 @@ pub struct GeWindLimitOutput {
     pub critical_rate_converged: Option<bool>,
     /// Upper end of the rate search (m/s); it starts at 10⁻³ of it.
     pub rate_search_max_m_s: f64,
+    /// The string criterion's critical length at the payout rate (m): where
+    /// the static tether's smallest tension in this wind equals ρA v² (in
+    /// calm air the closed form (F/ρA − v²)/g). A reference beside the GE
+    /// onset, not its safe side: in wind the GE spectrum may flutter first.
+    /// `null` when the criterion holds up to `length_search_max_m` or fails
+    /// at the shortest grid length (`string_critical_length_outcome`).
+    pub string_critical_length_m: Option<f64>,
+    /// `during`, `never` or `immediate`, as `critical_length_outcome`.
+    pub string_critical_length_outcome: String,
+    /// The string criterion's critical payout rate at
+    /// `critical_rate_length_m` (m/s): √(T_min/ρA) of the static tether in
+    /// this wind (calm air: √((F − ρA g L)/ρA)); `null` when it is slack there.
+    pub string_critical_rate_m_s: Option<f64>,
+    /// Calm air only: the closed form with the bending layer at the guide
+    /// (Airy: F − ρA g L − ρA v² = a₁ (EI_eff b²)^(1/3), a₁ = −2.33811), the
+    /// critical length at the payout rate (m), which the converged GE length
+    /// tends to.
+    pub bending_closed_form_length_m: Option<f64>,
+    /// Calm air only: the same closed form's critical rate at
+    /// `critical_rate_length_m` (m/s).
+    pub bending_closed_form_rate_m_s: Option<f64>,
+}
+
+/// The closed forms of one wind row (see [`GeWindLimitOutput`]).
+struct ClosedForms {
+    string_length: (&'static str, Option<f64>),
+    string_rate: Option<f64>,
+    bending_length: Option<f64>,
+    bending_rate: Option<f64>,
+}
+
+fn closed_forms(
+    problem: &EnvelopeProblem,
+    spec: &GeStabilitySpec,
+    wind_speed_m_s: f64,
+    length_search_max_m: f64,
+    config: &EquilibriumConfig,
+) -> ClosedForms {
+    let v = problem.limits.payout_rate_m_s.unwrap_or(0.0);
+    let shortest = problem
+        .tether_lengths_m
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let base = problem.point_problem(wind_speed_m_s, shortest);
+    let string_length = match string_onset::critical_length(
+        &base,
+        v,
+        (shortest, length_search_max_m.max(shortest)),
+        config,
+    ) {
+        Ok(StringLengthOnset::During { length_m }) => ("during", Some(length_m)),
+        Ok(StringLengthOnset::Never { .. }) => ("never", None),
+        Ok(StringLengthOnset::Immediate) | Err(_) => ("immediate", None),
+    };
+    let at = problem.point_problem(wind_speed_m_s, spec.critical_rate_length_m);
+    let string_rate = string_onset::critical_rate_m_s(&at, config).ok().flatten();
+    let calm = wind_speed_m_s == 0.0;
+    let airy = calm
+        .then(|| ge_system(problem, spec, wind_speed_m_s).ok())
+        .flatten()
+        .map(|sys| AiryOnset::of_model(&sys.model, problem.base.body.net_buoyancy_n));
+    ClosedForms {
+        string_length,
+        string_rate,
+        bending_length: airy.as_ref().and_then(|a| a.critical_length_m(v)),
+        bending_rate: airy
+            .as_ref()
+            .and_then(|a| a.critical_rate_m_s(spec.critical_rate_length_m)),
+    }
 }
 
 /// The quasi-static GE part of the envelope answer.
@@ -210,16 +287,24 @@ fn outcome(s: &QsSearch) -> (&'static str, Option<f64>) {
 /// The GE output of a solved envelope.
 pub fn ge_output(
     spec: &GeStabilitySpec,
-    mass_per_length_kg_m: f64,
-    diameter_m: f64,
-    winds: &[f64],
+    problem: &EnvelopeProblem,
+    config: &EquilibriumConfig,
     ge: &GeEnvelope,
 ) -> GeStabilityOutput {
+    let mass_per_length_kg_m = problem.base.cable.mass_per_length_kg_m;
+    let diameter_m = problem.base.cable.diameter_m;
+    let winds = &problem.wind_speeds_m_s;
+    let closed: Vec<ClosedForms> = winds
+        .par_iter()
+        .zip(&ge.wind_limits)
+        .map(|(&u, w)| closed_forms(problem, spec, u, w.length_search_max_m, config))
+        .collect();
     let mut finest = 0;
     let per_wind = winds
         .iter()
         .zip(&ge.wind_limits)
-        .map(|(&u, w)| {
+        .zip(closed)
+        .map(|((&u, w), cf)| {
             let (lo, at) = outcome(&w.critical_length);
             let (ro, rate) = outcome(&w.critical_rate);
             let state = at.and(w.critical_length.at_onset);
@@ -248,6 +333,11 @@ pub fn ge_output(
                 critical_rate_error_m_s: r_err,
                 critical_rate_converged: r_conv,
                 rate_search_max_m_s: w.rate_search_max_m_s,
+                string_critical_length_m: cf.string_length.1,
+                string_critical_length_outcome: cf.string_length.0.into(),
+                string_critical_rate_m_s: cf.string_rate,
+                bending_closed_form_length_m: cf.bending_length,
+                bending_closed_form_rate_m_s: cf.bending_rate,
             }
         })
         .collect();

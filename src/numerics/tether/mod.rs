@@ -10,6 +10,7 @@ pub mod envelope_ge;
 pub mod equilibrium;
 pub mod gust;
 pub mod presets;
+pub mod string_onset;
 pub mod string_tension;
 pub mod wind;
 
