@@ -140,3 +140,50 @@ fn wind_string_criterion_is_the_static_tethers() {
         None => assert_eq!(w.string_critical_length_outcome, "never"),
     }
 }
+
+fn plan_of(body: Value) -> tetherplan::contract::plan::dto::PlanResponse {
+    let req: tetherplan::contract::plan::dto::PlanRequest = serde_json::from_value(body).unwrap();
+    tetherplan::contract::plan::plan(&req, &NoProgress).expect("an answer")
+}
+
+/// The plan's GE table: each row's string rate is the closed form with the
+/// reserve buoyancy, `√(((1 − r)F − ρA g L)/ρA)`, in calm air, and the
+/// converged GE rate's estimate (safe value + error) lies above it by the
+/// bending lift (EI = 1000 N m²: a few m/s near the lift limit); past the
+/// string's lift limit the row has no string rate.
+#[test]
+fn plan_table_rows_carry_the_string_rate() {
+    let out = plan_of(json!({
+        "cable": {"mass_per_length_kg_m": RHO_A, "breaking_strength_n": 20000.0, "diameter_m": 0.006},
+        "aerostat": {"net_buoyancy_n": F, "mass_kg": 10.0, "drag_coefficient_nondim": 0.47,
+                     "reference_area_m2": 3.0},
+        "initial_length_m": 1.0,
+        "target_elevation_m": 1100.0,
+        "winch": {"max_rate_m_s": 100.0, "max_acceleration_m_s2": 5.0},
+        "lift_reserve_nondim": 0.05,
+        "stability": {"method": "quasi_static_ge", "bending_stiffness_n_m2": 1000.0,
+                      "table_samples": 8}
+    }));
+    let ge = out.ge_stability.expect("a GE block");
+    assert!(ge.converged && ge.table.len() == 8, "{:?}", ge.table.len());
+    for r in &ge.table {
+        let t0 = 0.95 * F - RHO_A * G * r.length_m;
+        if t0 <= 0.0 {
+            // past the string's lift limit (the GE table reaches beyond it
+            // by the bending lift): the string tether hangs slack there
+            assert_eq!(r.string_critical_rate_m_s, None, "{}", r.length_m);
+            continue;
+        }
+        let closed = (t0 / RHO_A).sqrt();
+        let v = r.string_critical_rate_m_s.expect("a string rate");
+        assert!(
+            (v - closed).abs() <= 1e-8 * closed,
+            "{}: {v} vs {closed}",
+            r.length_m
+        );
+        if !r.capped && !r.unstable {
+            let est = r.critical_rate_m_s + r.critical_rate_error_m_s.unwrap_or(0.0);
+            assert!(est > v, "{}: GE {est} below the string's {v}", r.length_m);
+        }
+    }
+}

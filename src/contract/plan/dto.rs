@@ -455,6 +455,11 @@ pub struct PlanGeTableRowOutput {
     pub critical_rate_error_m_s: Option<f64>,
     /// The pass's rate ceiling at rest at this length, √((S − ε(1−r)F)/ρA) (m/s).
     pub plan_rate_ceiling_m_s: f64,
+    /// The string criterion's critical rate at this length (m/s), the closed form beside the GE
+    /// one: √(T_min/ρA) of the static tether with the reserve buoyancy in the mean wind (calm air:
+    /// √(((1 − r)F − ρA g L)/ρA)). A reference, not a bound: in wind the GE spectrum may flutter
+    /// first. `null` where the static tether is slack.
+    pub string_critical_rate_m_s: Option<f64>,
 }
 
 /// The check of the schedule by the local GE QEP at its samples.

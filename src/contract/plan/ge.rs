@@ -10,7 +10,8 @@ use crate::numerics::plan::air::{Air, SteadyWind};
 use crate::numerics::plan::ge_stability::{self as ge_plan, GeStabilityOptions};
 use crate::numerics::plan::schedule::Schedule;
 use crate::numerics::plan::{BindingLimit, PlanProblem, STABILITY_MARGIN};
-use crate::numerics::tether::{Body, Cable};
+use crate::numerics::tether::string_onset;
+use crate::numerics::tether::{Body, Cable, EquilibriumConfig};
 
 /// Density of the tether's material assumed for its diameter in calm air
 /// (the GE rotary inertia ρA d²/16 needs one; about that of aramid/UHMWPE).
@@ -176,6 +177,12 @@ pub(super) fn ge_output(
                     / rho_a)
                     .max(0.0)
                     .sqrt(),
+                string_critical_rate_m_s: string_onset::critical_rate_m_s(
+                    &w.problem(&p.system, p.reserve_buoyancy_n(), r.length_m),
+                    &EquilibriumConfig::default(),
+                )
+                .ok()
+                .flatten(),
             })
             .collect(),
         check: chk.map(|c| PlanGeCheckOutput {
