@@ -290,7 +290,14 @@ mod tests {
             ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
         };
         let mut swaps = 0;
-        for (n, kl, ku) in [(1, 5, 5), (7, 5, 5), (60, 5, 5), (243, 5, 5), (30, 2, 3), (9, 3, 1)] {
+        for (n, kl, ku) in [
+            (1, 5, 5),
+            (7, 5, 5),
+            (60, 5, 5),
+            (243, 5, 5),
+            (30, 2, 3),
+            (9, 3, 1),
+        ] {
             let mut a = Band::zeros(n, kl, ku);
             for i in 0..n {
                 for j in i.saturating_sub(kl)..=(i + ku).min(n - 1) {
@@ -299,7 +306,12 @@ mod tests {
             }
             let (fast, slow) = (a.clone().factor().unwrap(), a.factor_reference().unwrap());
             assert_eq!(fast.pivots, slow.pivots);
-            swaps += fast.pivots.iter().enumerate().filter(|(k, p)| *k != **p).count();
+            swaps += fast
+                .pivots
+                .iter()
+                .enumerate()
+                .filter(|(k, p)| *k != **p)
+                .count();
             let bits = |b: &Band| b.data.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&fast.a), bits(&slow.a), "{n} × {n}, kl {kl}, ku {ku}");
             let rhs: Vec<f64> = (0..n).map(|_| rnd()).collect();

@@ -139,7 +139,7 @@ fn newton(
             .max(body_norm)
             .max(norm(&tip.residual))
             .max(tip_air.abs());
-        let a = air.terms(model, kin.length_m, q, &zero, true);
+        let a = air.terms_without_damping(model, kin.length_m, q, &zero);
         let total: Vec<f64> = (0..n).map(|i| total[i] - a.force[i]).collect();
         let rn = norm(&total);
         let scale = r_scale.max(norm(&a.force));
