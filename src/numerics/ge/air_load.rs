@@ -119,12 +119,38 @@ impl AirLoads {
         v: &[f64],
         linearise: bool,
     ) -> AirTerms {
+        self.terms_with(model, length_m, q, v, linearise, linearise)
+    }
+
+    /// [`AirLoads::terms`] with the stiffness but no damping (an empty
+    /// band): what a Newton on the equilibrium needs. The force and the
+    /// stiffness are those of `terms(…, true)` bit for bit.
+    pub fn terms_without_damping(
+        &self,
+        model: &GeModel,
+        length_m: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> AirTerms {
+        self.terms_with(model, length_m, q, v, true, false)
+    }
+
+    fn terms_with(
+        &self,
+        model: &GeModel,
+        length_m: f64,
+        q: &[f64],
+        v: &[f64],
+        linearise: bool,
+        with_damping: bool,
+    ) -> AirTerms {
         let n = model.dofs();
         let hb = super::element::HALF_BAND;
+        let with_damping = linearise && with_damping;
         let mut out = AirTerms {
             force: vec![0.0; n],
             stiffness: Band::zeros(if linearise { n } else { 0 }, hb, hb),
-            damping: Band::zeros(if linearise { n } else { 0 }, hb, hb),
+            damping: Band::zeros(if with_damping { n } else { 0 }, hb, hb),
         };
         if self.is_calm() {
             return out;
@@ -222,7 +248,9 @@ impl AirLoads {
                             for i in 0..2 {
                                 let (r, col) = (GeModel::dof(ka, j), GeModel::dof(kb, i));
                                 out.stiffness.add(r, col, -kq[ia][j][ib][i]);
-                                out.damping.add(r, col, -kv[ia][j][ib][i]);
+                                if with_damping {
+                                    out.damping.add(r, col, -kv[ia][j][ib][i]);
+                                }
                             }
                         }
                     }
@@ -248,7 +276,9 @@ impl AirLoads {
             ];
             for (j, row) in [i1, i2].into_iter().enumerate() {
                 out.stiffness.add(row, i1, -dw[j] * du); // w depends on z_top = L + u1
-                out.damping.add(row, i2, dw[j]); // w = U − u̇2
+                if with_damping {
+                    out.damping.add(row, i2, dw[j]); // w = U − u̇2
+                }
             }
         }
         out

@@ -156,8 +156,75 @@ pub fn airborne_length_m(
 /// The branch reference at `length_m`: the continuum shape interpolated
 /// onto the nodes of `model` (`u1 = z − ζL`, `u2 = x`, the rotation the
 /// chord's angle from the vertical) and its aerostat position; `None`
-/// when the continuum tether is grounded or not found.
+/// when the continuum tether is grounded or not found. Memoised per
+/// thread on every input (the same answer bit for bit, see
+/// `START_CACHE`).
 pub fn continuum_start(
+    model: &GeModel,
+    air: &AirLoads,
+    net_buoyancy_n: f64,
+    length_m: f64,
+) -> Option<(Vec<f64>, [f64; 2])> {
+    let key = StartKey::of(model, air, net_buoyancy_n, length_m);
+    if let Some(hit) = START_CACHE.with(|c| {
+        c.borrow()
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, v)| v.clone())
+    }) {
+        return hit;
+    }
+    let start = solve_continuum_start(model, air, net_buoyancy_n, length_m);
+    START_CACHE.with(|c| {
+        let mut c = c.borrow_mut();
+        if c.len() >= START_CACHE_ENTRIES {
+            c.remove(0);
+        }
+        c.push((key, start.clone()));
+    });
+    start
+}
+
+/// Continuum starts kept per thread ([`continuum_start`]).
+const START_CACHE_ENTRIES: usize = 8;
+
+/// Everything [`continuum_start`] depends on: the mesh's element count
+/// (nodes and RK4 steps), the cable's `ρA`, `EA` and gravity, the air, the
+/// buoyancy and the length (floats by their bits).
+#[derive(Clone, Debug, PartialEq)]
+struct StartKey {
+    elements: usize,
+    scalars: [u64; 5],
+    air: AirLoads,
+}
+
+impl StartKey {
+    fn of(model: &GeModel, air: &AirLoads, net_buoyancy_n: f64, length_m: f64) -> Self {
+        Self {
+            elements: model.elements,
+            scalars: [
+                model.section.mass_per_length_kg_m.to_bits(),
+                model.section.axial_stiffness_n.to_bits(),
+                model.gravity_m_s2.to_bits(),
+                net_buoyancy_n.to_bits(),
+                length_m.to_bits(),
+            ],
+            air: air.clone(),
+        }
+    }
+}
+
+type CachedStart = Option<(Vec<f64>, [f64; 2])>;
+
+thread_local! {
+    /// The last [`START_CACHE_ENTRIES`] continuum starts of this thread: a
+    /// search along the rate solves every state at one length, and each
+    /// state's branch acceptance needs the continuum tether there.
+    static START_CACHE: std::cell::RefCell<Vec<(StartKey, CachedStart)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+fn solve_continuum_start(
     model: &GeModel,
     air: &AirLoads,
     net_buoyancy_n: f64,
@@ -362,6 +429,41 @@ mod tests {
         assert_eq!(
             airborne_length_m(&m, &AirLoads::calm(), F, (1.0, 1960.0)),
             1960.0
+        );
+    }
+
+    /// The memoised continuum start is the solved one bit for bit, and a
+    /// change of any input (length, buoyancy, mesh, wind) is solved anew.
+    #[test]
+    fn memoised_start_is_the_solved_one() {
+        let (m, a) = (model(1.0, 20), air(8.0));
+        let bits = |s: &Option<(Vec<f64>, [f64; 2])>| {
+            s.as_ref().map(|(q, t)| {
+                q.iter()
+                    .chain(t.iter())
+                    .map(|x| x.to_bits())
+                    .collect::<Vec<_>>()
+            })
+        };
+        for (m, a, f, l) in [
+            (m.clone(), a.clone(), F, 900.0),
+            (m.clone(), a.clone(), F, 900.0 + 1e-9),
+            (m.clone(), a.clone(), 0.9 * F, 900.0),
+            (model(1.0, 40), a.clone(), F, 900.0),
+            (m.clone(), air(6.0), F, 900.0),
+            (m.clone(), a.clone(), F, 1300.0),
+        ] {
+            let solved = solve_continuum_start(&m, &a, f, l);
+            let first = continuum_start(&m, &a, f, l);
+            let again = continuum_start(&m, &a, f, l);
+            assert_eq!(bits(&first), bits(&solved), "{l} m, {f} N");
+            assert_eq!(bits(&again), bits(&solved), "{l} m, {f} N (cached)");
+        }
+        // 1300 m in 8 m/s is past the ground contact (1228.55 m)
+        assert!(continuum_start(&m, &a, F, 1300.0).is_none());
+        assert_ne!(
+            bits(&continuum_start(&m, &a, F, 900.0)),
+            bits(&continuum_start(&m, &air(6.0), F, 900.0))
         );
     }
 }
