@@ -52,6 +52,7 @@ pub mod element;
 pub mod extensible;
 pub mod qs_converged;
 pub mod qs_critical;
+pub mod qs_flutter;
 pub mod qs_wind;
 pub mod quasi_static;
 pub mod solver;
