@@ -206,5 +206,99 @@ fn windy_air() -> tetherplan::numerics::ge::air_load::AirLoads {
     }
 }
 
-criterion_group!(benches, bench, bench_quasi_static);
+/// Issue 21, flutter in wind: one evaluation of the local QEP on the
+/// wind branch (thesis tether, EI = 1 N m², solid 5 mm section, 1000 m,
+/// 8 m/s uniform wind, payout 20 m/s): the dense spectrum (companion,
+/// `6n` square) against one eigenpair refined by Newton on the complex
+/// band `T(λ)` from a start 10⁻⁴ off, at 20 and 80 elements; and the
+/// converged critical rate at 1000 m in that wind (the search of
+/// `qs_converged`, divergence levels and the base-mesh QEP).
+fn bench_wind_eigen(c: &mut Criterion) {
+    use tetherplan::numerics::ge::air_load::AirLoads;
+    use tetherplan::numerics::ge::qs_converged::{ConvergenceConfig, converged_critical_rate};
+    use tetherplan::numerics::ge::qs_flutter::{C64, refine_eigenpair};
+    use tetherplan::numerics::ge::qs_wind::branch_equilibrium;
+    use tetherplan::numerics::ge::quasi_static::{QsConfig, state_at, wind_matrices};
+    use tetherplan::numerics::ge::stability::{StateMotion, spectrum_of};
+    let air = AirLoads {
+        wind: tetherplan::numerics::tether::wind::WindProfile::uniform(8.0),
+        cable_diameter_m: 0.005,
+        ..windy_air()
+    };
+    let load = TipLoad {
+        force_n: [1000.0, 0.0],
+        moment_n_m: 0.0,
+    };
+    let kin = |v: f64| Kinematics {
+        length_m: 1000.0,
+        rate_m_s: v,
+        acceleration_m_s2: 0.0,
+    };
+    let tether = |n: usize| {
+        let s = Section::new(1e6, 1e6, 1.0, 0.078, 0.078 * 0.005 * 0.005 / 16.0).unwrap();
+        let mut m = GeModel::new(
+            s,
+            n,
+            TipBody {
+                mass_kg: 10.0,
+                link_length_m: 0.0,
+            },
+            9.81,
+        )
+        .unwrap();
+        m.slow_spectrum = true;
+        m
+    };
+    let never = || false;
+    let mut g = c.benchmark_group("ge_wind_qep");
+    g.sample_size(10);
+    for n in [20, 80] {
+        let m = tether(n);
+        let mut q =
+            branch_equilibrium(&m, kin(1.0), load, &air, &QsConfig::default(), None).unwrap();
+        let mut v = 1.0f64;
+        while v < 20.0 {
+            v = (v * 1.04).min(20.0);
+            q = branch_equilibrium(&m, kin(v), load, &air, &QsConfig::default(), Some(&q)).unwrap();
+        }
+        let st = state_at(&m, kin(v), load, &air, StateMotion::AtRest, q).unwrap();
+        let sys = || wind_matrices(&m, kin(v), load, &air, &st);
+        let dense = spectrum_of(&m, sys()).unwrap();
+        let lead = dense
+            .eigenvalues
+            .iter()
+            .copied()
+            .filter(|e| e.im > 1e-6)
+            .min_by(|a, b| a.im.total_cmp(&b.im))
+            .unwrap();
+        let start = C64::new(lead.re, lead.im) * C64::new(1.0 + 1e-4, 1e-4);
+        let pair = refine_eigenpair(&sys(), start, None).unwrap();
+        g.bench_function(format!("dense_spectrum_{n}_elements"), |b| {
+            b.iter(|| spectrum_of(&m, sys()).unwrap())
+        });
+        let s = sys();
+        g.bench_function(format!("tracked_eigenpair_{n}_elements"), |b| {
+            b.iter(|| refine_eigenpair(&s, start, Some(&pair.vector)).unwrap())
+        });
+    }
+    let m = tether(20);
+    g.bench_function("converged_critical_rate_wind_8_m_s_1000_m", |b| {
+        b.iter(|| {
+            converged_critical_rate(
+                &m,
+                1000.0,
+                &air,
+                1000.0,
+                150.0,
+                &ConvergenceConfig::default(),
+                &never,
+                None,
+            )
+            .unwrap()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_quasi_static, bench_wind_eigen);
 criterion_main!(benches);

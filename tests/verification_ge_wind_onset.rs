@@ -356,3 +356,25 @@ fn tracked_eigenvalue_equals_the_dense_one() {
         coarse = Some((p.lambda, p.vector));
     }
 }
+
+/// What the converged search of `qs_converged` answers today for the
+/// critical rate at 1000 m (divergence levels, base-mesh QEP check).
+#[test]
+#[ignore = "measurement: the converged rate search in wind"]
+fn measure_converged_rate_search() {
+    use tetherplan::numerics::ge::qs_converged::{ConvergenceConfig, converged_critical_rate};
+    for u in [8.0, 2.0, 0.5, 0.1] {
+        let c = converged_critical_rate(
+            &model(1.0, 20),
+            F,
+            &air(u),
+            LENGTH,
+            150.0,
+            &ConvergenceConfig::default(),
+            &|| false,
+            None,
+        )
+        .unwrap();
+        eprintln!("U = {u} m/s: {:?}\n    flutter {:?}", c.outcome, c.flutter);
+    }
+}
