@@ -54,6 +54,7 @@ pub mod qs_converged;
 pub mod qs_critical;
 pub mod qs_flutter;
 pub mod qs_wind;
+pub mod qs_wind_onset;
 pub mod quasi_static;
 pub mod solver;
 pub mod stability;

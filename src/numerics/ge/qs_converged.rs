@@ -117,12 +117,11 @@ use super::air_load::AirLoads;
 use super::airy_onset::AiryOnset;
 use super::element::{TipLoad, node};
 use super::qs_critical::{
-    OnsetState, QsOnset, QsSearchConfig, Scan, along_length, along_rate, nearest, onset_state,
-    refine_root, scan_change, search_onset_from,
+    OnsetState, QsOnset, Scan, along_length, along_rate, nearest, onset_state, refine_root,
+    scan_change,
 };
-use super::qs_wind::{branch_equilibrium, continuum_start};
-use super::quasi_static::{QsConfig, divergence_indicator, wind_equilibrium, wind_stability};
-use super::stability::StateMotion;
+use super::qs_wind::branch_equilibrium;
+use super::quasi_static::{QsConfig, divergence_indicator, wind_equilibrium};
 use crate::numerics::params::{InvalidInput, Kinematics, require_finite, require_positive};
 
 /// Relative tolerance of a converged onset unless the caller asks another.
@@ -243,6 +242,19 @@ pub struct ConvergedOnset {
     pub first_elements: Vec<f64>,
     /// The equilibrium at the safe value on the finest mesh.
     pub at_safe: OnsetState,
+    /// Which eigenvalue crosses: a real one (divergence, always in calm
+    /// air) or a complex pair (flutter, in wind).
+    pub kind: OnsetKind,
+    /// For a flutter onset, the crossing frequency `|Im λ|` on the finest
+    /// level (rad/s).
+    pub frequency_rad_s: Option<f64>,
+}
+
+/// The kind of a converged onset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OnsetKind {
+    Divergence,
+    Flutter,
 }
 
 impl ConvergedOnset {
@@ -530,7 +542,7 @@ fn hint(roots: &[(usize, f64)], guess: Option<&CalmGuess>) -> Option<Hint> {
 
 /// Coarse nodal values linearly interpolated onto the mesh of twice the
 /// elements (nested: the coarse nodes are every other fine node).
-fn prolong(q: &[f64], coarse_elements: usize) -> Vec<f64> {
+pub(super) fn prolong(q: &[f64], coarse_elements: usize) -> Vec<f64> {
     let mut out = vec![0.0; 6 * coarse_elements];
     for k in 1..=2 * coarse_elements {
         let v = if k % 2 == 0 {
@@ -692,9 +704,19 @@ pub fn converged_onset(
         force_n: [net_buoyancy_n, 0.0],
         moment_n_m: 0.0,
     };
+    if !air.is_calm() && config.qep_in_wind {
+        return super::qs_wind_onset::wind_onset(
+            model,
+            load,
+            air,
+            config,
+            (lo, hi),
+            &kin,
+            cancel,
+            start,
+        );
+    }
     let mut equilibria = 0;
-    let flutter_check = !air.is_calm() && config.qep_in_wind;
-    let mut flutter = None;
     let mut roots: Vec<(usize, f64)> = Vec::new();
     let mut first_elements: Vec<f64> = Vec::new();
     let mut known: Vec<(f64, Vec<f64>)> = start
@@ -763,58 +785,6 @@ pub fn converged_onset(
         n *= 2;
         nodes = nodes.map(|z| bisect_nodes(&z));
     };
-    // In wind: the base mesh's QEP just below its own divergence root
-    // (or at the upper end without one) must be free of growing
-    // oscillations; else a flutter onset comes first and the QEP search
-    // of the base mesh is reported instead (not converged).
-    if flutter_check && !matches!(outcome, ConvergedOutcome::Cancelled) {
-        let base = with_elements(model, config.base_elements)?;
-        let probe = match (&outcome, roots.first()) {
-            (_, Some(&(_, r))) => r * (1.0 - 1e-3),
-            (ConvergedOutcome::Never { up_to }, None) => *up_to,
-            _ => lo,
-        };
-        let k = kin(probe);
-        let branch = continuum_start(&base, air, net_buoyancy_n, k.length_m).map(|s| s.0);
-        let start_q = start
-            .filter(|q| q.len() == base.dofs())
-            .or(branch.as_deref());
-        let ok = match wind_stability(
-            &base,
-            k,
-            load,
-            air,
-            StateMotion::AtRest,
-            &QsConfig::default(),
-            start_q,
-        ) {
-            Ok(w) => {
-                let tol = w.spectrum.tolerance();
-                w.spectrum
-                    .eigenvalues
-                    .iter()
-                    .filter(|e| e.im != 0.0)
-                    .all(|e| e.re <= tol)
-            }
-            Err(_) => false,
-        };
-        equilibria += 1;
-        if !ok {
-            let s = search_onset_from(
-                &base,
-                net_buoyancy_n,
-                air,
-                StateMotion::AtRest,
-                &QsSearchConfig::default(),
-                (lo, hi),
-                &kin,
-                cancel,
-                start_q,
-            )?;
-            equilibria += s.equilibria;
-            flutter = Some(s.onset);
-        }
-    }
     let outcome = match outcome {
         ConvergedOutcome::During(mut c) => {
             c.first_elements = first_elements.clone();
@@ -837,12 +807,16 @@ pub fn converged_onset(
     };
     Ok(ConvergedSearch {
         outcome,
-        flutter,
+        flutter: None,
         equilibria,
     })
 }
 
-fn summarise(roots: &[(usize, f64)], config: &ConvergenceConfig, met: bool) -> ConvergedOnset {
+pub(super) fn summarise(
+    roots: &[(usize, f64)],
+    config: &ConvergenceConfig,
+    met: bool,
+) -> ConvergedOnset {
     let values: Vec<f64> = roots.iter().map(|r| r.1).collect();
     let (value, err, order) = richardson(&values);
     let finest = *values.last().unwrap_or(&f64::NAN);
@@ -863,6 +837,8 @@ fn summarise(roots: &[(usize, f64)], config: &ConvergenceConfig, met: bool) -> C
         levels: roots.to_vec(),
         at_safe: OnsetState::default(),
         first_elements: Vec::new(),
+        kind: OnsetKind::Divergence,
+        frequency_rad_s: None,
     }
 }
 

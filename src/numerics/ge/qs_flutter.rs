@@ -27,6 +27,9 @@ pub const EIGEN_RTOL: f64 = 1e-13;
 /// Relative change of `λ` below which a step that no longer halves the
 /// last one ends the refinement (roundoff plateau).
 pub const PLATEAU_RTOL: f64 = 1e-9;
+/// Relative step at which a refinement that used all its steps is still
+/// accepted.
+pub const LOOSE_RTOL: f64 = 1e-7;
 
 /// A square complex band matrix with `kl` sub- and `ku` super-diagonals,
 /// row-major with the storage of the LU's widened upper band (as
@@ -182,6 +185,18 @@ pub fn refine_eigenpair(
     lambda0: C64,
     x0: Option<&[C64]>,
 ) -> Option<EigenPair> {
+    refine_eigenpair_at_scale(sys, lambda0, x0, 0.0)
+}
+
+/// [`refine_eigenpair`] with the changes of `λ` measured against at
+/// least `scale` (1/s): near a divergence root `λ → 0` and a relative
+/// test alone never settles.
+pub fn refine_eigenpair_at_scale(
+    sys: &SystemMatrices,
+    lambda0: C64,
+    x0: Option<&[C64]>,
+    scale: f64,
+) -> Option<EigenPair> {
     let n = sys.stiffness.n;
     let mut lambda = lambda0;
     let mut x: Vec<C64> = match x0 {
@@ -208,7 +223,7 @@ pub fn refine_eigenpair(
     }
     x.iter_mut().for_each(|z| *z /= s);
     let u = x.clone();
-    let scale = lambda0.norm().max(1e-300);
+    let scale = lambda0.norm().max(scale).max(1e-300);
     let mut last = f64::INFINITY;
     for _ in 0..MAX_EIGEN_STEPS {
         let Some(lu) = ComplexBand::qep(sys, lambda).factor() else {
@@ -236,7 +251,12 @@ pub fn refine_eigenpair(
         }
         last = h;
     }
-    None
+    // not settled: accepted only when the last steps were already tiny
+    (last <= LOOSE_RTOL * lambda.norm().max(scale)).then(|| {
+        let s = x.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
+        x.iter_mut().for_each(|z| *z /= s);
+        EigenPair { lambda, vector: x }
+    })
 }
 
 /// `‖T(λ) x‖ / (‖T(λ)‖-ish scale · ‖x‖)`: the relative residual of a pair.
