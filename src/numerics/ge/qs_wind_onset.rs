@@ -384,12 +384,14 @@ pub(super) fn wind_onset<K: Fn(f64) -> Kinematics>(
                 found = Some((p, e));
                 break;
             }
-            // no state on the branch: the onset lies below (the branch ends)
-            None => break,
+            // no state on the branch: it ends between a and p
+            None => {
+                return branch_end(level, model, config, (a, p), rtol, cancel);
+            }
         }
     }
     let Some((mut b, mut eb)) = found else {
-        return done(ConvergedOutcome::Never { up_to: a }, level.equilibria);
+        return done(ConvergedOutcome::Never { up_to: hi }, level.equilibria);
     };
     while b - a > BASE_BRACKET * b.abs() {
         if cancel() {
@@ -493,4 +495,87 @@ pub(super) fn wind_onset<K: Fn(f64) -> Kinematics>(
     }
     equilibria += level.equilibria;
     done(ConvergedOutcome::During(o), equilibria)
+}
+
+/// Where the branch ends (no branch state past it: the continuum tether
+/// grounded, or a limit point) between `a` (a state) and `b` (none), on
+/// every level: bisection on the existence of the state, nested meshes
+/// from `level`'s, each level's window about the coarser end.
+fn branch_end<K: Fn(f64) -> Kinematics>(
+    mut level: WindLevel<'_, K>,
+    model: &GeModel,
+    config: &ConvergenceConfig,
+    (mut a, mut b): (f64, f64),
+    rtol: f64,
+    cancel: &dyn Fn() -> bool,
+) -> Result<ConvergedSearch, InvalidInput> {
+    let mut equilibria = 0;
+    let mut roots: Vec<(usize, f64)> = Vec::new();
+    let mut n = level.model.elements;
+    let outcome = loop {
+        while b - a > rtol * b.abs() {
+            if cancel() {
+                return Ok(ConvergedSearch {
+                    outcome: ConvergedOutcome::Cancelled,
+                    flutter: None,
+                    equilibria: equilibria + level.equilibria,
+                });
+            }
+            let m = 0.5 * (a + b);
+            if level.equilibrium(m).is_some() {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        let root = 0.5 * (a + b);
+        roots.push((n, root));
+        let values: Vec<f64> = roots.iter().map(|r| r.1).collect();
+        let (value, err, _) = richardson(&values);
+        let met = roots.len() >= 3 && err <= config.relative_tolerance * value.abs();
+        if met || 2 * n > config.max_elements {
+            break summarise(&roots, config, met);
+        }
+        let window = NEAR * root.abs() + level.step;
+        let guesses: Vec<(f64, Vec<f64>)> = level
+            .known
+            .iter()
+            .filter(|k| k.0 <= root && root - k.0 <= 4.0 * window)
+            .map(|(p, q)| (*p, prolong(q, n)))
+            .collect();
+        equilibria += level.equilibria;
+        n *= 2;
+        level = WindLevel {
+            model: with_elements(model, n)?,
+            guesses,
+            known: Vec::new(),
+            tips: std::mem::take(&mut level.tips),
+            equilibria: 0,
+            ..level
+        };
+        // a state below the coarser end, none above the window
+        a = root - window;
+        b = root + window;
+        while level.equilibrium(a).is_none() {
+            a -= window;
+            if a <= 0.0 || cancel() {
+                break;
+            }
+        }
+        if level.equilibrium(b).is_some() {
+            break summarise(&roots, config, false);
+        }
+    };
+    let mut o = outcome;
+    o.first_elements = roots.iter().map(|r| 1.0 / r.0 as f64).collect();
+    let safe = o.safe_value;
+    if let Some(q) = level.equilibrium(safe) {
+        o.at_safe = onset_state(&level.model, (level.kin)(safe), &q);
+    }
+    equilibria += level.equilibria;
+    Ok(ConvergedSearch {
+        outcome: ConvergedOutcome::During(o),
+        flutter: None,
+        equilibria,
+    })
 }
