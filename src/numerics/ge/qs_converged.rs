@@ -71,46 +71,13 @@
 //! positive definite while paying out and `K` symmetric, so by the
 //! Kelvin–Tait–Chetaev theorem the divergence root *is* the onset: no
 //! eigenvalues are solved. In wind `K` is not symmetric and a flutter
-//! onset may come first. The divergence is then the sign change of
-//! `det K` itself ([`super::quasi_static::divergence_indicator`]), and
-//! the base mesh's QEP just below its root must have no growing
-//! oscillation; when it has, a flutter onset comes first and the QEP
-//! search of [`super::qs_critical`] on the base mesh is reported
-//! ([`ConvergedSearch::flutter`]), not converged.
-//!
-//! **The QEP onset in wind, measured** (issue 21; thesis tether,
-//! EI = 1 N m², solid 5 mm section, 1000 m, the critical rate; the
-//! branch continued in the rate in 4 % steps from 1 m/s, each Newton from
-//! its neighbour; dense QEP every 1 m/s from 30 m/s, bisected to 10⁻⁶;
-//! `tests/verification_ge_wind_onset.rs`, `measure_dense_onsets`):
-//!
-//! | wind | 20 el. | 40 el. | 80 el. | aerostat 5 % lower at |
-//! |---|---|---|---|---|
-//! | 8 m/s | none to 190 | none to 190 | none to 190 | 42 m/s |
-//! | 2 m/s | 173.04 (ω 0.65) | 176.08 (ω 2.28) | 177.12 (ω 6.53) | 59 m/s |
-//! | 0.5 m/s | 59.0 (jump) | 57.0 (jump) | 56.5 (div.) | — |
-//! | 0.1 m/s | 58.56 (div.) | 56.81 (div.) | 56.12 (div.) | — |
-//!
-//! In 0.1 m/s the onset is a divergence (a real eigenvalue, `det K`
-//! changing sign) converging from above at about first order (steps
-//! 1.75, 0.69 m/s) toward the calm one (the string's `√(T_guide/ρA)` =
-//! 54.9 m/s plus the bending lift). From about 0.5 m/s on the wind is an
-//! imperfection of that bifurcation: the branch no longer loses
-//! stability there but blows down (in 8 m/s the aerostat is 5 % lower at
-//! 42 m/s and comes down to the guide's height near 175 m/s, on every mesh),
-//! and the first QEP instability moves to 170–180 m/s, in a state far
-//! from the tether's (1000 m paid out, aerostat 400 m lower), with a
-//! crossing frequency that does not converge (0.65 / 2.28 / 6.53 rad/s):
-//! a mesh artifact of a collapsed state, not a physical flutter. The
-//! 20-element flutter at 59.58 m/s of the earlier search was not
-//! reproduced on this branch (nor by `qs_critical::critical_rate_from`
-//! from the continuum start: `Never` to 150 m/s). So the local QEP on the
-//! wind branch is not a safe criterion near the string speed: the
-//! linear onset jumps from ≈ 56 to ≈ 175 m/s between 0.1 and 2 m/s of
-//! wind. The dense slow spectrum's `Re λ` is also only good to about
-//! 10⁻⁶ 1/s on 20–40 elements (against a residual-checked Newton pair,
-//! [`super::qs_flutter`]), above its stability tolerance (2.5·10⁻⁷ 1/s):
-//! its verdict near `Re λ = 0` is roundoff.
+//! onset may come first: with [`ConvergenceConfig::qep_in_wind`] (the
+//! default) the search is that of [`super::qs_wind_onset`] (the first
+//! crossing of the tracked critical eigenvalue, divergence or flutter,
+//! on every level, states continued along the parameter;
+//! [`ConvergedOnset::kind`], [`ConvergedOnset::frequency_rad_s`]); without
+//! it, the divergence alone (the sign change of `det K`,
+//! [`super::quasi_static::divergence_indicator`]) on uniform meshes.
 
 use super::GeModel;
 use super::air_load::AirLoads;
@@ -147,10 +114,9 @@ pub struct ConvergenceConfig {
     pub relative_tolerance: f64,
     pub base_elements: usize,
     pub max_elements: usize,
-    /// In wind: run the base mesh's QEP search to tell a divergence onset
-    /// from a flutter one ([`ConvergedSearch::flutter`]). Off: the
-    /// divergence alone (a caller that checks flutter elsewhere, as the
-    /// plan's schedule check does).
+    /// In wind: the first of divergence and flutter on every level
+    /// ([`super::qs_wind_onset`]). Off: the divergence alone (a caller
+    /// that checks flutter elsewhere, as the plan's schedule check does).
     pub qep_in_wind: bool,
     /// In calm air: meshes graded toward the guide, sized by the closed
     /// form's bending layer ([`calm_guess`]), and the closed form's root
@@ -284,9 +250,9 @@ pub enum ConvergedOutcome {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConvergedSearch {
     pub outcome: ConvergedOutcome,
-    /// In wind: the base-mesh QEP onset when it is not the divergence
-    /// (a flutter onset first, or no onset found by the QEP); `None` in
-    /// calm air (the divergence is the onset) or when confirmed.
+    /// Kept for the callers: always `None` now (in wind the onset of
+    /// `outcome` is the first of divergence and flutter on every level,
+    /// [`super::qs_wind_onset`]).
     pub flutter: Option<QsOnset>,
     pub equilibria: usize,
 }

@@ -30,6 +30,54 @@
 //! crossing frequency of the finer levels within [`FREQUENCY_RTOL`] of
 //! the coarser one's, and the parity of `det K` just below each flutter
 //! root that of the lower end (no divergence first).
+//!
+//! **The QEP onset in wind, measured** (issue 21; thesis tether,
+//! EI = 1 N m², solid 5 mm section, 1000 m, the critical rate; the
+//! branch continued in the rate in 4 % steps from 1 m/s, each Newton from
+//! its neighbour; dense QEP every 1 m/s from 30 m/s, bisected to 10⁻⁶;
+//! `tests/verification_ge_wind_onset.rs`, `measure_dense_onsets`):
+//!
+//! | wind | 20 el. | 40 el. | 80 el. | aerostat 5 % lower at |
+//! |---|---|---|---|---|
+//! | 8 m/s | none to 190 | none to 190 | none to 190 | 42 m/s |
+//! | 2 m/s | 173.04 (ω 0.65) | 176.08 (ω 2.28) | 177.12 (ω 6.53) | 59 m/s |
+//! | 0.5 m/s | 59.0 (jump) | 57.0 (jump) | 56.5 (div.) | — |
+//! | 0.1 m/s | 58.56 (div.) | 56.81 (div.) | 56.12 (div.) | — |
+//!
+//! In 0.1 m/s the onset is a divergence (a real eigenvalue, `det K`
+//! changing sign) converging from above at about first order (steps
+//! 1.75, 0.69 m/s) toward the calm one (the string's `√(T_guide/ρA)` =
+//! 54.9 m/s plus the bending lift). From about 0.5 m/s on the wind is an
+//! imperfection of that bifurcation: the branch no longer loses
+//! stability there but blows down (in 8 m/s the aerostat is 5 % lower at
+//! 42 m/s and comes down to the guide's height near 175 m/s, on every mesh),
+//! and the first QEP instability moves to 170–180 m/s, in a state far
+//! from the tether's (1000 m paid out, aerostat 400 m lower), with a
+//! crossing frequency that does not converge (0.65 / 2.28 / 6.53 rad/s):
+//! a mesh artifact of a collapsed state, not a physical flutter. The
+//! 20-element flutter at 59.58 m/s of the earlier search was not
+//! reproduced on this branch (nor by `qs_critical::critical_rate_from`
+//! from the continuum start: `Never` to 150 m/s). So the local QEP on the
+//! wind branch is not a safe criterion near the string speed: the
+//! linear onset jumps from ≈ 56 to ≈ 175 m/s between 0.1 and 2 m/s of
+//! wind. The dense slow spectrum's `Re λ` is also only good to about
+//! 10⁻⁶ 1/s on 20–40 elements (against a residual-checked Newton pair,
+//! [`super::qs_flutter`]), above its stability tolerance (2.5·10⁻⁷ 1/s):
+//! its verdict near `Re λ = 0` is roundoff.
+//!
+//! **Measured, the converged search** (`measure_converged_rate_search`;
+//! critical rate at 1000 m, the thesis tether at EI = 1 N m²): in
+//! 0.1 m/s a divergence, 58.537 / 56.822 / 56.121 / 55.625 / 55.364 m/s
+//! at 20 … 320 elements, 55.103 ± 0.026 m/s, converged (calm air, graded:
+//! 55.181 ± 0.005; the uniform levels do not resolve the 1.1 m bending
+//! layer, so the wind value lies between it and the string's 54.87 m/s);
+//! in 0.5 m/s 58.54 / 76.68 / 81.22 / 87.12 / 91.91 / 96.78 m/s, in 2 m/s
+//! 115.92 / 114.87 / 122.76 m/s (limit points of the blown-down branch,
+//! not converged: `converged: false`, safe value the lowest level); in
+//! 8 m/s no onset to 150 m/s. One evaluation of the critical pair costs
+//! 49 µs at 20 elements and 180 µs at 80 (criterion medians, bench
+//! `ge_wind_qep`) against 2.1 ms and 56 ms for the dense QEP; a whole
+//! search is dominated by the continued equilibria.
 
 use super::GeModel;
 use super::air_load::AirLoads;
