@@ -53,6 +53,7 @@ pub mod extensible;
 pub mod qs_converged;
 pub mod qs_critical;
 pub mod qs_flutter;
+pub mod qs_mesh;
 pub mod qs_wind;
 pub mod qs_wind_onset;
 pub mod quasi_static;
