@@ -370,7 +370,10 @@ fn measure_converged_rate_search() {
             &air(u),
             LENGTH,
             150.0,
-            &ConvergenceConfig::default(),
+            &ConvergenceConfig {
+                tracked_wind_onset: true,
+                ..Default::default()
+            },
             &|| false,
             None,
         )
@@ -389,7 +392,10 @@ fn wind_rate(
         &air(u),
         LENGTH,
         150.0,
-        config,
+        &tetherplan::numerics::ge::qs_converged::ConvergenceConfig {
+            tracked_wind_onset: true,
+            ..*config
+        },
         &|| false,
         None,
     )
