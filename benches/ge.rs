@@ -282,21 +282,21 @@ fn bench_wind_eigen(c: &mut Criterion) {
         });
     }
     let m = tether(20);
-    g.bench_function("converged_critical_rate_wind_8_m_s_1000_m", |b| {
-        b.iter(|| {
-            converged_critical_rate(
-                &m,
-                1000.0,
-                &air,
-                1000.0,
-                150.0,
-                &ConvergenceConfig::default(),
-                &never,
-                None,
-            )
-            .unwrap()
-        })
-    });
+    for (name, tracked) in [
+        ("converged_critical_rate_wind_8_m_s_1000_m", false),
+        ("converged_critical_rate_wind_8_m_s_1000_m_tracked", true),
+    ] {
+        let config = ConvergenceConfig {
+            tracked_wind_onset: tracked,
+            ..Default::default()
+        };
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                converged_critical_rate(&m, 1000.0, &air, 1000.0, 150.0, &config, &never, None)
+                    .unwrap()
+            })
+        });
+    }
     g.finish();
 }
 
