@@ -212,7 +212,17 @@ fn windy_air() -> tetherplan::numerics::ge::air_load::AirLoads {
 /// `6n` square) against one eigenpair refined by Newton on the complex
 /// band `T(λ)` from a start 10⁻⁴ off, at 20 and 80 elements; and the
 /// converged critical rate at 1000 m in that wind (the search of
-/// `qs_converged`, divergence levels and the base-mesh QEP).
+/// `qs_converged`, divergence levels and the base-mesh QEP; and the
+/// tracked first of divergence and flutter of `qs_wind_onset`).
+///
+/// Measured 2026-12-02 (criterion [low median high], --warm-up-time 1
+/// --measurement-time 3, 10 samples, 2 cores shared): dense QEP
+/// [2.05 2.14 2.21] ms at 20 elements, [51.9 55.9 59.7] ms at 80; tracked
+/// pair [45.7 49.3 55.7] µs at 20, [169 180 189] µs at 80; converged rate
+/// in 8 m/s (no onset to 150 m/s) [49.0 51.7 57.4] ms, tracked [42.2 47.4
+/// 50.9] ms. The tracked search on the 10 m/s wind length case
+/// (`converged_critical_time_wind_10_m_s_ei_1` with the tracked onset)
+/// took [2.52 2.55 2.58] s: hence off by default.
 fn bench_wind_eigen(c: &mut Criterion) {
     use tetherplan::numerics::ge::air_load::AirLoads;
     use tetherplan::numerics::ge::qs_converged::{ConvergenceConfig, converged_critical_rate};
