@@ -206,5 +206,109 @@ fn windy_air() -> tetherplan::numerics::ge::air_load::AirLoads {
     }
 }
 
-criterion_group!(benches, bench, bench_quasi_static);
+/// Issue 21, flutter in wind: one evaluation of the local QEP on the
+/// wind branch (thesis tether, EI = 1 N m², solid 5 mm section, 1000 m,
+/// 8 m/s uniform wind, payout 20 m/s): the dense spectrum (companion,
+/// `6n` square) against one eigenpair refined by Newton on the complex
+/// band `T(λ)` from a start 10⁻⁴ off, at 20 and 80 elements; and the
+/// converged critical rate at 1000 m in that wind (the search of
+/// `qs_converged`, divergence levels and the base-mesh QEP; and the
+/// tracked first of divergence and flutter of `qs_wind_onset`).
+///
+/// Measured 2026-12-02 (criterion [low median high], --warm-up-time 1
+/// --measurement-time 3, 10 samples, 2 cores shared): dense QEP
+/// [2.05 2.14 2.21] ms at 20 elements, [51.9 55.9 59.7] ms at 80; tracked
+/// pair [45.7 49.3 55.7] µs at 20, [169 180 189] µs at 80; converged rate
+/// in 8 m/s (no onset to 150 m/s) [49.0 51.7 57.4] ms, tracked [42.2 47.4
+/// 50.9] ms. The tracked search on the 10 m/s wind length case
+/// (`converged_critical_time_wind_10_m_s_ei_1` with the tracked onset)
+/// took [2.52 2.55 2.58] s: hence off by default.
+fn bench_wind_eigen(c: &mut Criterion) {
+    use tetherplan::numerics::ge::air_load::AirLoads;
+    use tetherplan::numerics::ge::qs_converged::{ConvergenceConfig, converged_critical_rate};
+    use tetherplan::numerics::ge::qs_flutter::{C64, refine_eigenpair};
+    use tetherplan::numerics::ge::qs_wind::branch_equilibrium;
+    use tetherplan::numerics::ge::quasi_static::{QsConfig, state_at, wind_matrices};
+    use tetherplan::numerics::ge::stability::{StateMotion, spectrum_of};
+    let air = AirLoads {
+        wind: tetherplan::numerics::tether::wind::WindProfile::uniform(8.0),
+        cable_diameter_m: 0.005,
+        ..windy_air()
+    };
+    let load = TipLoad {
+        force_n: [1000.0, 0.0],
+        moment_n_m: 0.0,
+    };
+    let kin = |v: f64| Kinematics {
+        length_m: 1000.0,
+        rate_m_s: v,
+        acceleration_m_s2: 0.0,
+    };
+    let tether = |n: usize| {
+        let s = Section::new(1e6, 1e6, 1.0, 0.078, 0.078 * 0.005 * 0.005 / 16.0).unwrap();
+        let mut m = GeModel::new(
+            s,
+            n,
+            TipBody {
+                mass_kg: 10.0,
+                link_length_m: 0.0,
+            },
+            9.81,
+        )
+        .unwrap();
+        m.slow_spectrum = true;
+        m
+    };
+    let never = || false;
+    let mut g = c.benchmark_group("ge_wind_qep");
+    g.sample_size(10);
+    for n in [20, 80] {
+        let m = tether(n);
+        let mut q =
+            branch_equilibrium(&m, kin(1.0), load, &air, &QsConfig::default(), None).unwrap();
+        let mut v = 1.0f64;
+        while v < 20.0 {
+            v = (v * 1.04).min(20.0);
+            q = branch_equilibrium(&m, kin(v), load, &air, &QsConfig::default(), Some(&q)).unwrap();
+        }
+        let st = state_at(&m, kin(v), load, &air, StateMotion::AtRest, q).unwrap();
+        let sys = || wind_matrices(&m, kin(v), load, &air, &st);
+        let dense = spectrum_of(&m, sys()).unwrap();
+        let lead = dense
+            .eigenvalues
+            .iter()
+            .copied()
+            .filter(|e| e.im > 1e-6)
+            .min_by(|a, b| a.im.total_cmp(&b.im))
+            .unwrap();
+        let start = C64::new(lead.re, lead.im) * C64::new(1.0 + 1e-4, 1e-4);
+        let pair = refine_eigenpair(&sys(), start, None).unwrap();
+        g.bench_function(format!("dense_spectrum_{n}_elements"), |b| {
+            b.iter(|| spectrum_of(&m, sys()).unwrap())
+        });
+        let s = sys();
+        g.bench_function(format!("tracked_eigenpair_{n}_elements"), |b| {
+            b.iter(|| refine_eigenpair(&s, start, Some(&pair.vector)).unwrap())
+        });
+    }
+    let m = tether(20);
+    for (name, tracked) in [
+        ("converged_critical_rate_wind_8_m_s_1000_m", false),
+        ("converged_critical_rate_wind_8_m_s_1000_m_tracked", true),
+    ] {
+        let config = ConvergenceConfig {
+            tracked_wind_onset: tracked,
+            ..Default::default()
+        };
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                converged_critical_rate(&m, 1000.0, &air, 1000.0, 150.0, &config, &never, None)
+                    .unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_quasi_static, bench_wind_eigen);
 criterion_main!(benches);

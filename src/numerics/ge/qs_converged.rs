@@ -71,20 +71,27 @@
 //! positive definite while paying out and `K` symmetric, so by the
 //! Kelvin–Tait–Chetaev theorem the divergence root *is* the onset: no
 //! eigenvalues are solved. In wind `K` is not symmetric and a flutter
-//! onset may come first. The divergence is then the sign change of
-//! `det K` itself ([`super::quasi_static::divergence_indicator`]), and
-//! the base mesh's QEP just below its root must have no growing
-//! oscillation; when it has, a flutter onset comes first and the QEP
-//! search of [`super::qs_critical`] on the base mesh is reported
-//! ([`ConvergedSearch::flutter`]), not converged.
+//! onset may come first: with [`ConvergenceConfig::qep_in_wind`] and
+//! [`ConvergenceConfig::tracked_wind_onset`] the search is that of
+//! [`super::qs_wind_onset`] (the first
+//! crossing of the tracked critical eigenvalue, divergence or flutter,
+//! on every level, states continued along the parameter;
+//! [`ConvergedOnset::kind`], [`ConvergedOnset::frequency_rad_s`]); else
+//! the base mesh's QEP just below its divergence root checks for a
+//! growing oscillation ([`ConvergedSearch::flutter`]); without
+//! `qep_in_wind`, the divergence alone (the sign change of `det K`,
+//! [`super::quasi_static::divergence_indicator`]) on uniform meshes.
 
 use super::GeModel;
 use super::air_load::AirLoads;
-use super::airy_onset::AiryOnset;
 use super::element::{TipLoad, node};
 use super::qs_critical::{
     OnsetState, QsOnset, QsSearchConfig, Scan, along_length, along_rate, nearest, onset_state,
     refine_root, scan_change, search_onset_from,
+};
+pub use super::qs_mesh::{
+    CalmGuess, FIRST_ELEMENT_IN_LAYERS, bisect_nodes, calm_length_guess, calm_rate_guess,
+    graded_nodes,
 };
 use super::qs_wind::{branch_equilibrium, continuum_start};
 use super::quasi_static::{QsConfig, divergence_indicator, wind_equilibrium, wind_stability};
@@ -114,15 +121,20 @@ pub struct ConvergenceConfig {
     pub relative_tolerance: f64,
     pub base_elements: usize,
     pub max_elements: usize,
-    /// In wind: run the base mesh's QEP search to tell a divergence onset
-    /// from a flutter one ([`ConvergedSearch::flutter`]). Off: the
-    /// divergence alone (a caller that checks flutter elsewhere, as the
-    /// plan's schedule check does).
+    /// In wind: the first of divergence and flutter on every level
+    /// ([`super::qs_wind_onset`]). Off: the divergence alone (a caller
+    /// that checks flutter elsewhere, as the plan's schedule check does).
     pub qep_in_wind: bool,
     /// In calm air: meshes graded toward the guide, sized by the closed
     /// form's bending layer ([`calm_guess`]), and the closed form's root
     /// as the base level's first guess. Off: uniform meshes (as in wind).
     pub graded_in_calm_air: bool,
+    /// In wind with `qep_in_wind`: the converged first of divergence and
+    /// flutter of [`super::qs_wind_onset`] (off by default: a length
+    /// search in 10 m/s costs 2.6 s there against 34–45 ms, the states
+    /// continued along the whole range on every level); off: the
+    /// divergence levels and the base mesh's QEP check.
+    pub tracked_wind_onset: bool,
 }
 
 impl Default for ConvergenceConfig {
@@ -133,6 +145,7 @@ impl Default for ConvergenceConfig {
             max_elements: MAX_CONVERGED_ELEMENTS,
             qep_in_wind: true,
             graded_in_calm_air: true,
+            tracked_wind_onset: false,
         }
     }
 }
@@ -209,6 +222,19 @@ pub struct ConvergedOnset {
     pub first_elements: Vec<f64>,
     /// The equilibrium at the safe value on the finest mesh.
     pub at_safe: OnsetState,
+    /// Which eigenvalue crosses: a real one (divergence, always in calm
+    /// air) or a complex pair (flutter, in wind).
+    pub kind: OnsetKind,
+    /// For a flutter onset, the crossing frequency `|Im λ|` on the finest
+    /// level (rad/s).
+    pub frequency_rad_s: Option<f64>,
+}
+
+/// The kind of a converged onset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OnsetKind {
+    Divergence,
+    Flutter,
 }
 
 impl ConvergedOnset {
@@ -238,9 +264,11 @@ pub enum ConvergedOutcome {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConvergedSearch {
     pub outcome: ConvergedOutcome,
-    /// In wind: the base-mesh QEP onset when it is not the divergence
-    /// (a flutter onset first, or no onset found by the QEP); `None` in
-    /// calm air (the divergence is the onset) or when confirmed.
+    /// In wind without [`ConvergenceConfig::tracked_wind_onset`]: the
+    /// base-mesh QEP onset when it is not the divergence (a flutter onset
+    /// first, or no onset found by the QEP); `None` in calm air, when
+    /// confirmed, or with the tracked search (its `outcome` is the first
+    /// of divergence and flutter on every level).
     pub flutter: Option<QsOnset>,
     pub equilibria: usize,
 }
@@ -496,7 +524,7 @@ fn hint(roots: &[(usize, f64)], guess: Option<&CalmGuess>) -> Option<Hint> {
 
 /// Coarse nodal values linearly interpolated onto the mesh of twice the
 /// elements (nested: the coarse nodes are every other fine node).
-fn prolong(q: &[f64], coarse_elements: usize) -> Vec<f64> {
+pub(super) fn prolong(q: &[f64], coarse_elements: usize) -> Vec<f64> {
     let mut out = vec![0.0; 6 * coarse_elements];
     for k in 1..=2 * coarse_elements {
         let v = if k % 2 == 0 {
@@ -511,93 +539,6 @@ fn prolong(q: &[f64], coarse_elements: usize) -> Vec<f64> {
         };
         out[GeModel::dof(k, 0)..GeModel::dof(k, 0) + 3].copy_from_slice(&v);
     }
-    out
-}
-
-/// The calm-air closed form's answer for a converged search
-/// ([`super::airy_onset`]): where the root is expected, and the first
-/// element of the graded base mesh.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CalmGuess {
-    /// The closed form's onset (m, or m/s along the rate).
-    pub root: f64,
-    /// The base mesh's first element on `ζ`: a quarter of the bending
-    /// layer `(EI_eff/b)^(1/3)` at the closed-form onset, over `L`.
-    pub first_element: f64,
-}
-
-/// First element of the graded base mesh, in layers `(EI_eff/b)^(1/3)`:
-/// measured (thesis tether, 20 to 320 elements) the roots converge at
-/// second order from the base mesh on for 0.25 to 1; a quarter gives the
-/// smallest errors (0.57 m at 20 elements, EI = 1000 N m²).
-pub const FIRST_ELEMENT_IN_LAYERS: f64 = 0.25;
-
-/// The closed form's guess for a calm-air search at `(length, rate)` once
-/// one of them is the closed form's onset; `None` without a bending layer.
-fn calm_guess(airy: &AiryOnset, length_m: f64, rate_m_s: f64, root: f64) -> Option<CalmGuess> {
-    let ei = airy.effective_bending_stiffness_n_m2(rate_m_s);
-    let b = airy.tension_slope_n_m(length_m, rate_m_s);
-    let first = FIRST_ELEMENT_IN_LAYERS * (ei / b).cbrt() / length_m;
-    (first.is_finite() && first > 0.0 && root.is_finite()).then_some(CalmGuess {
-        root,
-        first_element: first,
-    })
-}
-
-/// The closed form's guess for the critical length at `rate_m_s` (used
-/// in calm air; the graded base mesh is
-/// `graded_nodes(base_elements, first_element)`).
-pub fn calm_length_guess(model: &GeModel, net_buoyancy_n: f64, rate_m_s: f64) -> Option<CalmGuess> {
-    let airy = AiryOnset::of_model(model, net_buoyancy_n);
-    let l = airy.critical_length_m(rate_m_s)?;
-    calm_guess(&airy, l, rate_m_s, l)
-}
-
-/// The closed form's guess for the critical rate at `length_m`.
-pub fn calm_rate_guess(model: &GeModel, net_buoyancy_n: f64, length_m: f64) -> Option<CalmGuess> {
-    let airy = AiryOnset::of_model(model, net_buoyancy_n);
-    let v = airy.critical_rate_m_s(length_m)?;
-    calm_guess(&airy, length_m, v, v)
-}
-
-/// Nodes of `elements` elements on `ζ ∈ [0, 1]` growing geometrically
-/// from `first` at the guide (uniform when `first ≥ 1/elements`).
-pub fn graded_nodes(elements: usize, first: f64) -> Vec<f64> {
-    let n = elements.max(1);
-    if !(first > 0.0) || first * n as f64 >= 1.0 {
-        return (0..=n).map(|k| k as f64 / n as f64).collect();
-    }
-    // first (ρⁿ − 1)/(ρ − 1) = 1: bisection on ρ ∈ (1, 1/first]
-    let sum = |rho: f64| first * (rho.powi(n as i32) - 1.0) / (rho - 1.0);
-    let (mut a, mut b) = (1.0 + 1e-12, 1.0 / first);
-    for _ in 0..200 {
-        let m = 0.5 * (a + b);
-        if !(m > a && m < b) {
-            break;
-        }
-        if sum(m) < 1.0 { a = m } else { b = m }
-    }
-    let rho = 0.5 * (a + b);
-    let mut nodes = Vec::with_capacity(n + 1);
-    let (mut z, mut h) = (0.0, first);
-    nodes.push(0.0);
-    for _ in 1..n {
-        z += h;
-        h *= rho;
-        nodes.push(z);
-    }
-    nodes.push(1.0);
-    nodes
-}
-
-/// Every element of a mesh bisected (nested: the coarse nodes kept).
-pub fn bisect_nodes(nodes: &[f64]) -> Vec<f64> {
-    let mut out = Vec::with_capacity(2 * nodes.len() - 1);
-    for w in nodes.windows(2) {
-        out.push(w[0]);
-        out.push(0.5 * (w[0] + w[1]));
-    }
-    out.extend(nodes.last());
     out
 }
 
@@ -658,6 +599,18 @@ pub fn converged_onset(
         force_n: [net_buoyancy_n, 0.0],
         moment_n_m: 0.0,
     };
+    if !air.is_calm() && config.qep_in_wind && config.tracked_wind_onset {
+        return super::qs_wind_onset::wind_onset(
+            model,
+            load,
+            air,
+            config,
+            (lo, hi),
+            &kin,
+            cancel,
+            start,
+        );
+    }
     let mut equilibria = 0;
     let flutter_check = !air.is_calm() && config.qep_in_wind;
     let mut flutter = None;
@@ -808,7 +761,11 @@ pub fn converged_onset(
     })
 }
 
-fn summarise(roots: &[(usize, f64)], config: &ConvergenceConfig, met: bool) -> ConvergedOnset {
+pub(super) fn summarise(
+    roots: &[(usize, f64)],
+    config: &ConvergenceConfig,
+    met: bool,
+) -> ConvergedOnset {
     let values: Vec<f64> = roots.iter().map(|r| r.1).collect();
     let (value, err, order) = richardson(&values);
     let finest = *values.last().unwrap_or(&f64::NAN);
@@ -829,6 +786,8 @@ fn summarise(roots: &[(usize, f64)], config: &ConvergenceConfig, met: bool) -> C
         levels: roots.to_vec(),
         at_safe: OnsetState::default(),
         first_elements: Vec::new(),
+        kind: OnsetKind::Divergence,
+        frequency_rad_s: None,
     }
 }
 
