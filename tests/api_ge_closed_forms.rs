@@ -67,6 +67,7 @@ fn calm_air_string_and_bending_closed_forms() {
     let out = solve(0.0, 1000.0, 1000.0);
     let ge = out.quasi_static_ge.unwrap();
     let w = &ge.per_wind[0];
+    assert_eq!(w.critical_criterion, "quasi_static_ge");
     let h_string = (F / RHO_A - RATE * RATE) / G;
     let l = w.string_critical_length_m.unwrap();
     assert_eq!(w.string_critical_length_outcome, "during");
@@ -127,6 +128,13 @@ fn wind_string_criterion_is_the_static_tethers() {
     // the wind lifts the winch tension above the calm one: 61.1 m/s
     // against 54.9 m/s at 1000 m
     assert!((v - 61.1).abs() < 0.1, "{v}");
+    // converged in wind the criterion is the string's in that wind
+    // (`wind_criterion`: the GE onset is an imperfect bifurcation there)
+    assert_eq!(w.critical_criterion, "string_in_wind");
+    assert_eq!(w.critical_rate_outcome, "during");
+    let est = w.critical_rate_estimate_m_s.unwrap();
+    assert!((est - v).abs() <= 1e-9 * v, "{est} vs {v}");
+    assert!(w.critical_rate_m_s.unwrap() <= est && w.critical_rate_converged == Some(true));
     match w.string_critical_length_m {
         Some(l) => {
             let t = min_tension_n(8.0, l);

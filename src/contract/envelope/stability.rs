@@ -11,6 +11,7 @@ use crate::contract::equilibrium::require_range;
 use crate::numerics::ge::airy_onset::AiryOnset;
 use crate::numerics::ge::qs_converged::{ConvergedOutcome, ConvergedSearch, ConvergenceConfig};
 use crate::numerics::ge::qs_critical::{QsOnset, QsSearch};
+use crate::numerics::ge::wind_criterion::WIND_CRITERION;
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::envelope::EnvelopeProblem;
 use crate::numerics::tether::envelope_ge::{
@@ -164,6 +165,15 @@ pub struct GeWindLimitOutput {
     pub critical_rate_converged: Option<bool>,
     /// Upper end of the rate search (m/s); it starts at 10⁻³ of it.
     pub rate_search_max_m_s: f64,
+    /// What gives the critical length and rate: `quasi_static_ge` (the GE
+    /// onset, on the mesh or converged) or, converged in wind,
+    /// `string_in_wind` — the string criterion of the continuum tether in
+    /// this wind (min tension = ρA v²), because the local GE onset in wind
+    /// is an imperfect bifurcation with no usable limit (the blow-down grows
+    /// as T/(T − ρA v²); the GE QEP's first instability, near 175 m/s in
+    /// 2 m/s of wind, does not converge). It is below the GE onset (bending
+    /// only lifts it) and tends to the calm string criterion.
+    pub critical_criterion: String,
     /// The string criterion's critical length at the payout rate (m): where
     /// the static tether's smallest tension in this wind equals ρA v² (in
     /// calm air the closed form (F/ρA − v²)/g). A reference beside the GE
@@ -333,6 +343,15 @@ pub fn ge_output(
                 critical_rate_error_m_s: r_err,
                 critical_rate_converged: r_conv,
                 rate_search_max_m_s: w.rate_search_max_m_s,
+                critical_criterion: if spec.converge.is_some_and(|c| !c.tracked_wind_onset)
+                    && u != 0.0
+                    && problem.base.air_density_kg_m3 > 0.0
+                {
+                    WIND_CRITERION
+                } else {
+                    "quasi_static_ge"
+                }
+                .into(),
                 string_critical_length_m: cf.string_length.1,
                 string_critical_length_outcome: cf.string_length.0.into(),
                 string_critical_rate_m_s: cf.string_rate,

@@ -60,6 +60,7 @@ pub mod quasi_static;
 pub mod solver;
 pub mod stability;
 pub mod tether_system;
+pub mod wind_criterion;
 
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 

@@ -69,6 +69,7 @@ use crate::numerics::ge::qs_wind::airborne_length_m;
 use crate::numerics::ge::quasi_static::{QsConfig, WindStateStability, wind_stability};
 use crate::numerics::ge::stability::{GeStateFailure, StateMotion};
 use crate::numerics::ge::tether_system::{GeTetherOptions, GeTetherSystem, ge_tether_system};
+use crate::numerics::ge::wind_criterion;
 use crate::numerics::params::{InvalidInput, Kinematics, require_positive};
 use crate::numerics::tether::envelope::{
     Envelope, EnvelopePoint, EnvelopeProblem, judge_with, summarise,
@@ -322,11 +323,43 @@ pub fn wind_limits(
         sys.tip_load,
         spec.critical_rate_length_m,
     );
+    if let Some(cfg) = &spec.converge
+        && !sys.air.is_calm()
+        && !cfg.tracked_wind_onset
+    {
+        // In wind the local GE onset is an imperfect bifurcation, not a
+        // limit (`wind_criterion`): the string criterion of the continuum
+        // tether in this wind, converged and on the safe side.
+        let cl = wind_criterion::critical_length(
+            &sys.model,
+            sys.net_buoyancy_n,
+            &sys.air,
+            rate_m_s,
+            (lmin, length_search_max_m),
+        )?;
+        let cr = wind_criterion::critical_rate(
+            &sys.model,
+            sys.net_buoyancy_n,
+            &sys.air,
+            spec.critical_rate_length_m,
+            rate_search_max_m_s,
+        )?;
+        return Ok(GeWindLimits {
+            critical_length: safe_search(&cl),
+            length_search_max_m,
+            critical_rate: safe_search(&cr),
+            rate_search_max_m_s,
+            converged: Some(ConvergedLimits {
+                critical_length: cl,
+                critical_rate: cr,
+            }),
+        });
+    }
     if let Some(cfg) = &spec.converge {
-        // In wind every level follows the branch reached by paying out
-        // (`qs_wind`); the rate search still moves the quasi-static shape
-        // far from the continuum start and its levels are not yet
-        // reliable (issue 21): three levels, the safe side below each.
+        // In wind (with `tracked_wind_onset`) every level follows the
+        // branch reached by paying out (`qs_wind`); its levels are not
+        // reliable near the string speed (issue 21, `qs_wind_onset`):
+        // three levels, the safe side below each.
         let cfg = &if sys.air.is_calm() {
             *cfg
         } else {
