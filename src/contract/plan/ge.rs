@@ -173,8 +173,7 @@ pub(super) fn ge_output(
                 capped: r.capped,
                 unstable: r.unstable,
                 critical_rate_error_m_s: t.rate_error_m_s.get(i).copied(),
-                plan_rate_ceiling_m_s: ((ge.stability_tension_n(w, p, r.length_m) - margin)
-                    / rho_a)
+                plan_rate_ceiling_m_s: ((w.stability_tension_n(p, r.length_m) - margin) / rho_a)
                     .max(0.0)
                     .sqrt(),
                 string_critical_rate_m_s: string_onset::critical_rate_m_s(

@@ -128,8 +128,13 @@ fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidI
                 Some(w) => steady_wind(req, w)?,
                 None => (calm_wind(model.system.mass_per_length_kg_m), None),
             };
-            sw.ge = Some(GeCriterion::new(o));
-            sw.criterion_name = ge_plan::QS_GE_CRITERION;
+            let ge = GeCriterion::new(o);
+            sw.criterion_name = if ge.string_in_wind(&sw) {
+                ge_plan::QS_GE_WIND_CRITERION
+            } else {
+                ge_plan::QS_GE_CRITERION
+            };
+            sw.ge = Some(ge);
             (Air::Wind(Box::new(sw)), gust)
         }
     };

@@ -237,8 +237,15 @@ impl SteadyWind {
 
     /// `S(L)` with the reserve buoyancy (N).
     pub fn stability_tension_n(&self, p: &PlanProblem, length_m: f64) -> f64 {
+        let mut offset_n = 0.0;
         if let Some(ge) = &self.ge {
-            return ge.stability_tension_n(self, p, length_m);
+            if !ge.string_in_wind(self) {
+                return ge.stability_tension_n(self, p, length_m);
+            }
+            // converged GE in wind: the string criterion itself (the table,
+            // made for the answer, holds its rates)
+            let _ = ge.table(self, p);
+            offset_n = ge.offset_n;
         }
         let b = p.reserve_buoyancy_n();
         let key = key(&p.system, length_m, b, self.criterion as usize, 0);
@@ -257,6 +264,7 @@ impl SteadyWind {
             };
             [st, 0.0, 0.0]
         })[0]
+            - offset_n
     }
 
     /// Winch tension, top tension and altitude with the full buoyancy.

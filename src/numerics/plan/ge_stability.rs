@@ -67,6 +67,7 @@ use crate::numerics::ge::quasi_static::{
 };
 use crate::numerics::ge::stability::StateMotion;
 use crate::numerics::ge::tether_system::{GeTetherOptions, ge_tether_system};
+use crate::numerics::ge::wind_criterion;
 use crate::numerics::params::{InvalidInput, Kinematics};
 use crate::numerics::plan::PlanProblem;
 use crate::numerics::plan::air::SteadyWind;
@@ -240,6 +241,9 @@ pub struct GeCriterion {
     table: Arc<OnceLock<Result<(GeTable, GePlanModel), String>>>,
 }
 
+/// What the criterion is converged in wind ([`GeCriterion::string_in_wind`]), for the answer.
+pub const QS_GE_WIND_CRITERION: &str = "quasi-static GE stability, converged, in wind: the string criterion of the blown-down tether with the reserve buoyancy in this wind (its smallest tension less (m + ρA L)L̈ + ρA L̇² must stay ≥ ε(1−r)F, mean and gust), because the local GE onset in wind is an imperfect bifurcation with no usable limit (the blow-down grows as T/(T − ρA v²)); it is below the GE onset (bending only lifts it) and the schedule is then checked by the local GE QEP at its samples";
+
 /// What the criterion is, for the answer.
 pub const QS_GE_CRITERION: &str = "quasi-static geometrically exact stability of the tether with the reserve \
 buoyancy: the largest stable constant payout rate v*(L) of the local GE QEP about the blown-down equilibrium \
@@ -377,6 +381,17 @@ impl GeCriterion {
             .map_err(|e| e.as_str())
     }
 
+    /// Whether `S(L)` is the string criterion in `wind` itself, not the
+    /// table: converged in wind (`wind_criterion`), where the table's rows
+    /// are that criterion's rates and interpolating them would only lose.
+    pub fn string_in_wind(&self, wind: &SteadyWind) -> bool {
+        self.options.converge.is_some_and(|c| !c.tracked_wind_onset)
+            && wind.air_density_kg_m3 > 0.0
+            && [1.0, 10.0, 100.0, 1e3, 1e4]
+                .iter()
+                .any(|&z| wind.wind.speed_m_s(z) != 0.0)
+    }
+
     /// The table if it was made.
     pub fn made_table(&self) -> Option<&(GeTable, GePlanModel)> {
         self.table.get().and_then(|r| r.as_ref().ok())
@@ -480,6 +495,10 @@ fn build(
         qep_in_wind: false,
         ..c
     });
+    // Converged in wind: the string criterion of the continuum tether in
+    // the wind (`wind_criterion`: the GE onset there is an imperfect
+    // bifurcation, not a limit).
+    let string_in_wind = conv.is_some_and(|c| !c.tracked_wind_onset) && !gm.air.is_calm();
     let search_hi = if conv.is_some() && !gm.air.is_calm() {
         airborne_length_m(&gm.model, &gm.air, b, (lo, search_hi))
     } else {
@@ -494,9 +513,12 @@ fn build(
             Err(false) => lo,
         },
         Some(c) => {
-            let r =
+            let r = if string_in_wind {
+                wind_criterion::critical_length(&gm.model, b, &gm.air, 0.0, (lo, search_hi))
+            } else {
                 converged_critical_length(&gm.model, b, &gm.air, 0.0, c, (lo, search_hi), &never)
-                    .map_err(|e| e.to_string())?;
+            }
+            .map_err(|e| e.to_string())?;
             evaluations.fetch_add(r.equilibria, std::sync::atomic::Ordering::Relaxed);
             match r.outcome {
                 ConvergedOutcome::During(o) => {
@@ -527,7 +549,12 @@ fn build(
             let Some(c) = &conv else {
                 return (last_stable(0.0, cap, |v| stable(l, v)), 0.0);
             };
-            match converged_critical_rate(&gm.model, b, &gm.air, l, cap, c, &never, None) {
+            let r = if string_in_wind {
+                wind_criterion::critical_rate(&gm.model, b, &gm.air, l, cap)
+            } else {
+                converged_critical_rate(&gm.model, b, &gm.air, l, cap, c, &never, None)
+            };
+            match r {
                 Ok(r) => {
                     evaluations.fetch_add(r.equilibria, std::sync::atomic::Ordering::Relaxed);
                     match r.outcome {
@@ -597,13 +624,18 @@ fn build(
         })
         .collect();
     let curvature_margin_n = curvature_margins_n.iter().copied().fold(0.0, f64::max);
-    let interpolation_error_n = rows
-        .windows(2)
-        .zip(deviation.windows(2))
-        .zip(&curvature_margins_n)
-        .filter(|((r, _), _)| usable(&r[0]) && usable(&r[1]))
-        .map(|((_, d), m)| (d[1] - d[0]).abs() + m)
-        .fold(0.0, f64::max);
+    // Converged in wind `S` is the string criterion itself, not
+    // interpolated (`GeCriterion::string_in_wind`): no interpolation error.
+    let interpolation_error_n = if string_in_wind {
+        0.0
+    } else {
+        rows.windows(2)
+            .zip(deviation.windows(2))
+            .zip(&curvature_margins_n)
+            .filter(|((r, _), _)| usable(&r[0]) && usable(&r[1]))
+            .map(|((_, d), m)| (d[1] - d[0]).abs() + m)
+            .fold(0.0, f64::max)
+    };
     Ok((
         GeTable {
             rows,
