@@ -104,7 +104,10 @@ fn benches(c: &mut Criterion) {
     // Issue 21: the same envelope with the critical length and rate of
     // each wind converged (nested meshes from 20 elements, tolerance 1e-3,
     // safe side) and the cells judged by the converged length when the
-    // base mesh's QEP confirms the divergence [target ≤ 2 s].
+    // base mesh's QEP confirms the divergence [target ≤ 2 s]. In wind the
+    // limits are the string criterion of the continuum tether
+    // (`ge::wind_criterion`) and no cell needs a QEP: median 82 ms on 2
+    // quiet cores (7.70 s before, the GE divergence levels in wind).
     // Every row's length onset is a confirmed `Never` (up to the ground
     // contact), so no cell solves a QEP: the time is the wind limits, above
     // all the converged rate search at 3000 m (63–300 equilibria a row).

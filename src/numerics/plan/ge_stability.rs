@@ -41,7 +41,13 @@
 //! and every row's rate are the safe sides of the converged divergence
 //! onsets of [`crate::numerics::ge::qs_converged`] (nested meshes from
 //! `elements` up, Richardson, best estimate minus its error), with their
-//! error estimates in the table.
+//! error estimates in the table. In wind (unless `tracked_wind_onset`)
+//! the rows are the string criterion's rates of the continuum tether
+//! ([`crate::numerics::ge::wind_criterion`]) and the plan's `S(L)` is that
+//! criterion itself, mean and gust, with no interpolation
+//! ([`GeCriterion::string_in_wind`]): the GE divergence levels in wind were
+//! not physical (a row of 13.18 ± 63 m/s at 332 m between 78 and 76 m/s
+//! made the benchmark's log-law plan infeasible).
 //!
 //! **The check.** At schedule samples the local QEP of the GE model at
 //! `(L, L̇, L̈)` with the reserve buoyancy

@@ -48,6 +48,11 @@
 //! search confirms that the onset along the length is a divergence, every
 //! shorter cell is stable with no further eigenvalue solve (its growth rate
 //! is not reported); otherwise each cell also needs its base-mesh QEP.
+//! In wind (unless `tracked_wind_onset`) both limits are the string
+//! criterion of the continuum tether in that wind
+//! ([`crate::numerics::ge::wind_criterion`]: the GE onset there is an
+//! imperfect bifurcation), so no cell needs a QEP: the 40 × 50 converged
+//! envelope's median fell from 7.70 s to 82 ms (the plain envelope is 49 ms).
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
