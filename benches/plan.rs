@@ -82,10 +82,12 @@ fn bench(c: &mut Criterion) {
     // blown-down tether (`ge::wind_criterion`): the request is feasible
     // (it was infeasible with the GE divergence levels) and its schedule
     // is checked by the GE QEP at 43 samples. Median 308 ms (2 quiet
-    // cores), of which 272 ms is the wind plan itself (the string-method
+    // cores), of which 272 ms was the wind plan itself (the string-method
     // request above: RK4 equilibria at the pass's nodes, 95 % of the
-    // time); the GE table and check add 36 ms. Before (below): the GE
-    // divergence levels.
+    // time). With the haul-down's retrieval pass on the very same nodes
+    // (its equilibria cached once): 202 ms, the string-method plan 163 ms;
+    // the GE table and check add 39 ms. Before (below): the GE divergence
+    // levels.
     // Speed21 (fused equilibrium Newton, slice band LU, memoised
     // continuum starts, no air damping in Newton; answers bit for bit):
     // one plan on one thread 0.96 → 0.68 s CPU, 21.7 → 12.8 G

@@ -212,14 +212,21 @@ impl Grid {
         let total = (p.target_length_m - l0).abs();
         let h = total / n as f64;
         let rho_a = s.mass_per_length_kg_m;
+        // Node k from the shorter end, `lo + k (hi − lo)/n`, whichever the
+        // direction: a retrieval between the same lengths (the haul-down's)
+        // has the very same nodes, so their equilibria are cached once.
+        let (lo, hi) = (l0.min(p.target_length_m), l0.max(p.target_length_m));
+        let node = |k: usize| {
+            if k == n {
+                hi
+            } else if k == 0 {
+                lo
+            } else {
+                lo + total * k as f64 / n as f64
+            }
+        };
         let lengths: Vec<f64> = (0..=n)
-            .map(|i| {
-                if i == n {
-                    p.target_length_m
-                } else {
-                    l0 + sigma * h * i as f64
-                }
-            })
+            .map(|i| if sigma > 0.0 { node(i) } else { node(n - i) })
             .collect();
         let (cap, floor, rest_tensions) = if air.is_calm() {
             let cap = lengths
