@@ -328,70 +328,43 @@ pub fn wind_limits(
         sys.tip_load,
         spec.critical_rate_length_m,
     );
-    if let Some(cfg) = &spec.converge
-        && !sys.air.is_calm()
-        && !cfg.tracked_wind_onset
-    {
+    if let Some(cfg) = &spec.converge {
         // In wind the local GE onset is an imperfect bifurcation, not a
         // limit (`wind_criterion`): the string criterion of the continuum
-        // tether in this wind, converged and on the safe side.
-        let cl = wind_criterion::critical_length(
-            &sys.model,
-            sys.net_buoyancy_n,
-            &sys.air,
-            rate_m_s,
-            (lmin, length_search_max_m),
-        )?;
-        let cr = wind_criterion::critical_rate(
-            &sys.model,
-            sys.net_buoyancy_n,
-            &sys.air,
-            spec.critical_rate_length_m,
-            rate_search_max_m_s,
-        )?;
-        return Ok(GeWindLimits {
-            critical_length: safe_search(&cl),
-            length_search_max_m,
-            critical_rate: safe_search(&cr),
-            rate_search_max_m_s,
-            converged: Some(ConvergedLimits {
-                critical_length: cl,
-                critical_rate: cr,
-            }),
-        });
-    }
-    if let Some(cfg) = &spec.converge {
-        // In wind (with `tracked_wind_onset`) every level follows the
-        // branch reached by paying out (`qs_wind`); its levels are not
-        // reliable near the string speed (issue 21, `qs_wind_onset`):
-        // three levels, the safe side below each.
-        let cfg = &if sys.air.is_calm() {
-            *cfg
+        // tether in this wind, converged and on the safe side. With
+        // `tracked_wind_onset` every level follows the branch reached by
+        // paying out (`qs_wind`); its levels are not reliable near the
+        // string speed (issue 21, `qs_wind_onset`): three levels, the safe
+        // side below each.
+        let (cl, cr) = if !sys.air.is_calm() && !cfg.tracked_wind_onset {
+            (
+                wind_criterion::critical_length(
+                    &sys.model,
+                    sys.net_buoyancy_n,
+                    &sys.air,
+                    rate_m_s,
+                    (lmin, length_search_max_m),
+                )?,
+                wind_criterion::critical_rate(
+                    &sys.model,
+                    sys.net_buoyancy_n,
+                    &sys.air,
+                    spec.critical_rate_length_m,
+                    rate_search_max_m_s,
+                )?,
+            )
         } else {
-            ConvergenceConfig {
-                max_elements: 4 * cfg.base_elements,
-                ..*cfg
-            }
+            converged_limits(
+                sys,
+                spec,
+                cfg,
+                rate_m_s,
+                (lmin, length_search_max_m),
+                rate_search_max_m_s,
+                rate_start,
+                cancel,
+            )?
         };
-        let cl = converged_critical_length(
-            &sys.model,
-            sys.net_buoyancy_n,
-            &sys.air,
-            rate_m_s,
-            cfg,
-            (lmin, length_search_max_m),
-            cancel,
-        )?;
-        let cr = converged_critical_rate(
-            &sys.model,
-            sys.net_buoyancy_n,
-            &sys.air,
-            spec.critical_rate_length_m,
-            rate_search_max_m_s,
-            cfg,
-            cancel,
-            rate_start,
-        )?;
         return Ok(GeWindLimits {
             critical_length: safe_search(&cl),
             length_search_max_m,
@@ -432,6 +405,49 @@ pub fn wind_limits(
         rate_search_max_m_s,
         converged: None,
     })
+}
+
+/// The converged GE searches of one wind (calm air, or in wind with
+/// [`ConvergenceConfig::tracked_wind_onset`]).
+#[allow(clippy::too_many_arguments)]
+fn converged_limits(
+    sys: &GeTetherSystem,
+    spec: &GeStabilitySpec,
+    cfg: &ConvergenceConfig,
+    rate_m_s: f64,
+    (lmin, length_search_max_m): (f64, f64),
+    rate_search_max_m_s: f64,
+    rate_start: Option<&[f64]>,
+    cancel: &dyn Fn() -> bool,
+) -> Result<(ConvergedSearch, ConvergedSearch), InvalidInput> {
+    let cfg = &if sys.air.is_calm() {
+        *cfg
+    } else {
+        ConvergenceConfig {
+            max_elements: 4 * cfg.base_elements,
+            ..*cfg
+        }
+    };
+    let cl = converged_critical_length(
+        &sys.model,
+        sys.net_buoyancy_n,
+        &sys.air,
+        rate_m_s,
+        cfg,
+        (lmin, length_search_max_m),
+        cancel,
+    )?;
+    let cr = converged_critical_rate(
+        &sys.model,
+        sys.net_buoyancy_n,
+        &sys.air,
+        spec.critical_rate_length_m,
+        rate_search_max_m_s,
+        cfg,
+        cancel,
+        rate_start,
+    )?;
+    Ok((cl, cr))
 }
 
 /// One wind row: the static equilibria, the GE verdicts (continued along
