@@ -77,14 +77,14 @@ pub(super) fn wind_samples_output(
     s: &Schedule,
     count: usize,
 ) -> Vec<PlanSampleOutput> {
-    use rayon::prelude::*;
     let sy = &p.system;
-    s.samples(count)
-        .into_par_iter()
-        .map(|(t, k)| {
+    let samples = s.samples(count);
+    let lengths: Vec<f64> = samples.iter().map(|(_, k)| k.length_m).collect();
+    samples
+        .into_iter()
+        .zip(air.rest_loads_at(p, &lengths))
+        .map(|((t, k), (r, g))| {
             let (l, a) = (k.length_m, k.acceleration_m_s2);
-            let r = air.rest_loads(p, l);
-            let g = air.gust_rest_loads(p, l);
             let ceiling = r.rate_ceiling_m_s(sy, l, a);
             PlanSampleOutput {
                 time_s: t,

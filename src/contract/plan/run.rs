@@ -289,17 +289,30 @@ fn find_schedule(
             let mut tightened = opts.clone();
             let mut tightenings = 0;
             let mut ge_check = None;
-            let s = loop {
+            let (s, check) = loop {
                 let s = match schedule::fastest_with(p, &tightened) {
                     PlanOutcome::Infeasible(b) => return Ok(Err(b)),
                     PlanOutcome::Feasible(s) => s,
                 };
-                let Some(chk) = ge_check_of(&tightened.air, &s, ge_check_count(req)) else {
-                    break s;
+                // The GE check (on rayon) and the transient check (one
+                // thread) side by side; a tightening drops the transient.
+                let (chk, check) = rayon::join(
+                    || ge_check_of(&tightened.air, &s, ge_check_count(req)),
+                    || {
+                        retrieval::check_transient(
+                            &v.model,
+                            &s,
+                            req.disturbance_tip_deflection_m,
+                            observer,
+                        )
+                    },
+                );
+                let Some(chk) = chk else {
+                    break (s, check);
                 };
                 if chk.failed == 0 {
                     ge_check = Some(chk);
-                    break s;
+                    break (s, check);
                 }
                 if tightenings >= MAX_GE_TIGHTENINGS {
                     return Ok(Err(ge_binding(&chk)));
@@ -312,13 +325,7 @@ fn find_schedule(
                     w.ge = Some(ge.with_offset(offset));
                 }
             };
-            let check = retrieval::check_transient(
-                &v.model,
-                &s,
-                req.disturbance_tip_deflection_m,
-                observer,
-            )
-            .map_err(from_transient)?;
+            let check = check.map_err(from_transient)?;
             Found {
                 schedule: s,
                 check,

@@ -45,6 +45,7 @@ use rayon::prelude::*;
 
 use crate::numerics::params::AerostatSystem;
 use crate::numerics::plan::{PlanProblem, STABILITY_MARGIN};
+use crate::numerics::tether::equilibrium::ShootingContinuation;
 use crate::numerics::tether::{
     Body, Cable, Equilibrium, EquilibriumConfig, EquilibriumProblem, WindProfile,
 };
@@ -235,8 +236,36 @@ impl SteadyWind {
         problem.solve(&self.config).ok()
     }
 
+    /// [`Self::solve`], started from the continuation's neighbours when
+    /// there is one (and recorded in it).
+    fn solve_along(
+        &self,
+        problem: &EquilibriumProblem,
+        continuation: Option<&mut ShootingContinuation>,
+    ) -> Option<Equilibrium> {
+        let Some(c) = continuation else {
+            return self.solve(problem);
+        };
+        let l = problem.tether_length_m;
+        let eq = problem.solve_from(&self.config, c.start_at(l)).ok();
+        c.record(l, eq.as_ref());
+        eq
+    }
+
     /// `S(L)` with the reserve buoyancy (N).
     pub fn stability_tension_n(&self, p: &PlanProblem, length_m: f64) -> f64 {
+        self.stability_tension_along(p, length_m, None)
+    }
+
+    /// [`Self::stability_tension_n`] with the shootings started from the
+    /// continuations of a sequence of lengths (its answer is the same to
+    /// the shooting's tolerance).
+    fn stability_tension_along(
+        &self,
+        p: &PlanProblem,
+        length_m: f64,
+        mut along: Option<&mut Along>,
+    ) -> f64 {
         let mut offset_n = 0.0;
         if let Some(ge) = &self.ge {
             if !ge.string_in_wind(self) {
@@ -249,68 +278,137 @@ impl SteadyWind {
         }
         let b = p.reserve_buoyancy_n();
         let key = key(&p.system, length_m, b, self.criterion as usize, 0);
-        self.cached(key, || {
-            let at = |wind: &WindProfile| {
-                let pr = self.problem_in(wind, &p.system, b, length_m);
-                match self.solve(&pr) {
-                    Some(eq) => (self.criterion)(&pr, &eq),
-                    None => -b,
+        let at = |wind: &WindProfile, c: Option<&mut ShootingContinuation>| {
+            let pr = self.problem_in(wind, &p.system, b, length_m);
+            match self.solve_along(&pr, c) {
+                Some(eq) => ((self.criterion)(&pr, &eq), eq.altitude_m),
+                None => (-b, f64::NAN),
+            }
+        };
+        let [st, mean_alt, gust_alt] = self.cached(key, || {
+            let (mean, mean_alt) = at(&self.wind, along.as_deref_mut().map(|a| &mut a.reserve[0]));
+            match self.distinct_gust() {
+                Some(g) => {
+                    let (gust, gust_alt) = at(g, along.as_deref_mut().map(|a| &mut a.reserve[1]));
+                    [mean.min(gust), mean_alt, gust_alt]
                 }
-            };
-            let mean = at(&self.wind);
-            let st = match self.distinct_gust() {
-                Some(g) => mean.min(at(g)),
-                None => mean,
-            };
-            [st, 0.0, 0.0]
-        })[0]
-            - offset_n
+                None => [mean, mean_alt, f64::NAN],
+            }
+        });
+        if let Some(a) = along {
+            // a cached answer continues the sequences too (recorded twice is a no-op)
+            a.reserve[0].record_altitude(length_m, mean_alt);
+            if self.distinct_gust().is_some() {
+                a.reserve[1].record_altitude(length_m, gust_alt);
+            }
+        }
+        st - offset_n
     }
 
     /// Winch tension, top tension and altitude with the full buoyancy.
     pub fn operating(&self, s: &AerostatSystem, length_m: f64) -> (f64, f64, f64) {
+        self.operating_along(s, length_m, None)
+    }
+
+    fn operating_along(
+        &self,
+        s: &AerostatSystem,
+        length_m: f64,
+        mut continuation: Option<&mut ShootingContinuation>,
+    ) -> (f64, f64, f64) {
         let key = key(s, length_m, s.net_buoyancy_n, 0, 1);
         let [w, t, a] = self.cached(key, || {
             let pr = self.problem(s, s.net_buoyancy_n, length_m);
-            match self.solve(&pr) {
+            match self.solve_along(&pr, continuation.as_deref_mut()) {
                 Some(eq) => [eq.winch_tension_n, eq.top_tension_n, eq.altitude_m],
                 None => [f64::NAN; 3],
             }
         });
+        if let Some(c) = continuation {
+            c.record_altitude(length_m, a);
+        }
         (w, t, a)
     }
 
     /// [`Self::operating`] in the gust; `None` without gusts.
     pub fn gust_operating(&self, s: &AerostatSystem, length_m: f64) -> Option<(f64, f64, f64)> {
+        self.gust_operating_along(s, length_m, None)
+    }
+
+    fn gust_operating_along(
+        &self,
+        s: &AerostatSystem,
+        length_m: f64,
+        mut along: Option<&mut Along>,
+    ) -> Option<(f64, f64, f64)> {
         let g = self.gust.as_ref()?;
         if *g == self.wind {
-            return Some(self.operating(s, length_m));
+            return Some(self.operating_along(s, length_m, along.map(|a| &mut a.full[0])));
         }
         let key = key(s, length_m, s.net_buoyancy_n, 0, 2);
         let [w, t, a] = self.cached(key, || {
             let pr = self.problem_in(g, s, s.net_buoyancy_n, length_m);
-            match self.solve(&pr) {
+            match self.solve_along(&pr, along.as_deref_mut().map(|a| &mut a.full[1])) {
                 Some(eq) => [eq.winch_tension_n, eq.top_tension_n, eq.altitude_m],
                 None => [f64::NAN; 3],
             }
         });
+        if let Some(al) = along {
+            al.full[1].record_altitude(length_m, a);
+        }
         Some((w, t, a))
     }
 
     /// The winch and top tensions the limits bound: the larger of the
     /// mean's and the gust's (N).
     pub fn limit_tensions(&self, s: &AerostatSystem, length_m: f64) -> (f64, f64) {
-        let (w, t, _) = self.operating(s, length_m);
+        self.limit_tensions_along(s, length_m, None)
+    }
+
+    fn limit_tensions_along(
+        &self,
+        s: &AerostatSystem,
+        length_m: f64,
+        mut along: Option<&mut Along>,
+    ) -> (f64, f64) {
+        let (w, t, _) =
+            self.operating_along(s, length_m, along.as_deref_mut().map(|a| &mut a.full[0]));
         match self.distinct_gust() {
             Some(_) => {
                 let (gw, gt, _) = self
-                    .gust_operating(s, length_m)
+                    .gust_operating_along(s, length_m, along)
                     .expect("a gust profile is set");
                 (w.max(gw), t.max(gt))
             }
             None => (w, t),
         }
     }
+}
+
+/// The continuations of the shootings along one sequence of lengths: with
+/// the reserve and with the full buoyancy, each in the mean wind `[0]` and
+/// in the gust `[1]`.
+#[derive(Default)]
+struct Along {
+    reserve: [ShootingContinuation; 2],
+    full: [ShootingContinuation; 2],
+}
+
+/// Lengths per chunk of [`along`]: each chunk starts cold, so the answer
+/// depends on the chunking, never on the number of threads.
+const ALONG_CHUNK: usize = 64;
+
+/// `f` at every length, in fixed chunks on rayon, each chunk in order
+/// with its own continuations: the equilibria of a fine grid of lengths
+/// take about one RK4 pass each instead of five.
+fn along<T: Send>(lengths: &[f64], f: impl Fn(f64, &mut Along) -> T + Sync) -> Vec<T> {
+    lengths
+        .par_chunks(ALONG_CHUNK)
+        .flat_map_iter(|chunk| {
+            let mut a = Along::default();
+            chunk.iter().map(|&l| f(l, &mut a)).collect::<Vec<T>>()
+        })
+        .collect()
 }
 
 /// (length, buoyancy, ρA, g, criterion) bits and the kind of answer.
@@ -373,6 +471,41 @@ impl Air {
         }
     }
 
+    /// [`Self::rest_loads`] and [`Self::gust_rest_loads`] at every length
+    /// (on rayon in wind, the shootings continued along the lengths).
+    pub fn rest_loads_at(
+        &self,
+        p: &PlanProblem,
+        lengths: &[f64],
+    ) -> Vec<(RestLoads, Option<RestLoads>)> {
+        let Self::Wind(w) = self else {
+            return lengths
+                .iter()
+                .map(|&l| (self.rest_loads(p, l), None))
+                .collect();
+        };
+        let s = &p.system;
+        along(lengths, |l, a| {
+            let stability_tension_n = w.stability_tension_along(p, l, Some(a));
+            let (winch, top, alt) = w.operating_along(s, l, Some(&mut a.full[0]));
+            let mean = RestLoads {
+                stability_tension_n,
+                winch_tension_n: winch,
+                top_tension_n: top,
+                altitude_m: alt,
+            };
+            let gust = w
+                .gust_operating_along(s, l, Some(a))
+                .map(|(winch, top, alt)| RestLoads {
+                    stability_tension_n,
+                    winch_tension_n: winch,
+                    top_tension_n: top,
+                    altitude_m: alt,
+                });
+            (mean, gust)
+        })
+    }
+
     /// Whether the wind has gusts.
     pub fn has_gust(&self) -> bool {
         matches!(self, Self::Wind(w) if w.gust.is_some())
@@ -400,10 +533,7 @@ impl Air {
                 .iter()
                 .map(|&l| self.rest_loads(p, l).stability_tension_n)
                 .collect(),
-            Self::Wind(w) => lengths
-                .par_iter()
-                .map(|&l| w.stability_tension_n(p, l))
-                .collect(),
+            Self::Wind(w) => along(lengths, |l, a| w.stability_tension_along(p, l, Some(a))),
         }
     }
 
@@ -418,10 +548,9 @@ impl Air {
                     (r.winch_tension_n, r.top_tension_n)
                 })
                 .collect(),
-            Self::Wind(w) => lengths
-                .par_iter()
-                .map(|&l| w.limit_tensions(&p.system, l))
-                .collect(),
+            Self::Wind(w) => along(lengths, |l, a| {
+                w.limit_tensions_along(&p.system, l, Some(a))
+            }),
         }
     }
 
@@ -437,7 +566,9 @@ impl Air {
             return calm;
         };
         let need = STABILITY_MARGIN * p.reserve_buoyancy_n();
-        let ok = |l: f64| w.stability_tension_n(p, l) >= need;
+        // the bisection's shootings start from its earlier points
+        let mut along = Along::default();
+        let mut ok = |l: f64| w.stability_tension_along(p, l, Some(&mut along)) >= need;
         // The GE criterion may allow more than the calm string (bending).
         let calm = match &w.ge {
             Some(ge) => ge.search_upper_m(w, p).map_or(calm, |u| u.max(calm)),
@@ -472,7 +603,8 @@ impl Air {
         let Self::Wind(w) = self else {
             return Ok(altitude_m);
         };
-        let alt = |l: f64| w.operating(s, l).2;
+        let mut along = ShootingContinuation::default();
+        let mut alt = |l: f64| w.operating_along(s, l, Some(&mut along)).2;
         let top = alt(max_length_m);
         if !(top >= altitude_m) {
             return Err(if top.is_finite() { top } else { 0.0 });

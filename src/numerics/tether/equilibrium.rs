@@ -151,6 +151,106 @@ pub struct Equilibrium {
     pub residual_m: f64,
     /// Whether the shooting met its tolerance within the cap.
     pub converged: bool,
+    /// Last secant slope `dz(winch)/dz_top` of the shooting (None in a
+    /// uniform wind, or when it converged at its first pass): the start of
+    /// a neighbouring length's shooting ([`ShootingStart`]).
+    pub shooting_slope: Option<f64>,
+}
+
+/// Where a shooting starts: the aerostat's altitude (m) guessed from the
+/// answers of neighbouring lengths, and the slope of `z(winch)` in it
+/// (`None`: 1, the fixed point). Along a fine grid of lengths a guess
+/// extrapolated from the last four answers is mostly within the tolerance
+/// at once, so one pass of RK4 replaces the coarse and fine shootings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShootingStart {
+    pub z_top_m: f64,
+    pub slope: Option<f64>,
+}
+
+/// The starts of the shootings along a sequence of lengths
+/// ([`ShootingStart`]): the aerostat's altitude extrapolated (cubic, by
+/// Lagrange) from the last four converged answers, and the last secant
+/// slope. (The altitude `z_top − z(winch)` is a better guess of the root
+/// than the last `z_top` itself: the slope of `z(winch)` is near 1.)
+/// Forgets its history at an answer that did not converge.
+#[derive(Clone, Debug, Default)]
+pub struct ShootingContinuation {
+    /// `(L, altitude)` of the last converged answers, oldest first.
+    points: Vec<(f64, f64)>,
+    slope: Option<f64>,
+}
+
+/// Points of the extrapolation (cubic).
+const POINTS: usize = 4;
+
+impl ShootingContinuation {
+    /// The start at length `l` (None before any answer).
+    pub fn start_at(&self, l: f64) -> Option<ShootingStart> {
+        if self.points.is_empty() {
+            return None;
+        }
+        // Lagrange extrapolation through the last (up to four) points.
+        let pts = &self.points;
+        let z = if pts.len() == 1 {
+            pts[0].1 * l / pts[0].0
+        } else {
+            pts.iter()
+                .enumerate()
+                .map(|(i, &(li, zi))| {
+                    pts.iter()
+                        .enumerate()
+                        .filter(|&(j, _)| j != i)
+                        .fold(zi, |acc, (_, &(lj, _))| acc * (l - lj) / (li - lj))
+                })
+                .sum()
+        };
+        Some(ShootingStart {
+            z_top_m: z,
+            slope: self.slope,
+        })
+    }
+
+    /// Records the answer at length `l`; an answer that did not converge
+    /// (or the equilibrium not found) clears the history.
+    pub fn record(&mut self, l: f64, eq: Option<&Equilibrium>) {
+        match eq {
+            Some(e) if e.converged => {
+                self.record_altitude(l, e.altitude_m);
+                if e.shooting_slope.is_some() {
+                    self.slope = e.shooting_slope;
+                }
+            }
+            _ => *self = Self::default(),
+        }
+    }
+
+    /// Records a length whose answer came from elsewhere (its altitude).
+    pub fn record_altitude(&mut self, l: f64, altitude_m: f64) {
+        if !altitude_m.is_finite() {
+            *self = Self::default();
+            return;
+        }
+        // a length (nearly) repeated replaces its point: nodes closer than
+        // this would make the extrapolation amplify the answers' roundoff
+        if let Some(last) = self.points.last_mut()
+            && (last.0 - l).abs() <= 1e-6 * l.abs().max(1.0)
+        {
+            *last = (l, altitude_m);
+            return;
+        }
+        if self
+            .points
+            .iter()
+            .any(|&(lp, _)| (lp - l).abs() <= 1e-6 * l.abs().max(1.0))
+        {
+            self.points.clear();
+        }
+        if self.points.len() == POINTS {
+            self.points.remove(0);
+        }
+        self.points.push((l, altitude_m));
+    }
 }
 
 /// `(τx, τz, x, z, stretched length so far)`.
@@ -424,6 +524,19 @@ impl EquilibriumProblem {
     /// Solves the equilibrium. Invalid input is an error; slack and a
     /// shooting that misses its tolerance are outcomes.
     pub fn solve(&self, config: &EquilibriumConfig) -> Result<Equilibrium, InvalidInput> {
+        self.solve_from(config, None)
+    }
+
+    /// [`Self::solve`] with the shooting started at `start` (the answer of
+    /// a neighbouring length, extrapolated; see [`ShootingStart`]) instead
+    /// of a coarse solve from `z_top = L`. The answer meets the same
+    /// tolerance; when the started shooting misses it, the cold solve is
+    /// made instead. Without a start this is [`Self::solve`] itself.
+    pub fn solve_from(
+        &self,
+        config: &EquilibriumConfig,
+        start: Option<ShootingStart>,
+    ) -> Result<Equilibrium, InvalidInput> {
         self.validate()?;
         if config.steps == 0 || config.steps > MAX_STEPS {
             return Err(InvalidInput::new(
@@ -438,11 +551,24 @@ impl EquilibriumProblem {
             // meets the winch exactly: its residual is zero (issue 21: it
             // used to report the shift, `L − altitude`, as the residual).
             let pass = self.pass(l, config.steps, config.keep_shape);
-            let mut eq = self.assemble(pass, l, 1, true);
+            let mut eq = self.assemble(pass, l, 1, true, None);
             eq.residual_m = 0.0;
             return Ok(eq);
         }
         let tol = 1e-11 * l.max(1.0);
+        if let Some(st) = start.filter(|s| s.z_top_m.is_finite() && s.z_top_m > 0.0) {
+            let fine = self.shoot(
+                st.z_top_m,
+                st.slope,
+                config.steps,
+                config.keep_shape,
+                tol,
+                config.max_iterations,
+            );
+            if fine.converged {
+                return Ok(self.assemble(fine.pass, fine.z_top, fine.iterations, true, fine.slope));
+            }
+        }
         // A coarse solve (an eighth of the steps, loose tolerance) gives the
         // start of the fine one, which then needs two or three passes.
         let coarse_steps = (config.steps / 8).max(8);
@@ -471,7 +597,13 @@ impl EquilibriumProblem {
                 .max(2),
         );
         let iterations = coarse_iterations + fine.iterations;
-        Ok(self.assemble(fine.pass, fine.z_top, iterations, fine.converged))
+        Ok(self.assemble(
+            fine.pass,
+            fine.z_top,
+            iterations,
+            fine.converged,
+            fine.slope.or(slope),
+        ))
     }
 
     /// Secant iteration on `g(z_top) = z(winch)`, safeguarded by a bracket
@@ -562,7 +694,14 @@ impl EquilibriumProblem {
         best
     }
 
-    fn assemble(&self, p: Pass, z_top: f64, iterations: usize, converged: bool) -> Equilibrium {
+    fn assemble(
+        &self,
+        p: Pass,
+        z_top: f64,
+        iterations: usize,
+        converged: bool,
+        shooting_slope: Option<f64>,
+    ) -> Equilibrium {
         let l = self.tether_length_m;
         let compliance = self.cable.axial_stiffness_n.map_or(0.0, |ea| 1.0 / ea);
         let [ex, ez, xe, ze, lifted_stretched] = p.end;
@@ -643,6 +782,7 @@ impl EquilibriumProblem {
             iterations,
             residual_m: ze.abs(),
             converged,
+            shooting_slope,
         }
     }
 }
@@ -766,5 +906,77 @@ mod tests {
         let (x, z) = catenary_top(h, v, p.weight_n_m(), 1000.0);
         assert!((e.altitude_m - z).abs() < 1e-6 * z, "{} {z}", e.altitude_m);
         assert!((e.downwind_m - x).abs() < 1e-6 * z, "{} {x}", e.downwind_m);
+    }
+
+    /// A log-law wind over the tether with drag: `z(winch)` depends on
+    /// `z_top`, so the shooting iterates.
+    fn sheared(length_m: f64) -> EquilibriumProblem {
+        let mut p = problem(0.0);
+        p.cable.normal_drag_coefficient = 1.2;
+        p.wind = WindProfile::LogLaw {
+            reference_speed_m_s: 6.0,
+            reference_height_m: 10.0,
+            roughness_length_m: 0.03,
+        };
+        p.tether_length_m = length_m;
+        p
+    }
+
+    #[test]
+    fn continued_shootings_meet_the_cold_answers_in_fewer_passes() {
+        let config = EquilibriumConfig {
+            keep_shape: false,
+            ..EquilibriumConfig::default()
+        };
+        let mut c = ShootingContinuation::default();
+        let (mut cold_passes, mut warm_passes) = (0, 0);
+        // the plan's grid: 4000 segments over 1000 m
+        for k in 0..=200 {
+            let l = 500.0 + 0.25 * k as f64;
+            let p = sheared(l);
+            let cold = p.solve(&config).unwrap();
+            let warm = p.solve_from(&config, c.start_at(l)).unwrap();
+            c.record(l, Some(&warm));
+            assert!(cold.converged && warm.converged);
+            // both meet the shooting tolerance 1e-11 L on z(winch): the
+            // altitudes agree to a few times it, the tensions to roundoff
+            assert!(warm.residual_m <= 1e-11 * l, "{l}: {}", warm.residual_m);
+            assert!(
+                (warm.altitude_m - cold.altitude_m).abs() <= 4e-11 * l,
+                "{l}"
+            );
+            let dt = (warm.winch_tension_n - cold.winch_tension_n).abs();
+            assert!(dt <= 1e-9 * cold.winch_tension_n, "{l}: {dt}");
+            cold_passes += cold.iterations;
+            warm_passes += warm.iterations;
+        }
+        // cold: a coarse and a fine shooting (about 5 passes); continued:
+        // about one pass once four answers are known
+        assert!(cold_passes >= 4 * 201, "{cold_passes}");
+        assert!(
+            warm_passes <= 201 + 40,
+            "{warm_passes} against {cold_passes}"
+        );
+    }
+
+    #[test]
+    fn a_start_far_off_falls_back_to_the_cold_solve() {
+        let config = EquilibriumConfig::default();
+        let p = sheared(800.0);
+        let cold = p.solve(&config).unwrap();
+        for z in [1e-3, 0.5, 2000.0, 1e6] {
+            let s = Some(ShootingStart {
+                z_top_m: z,
+                slope: Some(1.0),
+            });
+            let e = p.solve_from(&config, s).unwrap();
+            assert!(e.converged, "{z}");
+            assert!(
+                (e.altitude_m - cold.altitude_m).abs() <= 4e-11 * 800.0,
+                "{z}"
+            );
+        }
+        // no start: the cold solve itself, bit for bit
+        assert_eq!(p.solve_from(&config, None).unwrap(), cold);
     }
 }
