@@ -86,8 +86,12 @@ fn bench(c: &mut Criterion) {
     // request above: RK4 equilibria at the pass's nodes, 95 % of the
     // time). With the haul-down's retrieval pass on the very same nodes
     // (its equilibria cached once): 202 ms, the string-method plan 163 ms;
-    // the GE table and check add 39 ms. Before (below): the GE divergence
-    // levels.
+    // the GE table and check add 39 ms. Measured again at the start of
+    // the next session on its machine: 228 ms (string method 200 ms).
+    // Then the shootings continued along the grid's lengths (about one
+    // RK4 pass per equilibrium instead of five) and the GE check run
+    // beside the transient check: 149 ms (string method 103 ms), target
+    // met. Before (below): the GE divergence levels.
     // Speed21 (fused equilibrium Newton, slice band LU, memoised
     // continuum starts, no air damping in Newton; answers bit for bit):
     // one plan on one thread 0.96 → 0.68 s CPU, 21.7 → 12.8 G
