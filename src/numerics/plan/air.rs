@@ -314,11 +314,24 @@ impl SteadyWind {
         &self,
         s: &AerostatSystem,
         length_m: f64,
+        continuation: Option<&mut ShootingContinuation>,
+    ) -> (f64, f64, f64) {
+        self.full_buoyancy_state(&self.wind, 1, s, length_m, continuation)
+    }
+
+    /// Winch tension, top tension and altitude with the full buoyancy in
+    /// `wind` (cached as `kind`), the shooting continued when asked.
+    fn full_buoyancy_state(
+        &self,
+        wind: &WindProfile,
+        kind: u8,
+        s: &AerostatSystem,
+        length_m: f64,
         mut continuation: Option<&mut ShootingContinuation>,
     ) -> (f64, f64, f64) {
-        let key = key(s, length_m, s.net_buoyancy_n, 0, 1);
+        let key = key(s, length_m, s.net_buoyancy_n, 0, kind);
         let [w, t, a] = self.cached(key, || {
-            let pr = self.problem(s, s.net_buoyancy_n, length_m);
+            let pr = self.problem_in(wind, s, s.net_buoyancy_n, length_m);
             match self.solve_along(&pr, continuation.as_deref_mut()) {
                 Some(eq) => [eq.winch_tension_n, eq.top_tension_n, eq.altitude_m],
                 None => [f64::NAN; 3],
@@ -339,24 +352,13 @@ impl SteadyWind {
         &self,
         s: &AerostatSystem,
         length_m: f64,
-        mut along: Option<&mut Along>,
+        along: Option<&mut Along>,
     ) -> Option<(f64, f64, f64)> {
         let g = self.gust.as_ref()?;
         if *g == self.wind {
             return Some(self.operating_along(s, length_m, along.map(|a| &mut a.full[0])));
         }
-        let key = key(s, length_m, s.net_buoyancy_n, 0, 2);
-        let [w, t, a] = self.cached(key, || {
-            let pr = self.problem_in(g, s, s.net_buoyancy_n, length_m);
-            match self.solve_along(&pr, along.as_deref_mut().map(|a| &mut a.full[1])) {
-                Some(eq) => [eq.winch_tension_n, eq.top_tension_n, eq.altitude_m],
-                None => [f64::NAN; 3],
-            }
-        });
-        if let Some(al) = along {
-            al.full[1].record_altitude(length_m, a);
-        }
-        Some((w, t, a))
+        Some(self.full_buoyancy_state(g, 2, s, length_m, along.map(|a| &mut a.full[1])))
     }
 
     /// The winch and top tensions the limits bound: the larger of the
