@@ -960,6 +960,33 @@ mod tests {
     }
 
     #[test]
+    fn continued_shootings_follow_the_tether_onto_the_ground() {
+        // F/(ρA g) = 4077 m in calm air; blown down, the tether reaches the
+        // ground sooner: the lengths pass from airborne to grounded
+        let config = EquilibriumConfig::default();
+        let mut c = ShootingContinuation::default();
+        let mut grounded = 0;
+        for k in 0..=150 {
+            let l = 2000.0 + 15.0 * k as f64;
+            let p = sheared(l);
+            let cold = p.solve(&config).unwrap();
+            let warm = p.solve_from(&config, c.start_at(l)).unwrap();
+            c.record(l, Some(&warm));
+            assert_eq!(warm.slack, cold.slack, "{l}");
+            assert_eq!(warm.converged, cold.converged, "{l}");
+            assert!((warm.altitude_m - cold.altitude_m).abs() <= 1e-9 * l, "{l}");
+            assert!(
+                (warm.grounded_length_m - cold.grounded_length_m).abs() <= 1e-6,
+                "{l}"
+            );
+            let dt = (warm.min_tension_n - cold.min_tension_n).abs();
+            assert!(dt <= 1e-6 * cold.top_tension_n, "{l}: {dt}");
+            grounded += usize::from(cold.slack);
+        }
+        assert!(grounded > 20 && grounded < 140, "{grounded}");
+    }
+
+    #[test]
     fn a_start_far_off_falls_back_to_the_cold_solve() {
         let config = EquilibriumConfig::default();
         let p = sheared(800.0);
