@@ -496,10 +496,17 @@ pub struct PlanGeStabilityOutput {
     pub max_safe_length_error_m: Option<f64>,
     /// Cap of the critical-rate searches (m/s).
     pub rate_cap_m_s: f64,
-    /// Largest change of S − S₀ between table rows (N): the most the lower-neighbour interpolation takes off.
+    /// Bound on the table's interpolation error where it can change the plan (N): the largest change of
+    /// S − S₀ between table rows (the most the lower-neighbour interpolation takes off, plus its curvature margin)
+    /// over the intervals where the interpolated S can limit a schedule, i.e. S < (m + ρA L)·a_max + ρA·v_max² +
+    /// ε(1 − r)F at the interval's longer end; 0 where the stability ceiling binds nowhere. Converged in wind: 0
+    /// (no interpolation).
     pub interpolation_error_n: f64,
     /// The same as a critical length, interpolation_error_n / (ρA g) (m).
     pub interpolation_error_length_m: f64,
+    /// The same bound over every interval of the table (N), including short lengths where the bending offset
+    /// changes fast but the ceiling is far above the winch's rate and cannot bind.
+    pub interpolation_error_all_lengths_n: f64,
     pub table: Vec<PlanGeTableRowOutput>,
     pub check: Option<PlanGeCheckOutput>,
     /// Re-plans with a lowered GE criterion after a failed check.

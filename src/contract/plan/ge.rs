@@ -163,6 +163,7 @@ pub(super) fn ge_output(
         rate_cap_m_s: t.rate_cap_m_s,
         interpolation_error_n: t.interpolation_error_n,
         interpolation_error_length_m: t.interpolation_error_n / (rho_a * p.system.gravity_m_s2),
+        interpolation_error_all_lengths_n: t.interpolation_error_all_lengths_n,
         table: t
             .rows
             .iter()
