@@ -38,6 +38,17 @@ impl Observer for ProgressObserver<'_> {
     }
 }
 
+/// An observer that forwards cancellation only: the transient check of a
+/// re-planned schedule, after the first one already reported its progress
+/// to the end (progress never goes back).
+struct CancelOnly<'a>(&'a dyn Observer);
+
+impl Observer for CancelOnly<'_> {
+    fn cancelled(&self) -> bool {
+        self.0.cancelled()
+    }
+}
+
 fn from_transient(e: TransientError) -> RequestError {
     match e {
         TransientError::Invalid(e) => RequestError::Invalid(e),
@@ -296,6 +307,7 @@ fn find_schedule(
                 };
                 // The GE check (on rayon) and the transient check (one
                 // thread) side by side; a tightening drops the transient.
+                let quiet = CancelOnly(observer);
                 let (chk, check) = rayon::join(
                     || ge_check_of(&tightened.air, &s, ge_check_count(req)),
                     || {
@@ -303,7 +315,7 @@ fn find_schedule(
                             &v.model,
                             &s,
                             req.disturbance_tip_deflection_m,
-                            observer,
+                            if tightenings == 0 { observer } else { &quiet },
                         )
                     },
                 );
