@@ -45,7 +45,7 @@ use rayon::prelude::*;
 
 use crate::numerics::params::AerostatSystem;
 use crate::numerics::plan::{PlanProblem, STABILITY_MARGIN};
-use crate::numerics::tether::equilibrium::ShootingContinuation;
+use crate::numerics::tether::continuation::ShootingContinuation;
 use crate::numerics::tether::{
     Body, Cable, Equilibrium, EquilibriumConfig, EquilibriumProblem, WindProfile,
 };
