@@ -94,37 +94,21 @@ impl ShootingContinuation {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::numerics::tether::equilibrium::{
-        Body, Cable, EquilibriumConfig, EquilibriumProblem,
-    };
+    use crate::numerics::tether::equilibrium::{EquilibriumConfig, EquilibriumProblem};
     use crate::numerics::tether::wind::WindProfile;
 
     /// A log-law wind over the tether with drag: `z(winch)` depends on
     /// `z_top`, so the shooting iterates.
     fn sheared(length_m: f64) -> EquilibriumProblem {
-        EquilibriumProblem {
-            cable: Cable {
-                mass_per_length_kg_m: 0.05,
-                diameter_m: 0.006,
-                normal_drag_coefficient: 1.2,
-                axial_stiffness_n: None,
-                breaking_strength_n: Some(30_000.0),
-            },
-            body: Body {
-                net_buoyancy_n: 2000.0,
-                drag_coefficient: 0.3,
-                lift_coefficient: 0.0,
-                reference_area_m2: 20.0,
-            },
-            wind: WindProfile::LogLaw {
-                reference_speed_m_s: 6.0,
-                reference_height_m: 10.0,
-                roughness_length_m: 0.03,
-            },
-            air_density_kg_m3: 1.225,
-            tether_length_m: length_m,
-            gravity_m_s2: 9.81,
-        }
+        let mut p = crate::numerics::tether::equilibrium::tests::problem(0.0);
+        p.cable.normal_drag_coefficient = 1.2;
+        p.wind = WindProfile::LogLaw {
+            reference_speed_m_s: 6.0,
+            reference_height_m: 10.0,
+            roughness_length_m: 0.03,
+        };
+        p.tether_length_m = length_m;
+        p
     }
 
     #[test]

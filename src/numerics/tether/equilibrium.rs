@@ -764,10 +764,11 @@ pub fn catenary_top(h_n: f64, v_n: f64, w_n_m: f64, l_m: f64) -> (f64, f64) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn problem(wind: f64) -> EquilibriumProblem {
+    /// The test tether: 1000 m, 2000 N, no tether drag, in a uniform wind.
+    pub(crate) fn problem(wind: f64) -> EquilibriumProblem {
         EquilibriumProblem {
             cable: Cable {
                 mass_per_length_kg_m: 0.05,
