@@ -296,35 +296,55 @@ fn bands_request() -> Value {
 /// Runs `job` (submitted via `api`, 3 workers on `db`), SIGKILLs the worker
 /// of a running chunk once some chunk is done, and checks that every chunk
 /// is done exactly once; returns the job's stored answer (JSON text).
+///
+/// A worker can finish its chunk between the poll that sees it running and
+/// the kill. Then it holds nothing when it dies, so the kill proves nothing:
+/// a fresh worker takes its place and another running chunk's worker is
+/// killed, until a dead worker is seen holding a chunk.
 fn run_with_a_killed_worker(db: &TestDb, job: &Value) -> String {
     let api = Proc::api(&db.url);
     let mut workers: Vec<Option<Proc>> = (0..3).map(|_| Some(Proc::worker(&db.url))).collect();
     let mut pg = db.client();
     let id = api.submit(job);
-    // Mid-run: a chunk done, another held by a worker.
     let start = Instant::now();
-    let (victim_id, victim_chunk) = loop {
-        let rows = chunks(&mut pg, id);
-        let done = rows.iter().filter(|r| r.1 == "done").count();
-        if done >= 1
-            && done + 2 <= rows.len()
-            && let Some(r) = rows.iter().find(|r| r.1 == "running" && r.3.is_some())
-        {
-            break (r.3.clone().unwrap(), r.0);
+    let (victim_id, orphans) = 'kill: loop {
+        // Mid-run: a chunk done, another held by a live worker.
+        let (victim_id, victim) = loop {
+            let rows = chunks(&mut pg, id);
+            let done = rows.iter().filter(|r| r.1 == "done").count();
+            let held = rows.iter().filter(|r| r.1 == "running").find_map(|r| {
+                let owner = r.3.clone()?;
+                let index = workers
+                    .iter()
+                    .position(|w| w.as_ref().is_some_and(|w| w.pid() == pid_of(&owner)))?;
+                Some((owner, index))
+            });
+            if done >= 1
+                && done + 2 <= rows.len()
+                && let Some(held) = held
+            {
+                break held;
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(90),
+                "never mid-run: {rows:?}"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        workers[victim].take().unwrap().kill();
+        let orphans: Vec<i32> = chunks(&mut pg, id)
+            .iter()
+            .filter(|r| r.1 == "running" && r.3.as_deref() == Some(victim_id.as_str()))
+            .map(|r| r.0)
+            .collect();
+        if !orphans.is_empty() {
+            break 'kill (victim_id, orphans);
         }
-        assert!(
-            start.elapsed() < Duration::from_secs(90),
-            "never mid-run: {rows:?}"
-        );
-        std::thread::sleep(Duration::from_millis(20));
+        eprintln!("{victim_id} finished its chunk before the kill; killing another");
+        workers.push(Some(Proc::worker(&db.url)));
     };
     let n = chunks(&mut pg, id).len();
     assert!(n >= 4, "the job is split into {n} chunks");
-    let victim = workers
-        .iter()
-        .position(|w| w.as_ref().unwrap().pid() == pid_of(&victim_id))
-        .expect("the chunk's owner is one of the workers");
-    workers[victim].take().unwrap().kill();
     let v = api.wait_finished(id, Duration::from_secs(120));
     assert_eq!(v["status"], "done", "{v}");
     assert_eq!(v["progress"], 1.0);
@@ -335,16 +355,19 @@ fn run_with_a_killed_worker(db: &TestDb, job: &Value) -> String {
         rows.iter().all(|r| r.1 == "done"),
         "every chunk done once: {rows:?}"
     );
-    let killed = &rows[victim_chunk as usize];
-    assert!(
-        killed.2 >= 2,
-        "the killed chunk was claimed again: {killed:?}"
-    );
-    assert_ne!(
-        killed.4.as_deref(),
-        Some(victim_id.as_str()),
-        "the dead worker wrote nothing"
-    );
+    for &chunk in &orphans {
+        let killed = &rows[chunk as usize];
+        assert!(
+            killed.2 >= 2,
+            "the killed chunk was claimed again: {killed:?}"
+        );
+        assert_ne!(
+            killed.4.as_deref(),
+            Some(victim_id.as_str()),
+            "the dead worker wrote nothing"
+        );
+    }
+    let victim_chunk = orphans[0];
     let retried = rows.iter().filter(|r| r.2 >= 2).count();
     eprintln!("{n} chunks, {retried} retried after SIGKILL of {victim_id} (chunk {victim_chunk})");
     // The one stored answer is the one the API serves.
