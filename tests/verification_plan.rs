@@ -535,19 +535,57 @@ fn wind_margin(s: &tetherplan::contract::plan::dto::PlanSampleOutput, wind_m_s: 
     })
     .unwrap();
     assert!(!eq.slack);
+    // Paying out, the aerostat's ascent drag bound: ½ρ C_D A (v² + 2 U v).
+    let c_d = 0.5 * 1.225 * 0.47 * 3.0;
+    let v = s.rate_m_s.max(0.0);
     eq.min_tension_n
         - (10.0 + 0.078 * s.length_m) * s.acceleration_m_s2
         - 0.078 * s.rate_m_s * s.rate_m_s
+        - c_d * (v * v + 2.0 * wind_m_s * v)
 }
 
 #[test]
 fn wind_lowers_the_reachable_altitude_and_lengthens_the_plan() {
-    // Calm air through the wind path (U = 0) is the calm-air plan.
+    // Calm air through the wind path (U = 0) is the calm-air plan with the
+    // aerostat's ascent drag: its rate ceiling is the closed form
+    // √(((1 − r)(1 − ε)F − ρA g L − (m + ρA L)L̈)/(ρA + ½ρ C_D A)).
     let calm = run(thesis_body(1000.0, 0.05));
     let zero = run(windy(1000.0, 0.0));
     let (dc, dz) = (calm.duration_s.unwrap(), zero.duration_s.unwrap());
-    assert!((dc - dz).abs() < 1e-9 * dc, "{dc} vs {dz}");
+    assert!(
+        dz > 1.1 * dc,
+        "the ascent drag slows the plan: {dc} s vs {dz} s"
+    );
     assert!((zero.wind.as_ref().unwrap().target_length_m.unwrap() - 1000.0).abs() < 1e-6);
+    let c_d = 0.5 * 1.225 * 0.47 * 3.0;
+    let mut on_ceiling = 0;
+    for s in &zero.schedule {
+        let budget = 0.95 * (1.0 - 1e-3) * 1000.0
+            - 0.078 * 9.81 * s.length_m
+            - (10.0 + 0.078 * s.length_m) * s.acceleration_m_s2;
+        let ceiling = (budget / (0.078 + c_d)).sqrt();
+        assert!(
+            s.rate_m_s <= ceiling * (1.0 + 1e-3),
+            "t = {:.2} s: {} m/s above the closed-form ceiling {ceiling} m/s",
+            s.time_s,
+            s.rate_m_s
+        );
+        // the reported ceiling has no margin ε
+        let reported = ((budget + 0.95 * 1e-3 * 1000.0) / (0.078 + c_d)).sqrt();
+        assert!(
+            (s.rate_ceiling_m_s - reported).abs() < 1e-9 * reported,
+            "t = {:.2} s: reported ceiling {} against {reported}",
+            s.time_s,
+            s.rate_ceiling_m_s
+        );
+        if s.rate_m_s >= ceiling * (1.0 - 1e-3) {
+            on_ceiling += 1;
+        }
+    }
+    assert!(
+        on_ceiling > 10,
+        "the plan rides the ceiling ({on_ceiling} samples)"
+    );
     let mut last_duration = 0.0;
     let mut last_reach = f64::INFINITY;
     for u in [0.0, 2.0, 4.0, 6.0] {

@@ -453,7 +453,8 @@ pub struct PlanGeTableRowOutput {
     /// Converged table only: the estimated discretisation error of the critical rate (m/s); the rate
     /// is the safe side (best estimate minus this).
     pub critical_rate_error_m_s: Option<f64>,
-    /// The pass's rate ceiling at rest at this length, √((S − ε(1−r)F)/ρA) (m/s).
+    /// The pass's rate ceiling at rest at this length, paying out: the largest L̇ with
+    /// ρA L̇² + δ(L̇) ≤ S − ε(1−r)F, δ the bound on the aerostat's ascent drag (m/s).
     pub plan_rate_ceiling_m_s: f64,
     /// The string criterion's critical rate at this length (m/s), the closed form beside the GE
     /// one: √(T_min/ρA) of the static tether with the reserve buoyancy in the mean wind (calm air:

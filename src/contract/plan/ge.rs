@@ -174,9 +174,9 @@ pub(super) fn ge_output(
                 capped: r.capped,
                 unstable: r.unstable,
                 critical_rate_error_m_s: t.rate_error_m_s.get(i).copied(),
-                plan_rate_ceiling_m_s: ((w.stability_tension_n(p, r.length_m) - margin) / rho_a)
-                    .max(0.0)
-                    .sqrt(),
+                plan_rate_ceiling_m_s: w
+                    .ascent_drag(r.length_m)
+                    .ceiling_m_s(rho_a, w.stability_tension_n(p, r.length_m) - margin),
                 string_critical_rate_m_s: string_onset::critical_rate_m_s(
                     &w.problem(&p.system, p.reserve_buoyancy_n(), r.length_m),
                     &EquilibriumConfig::default(),

@@ -26,8 +26,11 @@
 //! ground). It is one function of `(problem, equilibrium)`, so a
 //! quasi-static geometrically exact check can replace it.
 //!
-//! Aerodynamic forces of the aerostat's own motion (payout speed against
-//! the wind) are neglected: the loads are those of the steady wind.
+//! Paying out, the aerostat climbs into the air and its own drag takes
+//! tension off the tether: [`super::ascent`] bounds the loss, `δ(L̇)`,
+//! and the stability criterion subtracts it
+//! (`T_eff = S − (m + ρA L)L̈ − ρA L̇² − δ(L̇)`). The tensions the rating
+//! bounds keep the loads at rest (the ascent only lowers them).
 //!
 //! **Gusts** (SPEC §10, [`SteadyWind::gust`]): every limit holds at the
 //! gust speed as well. The tensions the pass bounds are the larger of the
@@ -44,6 +47,7 @@ use std::sync::{Arc, Mutex};
 use rayon::prelude::*;
 
 use crate::numerics::params::AerostatSystem;
+use crate::numerics::plan::ascent::AscentDrag;
 use crate::numerics::plan::{PlanProblem, STABILITY_MARGIN};
 use crate::numerics::tether::continuation::ShootingContinuation;
 use crate::numerics::tether::{
@@ -63,10 +67,12 @@ pub struct RestLoads {
     pub top_tension_n: f64,
     /// Altitude of the aerostat above the winch, full buoyancy (m).
     pub altitude_m: f64,
+    /// The tension its ascent may take off while paying out.
+    pub ascent: AscentDrag,
 }
 
 impl RestLoads {
-    /// `T_eff = S − (m + ρA L) L̈ − ρA L̇²` (N).
+    /// `T_eff = S − (m + ρA L) L̈ − ρA L̇² − δ(L̇)` (N).
     pub fn effective_tension_n(
         &self,
         s: &AerostatSystem,
@@ -78,6 +84,7 @@ impl RestLoads {
         self.stability_tension_n
             - (s.aerostat_mass_kg + rho_a * length_m) * acc
             - rho_a * rate * rate
+            - self.ascent.loss_n(rate)
     }
 
     /// Winch tension with the acceleration (N).
@@ -94,9 +101,10 @@ impl RestLoads {
     /// Largest stable rate at this length and acceleration (m/s); 0 when
     /// even rest is unstable.
     pub fn rate_ceiling_m_s(&self, s: &AerostatSystem, length_m: f64, acc: f64) -> f64 {
-        (self.effective_tension_n(s, length_m, 0.0, acc) / s.mass_per_length_kg_m)
-            .max(0.0)
-            .sqrt()
+        self.ascent.ceiling_m_s(
+            s.mass_per_length_kg_m,
+            self.effective_tension_n(s, length_m, 0.0, acc),
+        )
     }
 }
 
@@ -250,6 +258,23 @@ impl SteadyWind {
         let eq = problem.solve_from(&self.config, c.start_at(l)).ok();
         c.record(l, eq.as_ref());
         eq
+    }
+
+    /// The bound on the tension the aerostat's ascent takes off at length
+    /// `length_m` ([`super::ascent`]): the faster of the mean wind and the
+    /// gust anywhere below it.
+    pub fn ascent_drag(&self, length_m: f64) -> AscentDrag {
+        let gust = self
+            .gust
+            .as_ref()
+            .map_or(0.0, |g| g.fastest_below_m_s(length_m));
+        AscentDrag::new(
+            self.air_density_kg_m3,
+            self.body.drag_coefficient,
+            self.body.lift_coefficient,
+            self.body.reference_area_m2,
+            self.wind.fastest_below_m_s(length_m).max(gust),
+        )
     }
 
     /// `S(L)` with the reserve buoyancy (N).
@@ -459,6 +484,7 @@ impl Air {
                     winch_tension_n: s.net_buoyancy_n - w,
                     top_tension_n: s.net_buoyancy_n,
                     altitude_m: length_m,
+                    ascent: AscentDrag::NONE,
                 }
             }
             Self::Wind(w) => {
@@ -468,6 +494,7 @@ impl Air {
                     winch_tension_n: winch,
                     top_tension_n: top,
                     altitude_m: alt,
+                    ascent: w.ascent_drag(length_m),
                 }
             }
         }
@@ -490,11 +517,13 @@ impl Air {
         along(lengths, |l, a| {
             let stability_tension_n = w.stability_tension_along(p, l, Some(a));
             let (winch, top, alt) = w.operating_along(s, l, Some(&mut a.full[0]));
+            let ascent = w.ascent_drag(l);
             let mean = RestLoads {
                 stability_tension_n,
                 winch_tension_n: winch,
                 top_tension_n: top,
                 altitude_m: alt,
+                ascent,
             };
             let gust = w
                 .gust_operating_along(s, l, Some(a))
@@ -503,9 +532,19 @@ impl Air {
                     winch_tension_n: winch,
                     top_tension_n: top,
                     altitude_m: alt,
+                    ascent,
                 });
             (mean, gust)
         })
+    }
+
+    /// The bound on the tension the aerostat's ascent takes off at a
+    /// length ([`super::ascent`]); none in calm air without the air's data.
+    pub fn ascent_drag(&self, length_m: f64) -> AscentDrag {
+        match self {
+            Self::Calm => AscentDrag::NONE,
+            Self::Wind(w) => w.ascent_drag(length_m),
+        }
     }
 
     /// Whether the wind has gusts.
@@ -525,6 +564,7 @@ impl Air {
             winch_tension_n: winch,
             top_tension_n: top,
             altitude_m: alt,
+            ascent: w.ascent_drag(length_m),
         })
     }
 

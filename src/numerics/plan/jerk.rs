@@ -172,15 +172,19 @@ pub(crate) fn shortfalls(p: &PlanProblem, grid: &Grid, s: &Schedule) -> (f64, f6
     let mut check = |t: f64| {
         let k = s.at(t);
         let l = k.length_m;
-        let cap = grid.interpolate(&grid.cap, l);
-        let x = sy.aerostat_mass_kg / rho_a + l;
-        stab = stab.max(rho_a * (k.rate_m_s * k.rate_m_s + x * k.acceleration_m_s2 - cap));
+        stab = stab.max(Grid::shortfall_n(
+            rho_a,
+            grid.stability_at(l),
+            k.rate_m_s * k.rate_m_s,
+            k.acceleration_m_s2,
+        ));
         if let (Some(allow), Some((w, top))) = (p.allowable_tension_n, &rest) {
             let r = RestLoads {
                 stability_tension_n: 0.0,
                 winch_tension_n: grid.interpolate(w, l),
                 top_tension_n: grid.interpolate(top, l),
                 altitude_m: l,
+                ascent: crate::numerics::plan::ascent::AscentDrag::NONE,
             };
             tension = tension.max(r.max_tension_at_n(sy, l, k.acceleration_m_s2) - allow);
         }

@@ -28,6 +28,7 @@
 //! forecast → latest haul-down start).
 
 pub mod air;
+pub mod ascent;
 pub mod deadline;
 pub mod ge_stability;
 pub mod jerk;

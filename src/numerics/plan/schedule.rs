@@ -192,10 +192,15 @@ pub(crate) struct Grid {
     pub(crate) h: f64,
     pub(crate) lengths: Vec<f64>,
     /// Stability right-hand side `(S(L) − ε(1 − r)F)/ρA` (m²/s²); calm
-    /// air: `((1 − r)(1 − ε)F − ρA g L)/ρA`.
+    /// air: `((1 − r)(1 − ε)F − ρA g L)/ρA`. Paying out with the
+    /// aerostat's ascent drag: `(S − ε(1 − r)F − a₁v₀/2)/(k ρA)`.
     pub(crate) cap: Vec<f64>,
-    /// `m/ρA + L` (m).
+    /// `(m + ρA L)/(k ρA)` (m).
     pub(crate) x: Vec<f64>,
+    /// The factor `k ≥ 1` on `ρA L̇²` that takes the aerostat's ascent
+    /// drag in ([`crate::numerics::plan::ascent`]; `cap` is divided by it
+    /// too): 1 without it.
+    pub(crate) k: Vec<f64>,
     /// Smallest `L̈` the tension rating allows (m/s²).
     pub(crate) floor: Vec<f64>,
     /// Winch and top tension at rest, full buoyancy (N), when rated.
@@ -259,19 +264,50 @@ impl Grid {
             };
             (cap, floor, rest)
         };
-        let x = lengths
+        let mut cap: Vec<f64> = cap;
+        let mut x: Vec<f64> = lengths
             .iter()
             .map(|&l| s.aerostat_mass_kg / rho_a + l)
             .collect();
+        let mut k = vec![1.0; lengths.len()];
+        if sigma > 0.0 && !air.is_calm() {
+            // Paying out: the ascent drag's linear form at each node.
+            for (i, &l) in lengths.iter().enumerate() {
+                let ascent = air.ascent_drag(l);
+                if ascent.is_none() {
+                    continue;
+                }
+                let (ki, budget) = ascent.linearised(rho_a, rho_a * cap[i]);
+                k[i] = ki;
+                cap[i] = budget / (rho_a * ki);
+                x[i] /= ki;
+            }
+        }
         Self {
             sigma,
             h,
             lengths,
             cap,
             x,
+            k,
             floor,
             rest_tensions,
         }
+    }
+
+    /// How far `T_eff` falls short of `ε(1 − r)F` at node data `(cap, x,
+    /// k)` with `u = L̇²` and `L̈ = acc` (N; ≤ 0 admissible).
+    pub(crate) fn shortfall_n(rho_a: f64, (cap, x, k): (f64, f64, f64), u: f64, acc: f64) -> f64 {
+        rho_a * k * (u + x * acc - cap)
+    }
+
+    /// The node data `(cap, x, k)` interpolated at length `l`.
+    pub(crate) fn stability_at(&self, l: f64) -> (f64, f64, f64) {
+        (
+            self.interpolate(&self.cap, l),
+            self.interpolate(&self.x, l),
+            self.interpolate(&self.k, l),
+        )
     }
 
     /// The same grid with the stability margin moved from `from` to `to`
@@ -292,8 +328,14 @@ impl Grid {
             sigma: self.sigma,
             h: self.h,
             lengths: self.lengths.clone(),
-            cap: self.cap.iter().map(|c| c - shift).collect(),
+            cap: self
+                .cap
+                .iter()
+                .zip(&self.k)
+                .map(|(c, k)| c - shift / k)
+                .collect(),
             x: self.x.clone(),
+            k: self.k.clone(),
             floor,
             rest_tensions: self.rest_tensions.clone(),
         }
@@ -532,7 +574,7 @@ pub(crate) fn pass_on(p: &PlanProblem, g: &Grid, margin: f64, air: &Air) -> Plan
             let short = if air.is_calm() {
                 margin * f_scale - p.effective_tension_n(g.lengths[k], vel, a_phys)
             } else {
-                rho_a * (vel * vel + g.x[k] * a_phys - g.cap[k])
+                Grid::shortfall_n(rho_a, (g.cap[k], g.x[k], g.k[k]), vel * vel, a_phys)
             };
             worst = worst.max(short);
         }
@@ -724,9 +766,8 @@ fn trapezoid_ok(p: &PlanProblem, v: f64, grid: Option<&Grid>) -> bool {
             if let Some(g) = grid {
                 let sy = &p.system;
                 let rho_a = sy.mass_per_length_kg_m;
-                // T_eff − εR = ρA (cap − v² − x L̈)
-                let cap = g.interpolate(&g.cap, l);
-                let ok = rho_a * (cap - u - (sy.aerostat_mass_kg / rho_a + l) * acc) >= -tol;
+                // T_eff − εR = k ρA (cap − v² − x L̈)
+                let ok = Grid::shortfall_n(rho_a, g.stability_at(l), u, acc) <= tol;
                 let rated = match (p.allowable_tension_n, &g.rest_tensions) {
                     (Some(allow), Some(r)) => {
                         let w: Vec<f64> = r.iter().map(|x| x.0).collect();
@@ -736,6 +777,7 @@ fn trapezoid_ok(p: &PlanProblem, v: f64, grid: Option<&Grid>) -> bool {
                             winch_tension_n: g.interpolate(&w, l),
                             top_tension_n: g.interpolate(&t, l),
                             altitude_m: l,
+                            ascent: crate::numerics::plan::ascent::AscentDrag::NONE,
                         };
                         rest.max_tension_at_n(sy, l, acc) <= allow * (1.0 + 1e-12)
                     }

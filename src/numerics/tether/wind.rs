@@ -84,6 +84,26 @@ impl WindProfile {
         }
     }
 
+    /// The fastest `|U|` at any height from the ground to `z_m` (m/s):
+    /// the uniform, power and log laws grow with height, a table is
+    /// searched through its points.
+    pub fn fastest_below_m_s(&self, z_m: f64) -> f64 {
+        let at_top = self.speed_m_s(z_m).abs();
+        match self {
+            Self::Flow(SteadyFlow::Tabulated {
+                elevations_m,
+                speeds_m_s,
+            }) => elevations_m
+                .iter()
+                .zip(speeds_m_s)
+                .enumerate()
+                .filter(|&(i, (&z, _))| i == 0 || z <= z_m)
+                .map(|(_, (_, &u))| u.abs())
+                .fold(at_top, f64::max),
+            _ => at_top,
+        }
+    }
+
     /// Whether `U` does not depend on `z` (the shooting then needs no iteration).
     pub fn is_uniform(&self) -> bool {
         matches!(self, Self::Flow(SteadyFlow::Uniform { .. }))
