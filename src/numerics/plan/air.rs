@@ -129,7 +129,8 @@ pub fn string_tension_criterion(problem: &EquilibriumProblem, eq: &Equilibrium) 
 /// What [`string_tension_criterion`] is, for the answer.
 pub const STRING_TENSION_CRITERION: &str = "string tension criterion on the steady-wind equilibrium \
 (as the operating envelope): the smallest tension of the blown-down tether with the reserve buoyancy, less \
-(m + ρA L)L̈ + ρA L̇², must stay ≥ ε(1−r)F; a slack tether (touching the ground) is unstable";
+(m + ρA L)L̈ + ρA L̇² and, paying out, the bound on the aerostat's ascent drag, must stay ≥ ε(1−r)F; a slack \
+tether (touching the ground) is unstable";
 
 /// A steady wind and the aerodynamic data of the tether and the aerostat.
 #[derive(Clone, Debug)]

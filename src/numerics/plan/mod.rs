@@ -16,7 +16,8 @@
 //! from above, so the criterion is the converged, conservative limit). The
 //! plan keeps `T_eff ≥ ε (1 − r)F` with the safety margin
 //! [`STABILITY_MARGIN`]. Accelerating payout lowers the rate ceiling
-//! `√((T_eff + ρA L̇²)/ρA)`; braking raises it.
+//! `√((T_eff + ρA L̇²)/ρA)`; braking raises it. With the air's data the
+//! aerostat's own drag while it climbs is taken off too ([`ascent`]).
 //!
 //! **Tension.** The axial force is `T(x) = F − m L̈ − ρA (g + L̈)(L − x)`:
 //! largest at the aerostat (`F − m L̈`) unless `L̈ < −g`; the winch holds
