@@ -77,7 +77,7 @@ impl SegmentLimit {
         match self {
             Self::Accelerate => "speed up at the winch's maximum acceleration",
             Self::Cruise => "hold the winch's maximum rate",
-            Self::Stability => "follow the stability ceiling (rate set by the lift reserve)",
+            Self::Stability => "follow the stability ceiling (the rate the lift reserve and the climb allow)",
             Self::Tension => "change speed no faster than the tension rating allows",
             Self::Brake => "slow down at the winch's maximum deceleration",
         }
