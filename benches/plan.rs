@@ -91,7 +91,12 @@ fn bench(c: &mut Criterion) {
     // Then the shootings continued along the grid's lengths (about one
     // RK4 pass per equilibrium instead of five) and the GE check run
     // beside the transient check: 149 ms (string method 103 ms), target
-    // met. Before (below): the GE divergence levels.
+    // met. Then the plan counted the aerostat's ascent drag (the stability
+    // ceiling now binds: a longer schedule, 4000 knots of varying rate):
+    // 192 ms (string method 171 ms), a fifth of it finding a rate table's
+    // stop time by a linear search at every kinematics call of the
+    // transient check. With the stop time found once: 165 ms (string
+    // method 118 ms). Before (below): the GE divergence levels.
     // Speed21 (fused equilibrium Newton, slice band LU, memoised
     // continuum starts, no air damping in Newton; answers bit for bit):
     // one plan on one thread 0.96 → 0.68 s CPU, 21.7 → 12.8 G

@@ -47,6 +47,9 @@ pub enum Profile {
     PiecewiseLinearRate {
         schedule: RateSchedule,
         target_length_m: Option<f64>,
+        /// When it stops (s), found once when it is built (a search
+        /// through the table).
+        stop_s: Option<f64>,
     },
 }
 
@@ -361,9 +364,20 @@ impl Profile {
                 ));
             }
         }
+        let reach = match target_length_m {
+            Some(target) => {
+                schedule.first_crossing(target, (target - schedule.initial_length_m).signum())
+            }
+            None => schedule.first_crossing(0.0, -1.0),
+        };
+        let stop_s = match (reach, schedule.rest_time_s()) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
         let profile = Self::PiecewiseLinearRate {
             schedule,
             target_length_m,
+            stop_s,
         };
         let horizon = profile
             .stop_time_s()
@@ -401,8 +415,9 @@ impl Profile {
 
     /// Length, rate and acceleration at time `t_s`.
     pub fn kinematics(&self, t_s: f64) -> Kinematics {
-        let t = t_s.min(self.stop_time_s().unwrap_or(f64::INFINITY));
-        let stopped = self.stop_time_s().is_some_and(|stop| t_s >= stop);
+        let stop = self.stop_time_s();
+        let t = t_s.min(stop.unwrap_or(f64::INFINITY));
+        let stopped = stop.is_some_and(|stop| t_s >= stop);
         let moving = |k: Kinematics| {
             if stopped {
                 Kinematics {
@@ -452,6 +467,7 @@ impl Profile {
             Self::PiecewiseLinearRate {
                 schedule,
                 target_length_m,
+                ..
             } => {
                 let k = moving(schedule.kinematics(t));
                 match target_length_m {
@@ -500,20 +516,7 @@ impl Profile {
                 (target_length_m - schedule.initial_length_m) / cruise_rate_m_s
                     + 0.5 * (ramp_up_s + ramp_down_s),
             ),
-            Self::PiecewiseLinearRate {
-                ref schedule,
-                target_length_m,
-            } => {
-                let reach = match target_length_m {
-                    Some(target) => schedule
-                        .first_crossing(target, (target - schedule.initial_length_m).signum()),
-                    None => schedule.first_crossing(0.0, -1.0),
-                };
-                match (reach, schedule.rest_time_s()) {
-                    (Some(a), Some(b)) => Some(a.min(b)),
-                    (a, b) => a.or(b),
-                }
-            }
+            Self::PiecewiseLinearRate { stop_s, .. } => stop_s,
         }
     }
 

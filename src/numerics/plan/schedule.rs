@@ -77,7 +77,9 @@ impl SegmentLimit {
         match self {
             Self::Accelerate => "speed up at the winch's maximum acceleration",
             Self::Cruise => "hold the winch's maximum rate",
-            Self::Stability => "follow the stability ceiling (the rate the lift reserve and the climb allow)",
+            Self::Stability => {
+                "follow the stability ceiling (the rate the lift reserve and the climb allow)"
+            }
             Self::Tension => "change speed no faster than the tension rating allows",
             Self::Brake => "slow down at the winch's maximum deceleration",
         }
