@@ -235,7 +235,7 @@ impl Grid {
         let lengths: Vec<f64> = (0..=n)
             .map(|i| if sigma > 0.0 { node(i) } else { node(n - i) })
             .collect();
-        let (cap, floor, rest_tensions) = if air.is_calm() {
+        let (mut cap, floor, rest_tensions): (Vec<f64>, _, _) = if air.is_calm() {
             let cap = lengths
                 .iter()
                 .map(|&l| {
@@ -266,7 +266,6 @@ impl Grid {
             };
             (cap, floor, rest)
         };
-        let mut cap: Vec<f64> = cap;
         let mut x: Vec<f64> = lengths
             .iter()
             .map(|&l| s.aerostat_mass_kg / rho_a + l)
