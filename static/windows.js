@@ -52,17 +52,6 @@
   <div id="windows-bands" class="windows-bands" aria-label="Launch windows"></div>`;
   plan.after(section);
   const $ = (id) => document.getElementById(id);
-  const style = document.createElement("style");
-  style.textContent = `
-  .windows-timeline{display:flex;gap:2px;align-items:flex-end;height:140px;overflow-x:auto;margin:.5rem 0}
-  .windows-timeline button{flex:0 0 2.2rem;padding:0;border:1px solid #888;display:flex;flex-direction:column;justify-content:flex-end;height:100%;background:#fafafa;cursor:pointer;font-size:.65rem}
-  .windows-timeline button[data-verdict=go] .bar{background:#2e7d32}
-  .windows-timeline button[data-verdict=no-go] .bar{background:#c62828}
-  .windows-timeline button[aria-pressed=true]{outline:3px solid #1565c0}
-  .windows-timeline .bar{width:100%}
-  .windows-bands{position:relative;height:1.2rem}
-  .windows-bands span{position:absolute;height:100%;background:#a5d6a7;border:1px solid #2e7d32;font-size:.7rem;overflow:hidden}`;
-  document.head.append(style);
 
   function detect(text) {
     const t = text.trim();

