@@ -8,6 +8,7 @@ pub mod dynamics;
 pub mod ge;
 pub mod ge_reduced;
 pub mod mesh;
+pub mod monitor;
 pub mod newmark;
 pub mod params;
 pub mod plan;
