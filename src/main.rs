@@ -121,6 +121,10 @@ enum Command {
     /// The largest tension over an exposure, Monte Carlo over turbulence
     /// seeds (progress bar in samples).
     DynamicsPeaks(InputArg),
+    /// Launch windows by the hour from a forecast (Open-Meteo JSON, METAR,
+    /// TAF or CSV): each period judged as the plan judges its wind
+    /// (progress bar in plans).
+    Windows(InputArg),
 }
 
 /// A progress bar on standard error for `total` units of `what`.
@@ -290,6 +294,14 @@ fn main() -> ExitCode {
             req.prepare()?;
             let bar = progress_bar(req.samples as u64, "samples");
             let out = contract::dynamics::peaks::peaks(req, Parallelism::Rayon, &bar);
+            bar.0.finish_and_clear();
+            out
+        }),
+        Command::Windows(arg) => answer_with(arg, contract::windows::parse_windows, |req| {
+            let started = std::time::Instant::now();
+            let prepared = contract::windows::prepare(req)?;
+            let bar = progress_bar(prepared.plan_count() as u64, "plans");
+            let out = contract::windows::run::answer(req, &prepared, &bar, started);
             bar.0.finish_and_clear();
             out
         }),

@@ -24,6 +24,7 @@ pub mod solve;
 pub mod spec;
 pub mod systems;
 pub mod tether;
+pub mod windows;
 
 use std::path::Path;
 use std::sync::Arc;
@@ -173,6 +174,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
         )
         .route("/api/v1/dynamics", post(dynamics::run_dynamics))
         .route("/api/v1/dynamics/peaks", post(dynamics::run_dynamics_peaks))
+        .route("/api/v1/windows", post(windows::compute_windows))
         .route("/api/v1/systems", get(systems::list_systems))
         .route(
             "/api/v1/systems/{name}",

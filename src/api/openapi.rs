@@ -41,6 +41,7 @@ use crate::jobs::store::JobStatus;
         crate::api::bands::compute_envelope_bands,
         crate::api::dynamics::run_dynamics,
         crate::api::dynamics::run_dynamics_peaks,
+        crate::api::windows::compute_windows,
         crate::api::systems::put_system,
         crate::api::systems::get_system,
         crate::api::systems::delete_system,
@@ -61,6 +62,7 @@ use crate::jobs::store::JobStatus;
         Health, crate::contract::bands::BandsResponse,
         crate::contract::bands::PlanBandsResponse, crate::contract::bands::EnvelopeBandsResponse,
         crate::contract::dynamics::DynamicsResponse, crate::contract::dynamics::DynamicsPeaksResponse,
+        crate::contract::windows::WindowsResponse,
     )),
     modifiers(&BearerTokens),
     tags(

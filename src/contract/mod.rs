@@ -19,6 +19,7 @@ pub mod ranges;
 pub mod string;
 pub mod system;
 pub mod transient;
+pub mod windows;
 
 // The old paths of the modules that moved into their domain folders, kept
 // for the API, the jobs, the CLI and the tests.

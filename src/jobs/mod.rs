@@ -17,6 +17,7 @@
 pub mod bands;
 pub mod chunks;
 pub mod dynamics;
+pub mod windows;
 pub mod estimate;
 pub mod flights;
 pub mod flights_sqlite;

@@ -5,6 +5,7 @@
 pub mod aero;
 pub mod chart;
 pub mod dynamics;
+pub mod forecast;
 pub mod ge;
 pub mod ge_reduced;
 pub mod mesh;
