@@ -48,19 +48,37 @@ fn batch(t0: f64, n: usize, f: impl Fn(f64) -> f64) -> Value {
     )
 }
 
-async fn send_body(app: &axum::Router, token: &str, uri: &str, ct: &str, body: String) -> (StatusCode, Value) {
+async fn send_body(
+    app: &axum::Router,
+    token: &str,
+    uri: &str,
+    ct: &str,
+    body: String,
+) -> (StatusCode, Value) {
     let req = Request::builder()
         .method("POST")
         .uri(uri)
         .header(header::CONTENT_TYPE, ct)
         .header(header::AUTHORIZATION, format!("Bearer {token}"));
     let a = request(app, req, Body::from(body)).await;
-    (a.status, serde_json::from_str(&a.text).unwrap_or(Value::Null))
+    (
+        a.status,
+        serde_json::from_str(&a.text).unwrap_or(Value::Null),
+    )
 }
 
-async fn as_json(app: &axum::Router, token: &str, method: &str, uri: &str, body: Option<&Value>) -> (StatusCode, Value) {
+async fn as_json(
+    app: &axum::Router,
+    token: &str,
+    method: &str,
+    uri: &str,
+    body: Option<&Value>,
+) -> (StatusCode, Value) {
     let (s, t) = send_as(app, token, method, uri, body).await;
-    (s, serde_json::from_str(&t).unwrap_or_else(|e| panic!("{e}: {t}")))
+    (
+        s,
+        serde_json::from_str(&t).unwrap_or_else(|e| panic!("{e}: {t}")),
+    )
 }
 
 fn check<'a>(flight: &'a Value, name: &str) -> &'a Value {
@@ -75,7 +93,14 @@ fn check<'a>(flight: &'a Value, name: &str) -> &'a Value {
 #[tokio::test]
 async fn a_flight_belongs_to_its_token_and_its_monitor_raises_and_latches() {
     let (app, _) = app_with_tokens(&["alpha", "beta"]);
-    let (s, created) = as_json(&app, "alpha", "POST", "/api/v1/flights", Some(&flight_body("one"))).await;
+    let (s, created) = as_json(
+        &app,
+        "alpha",
+        "POST",
+        "/api/v1/flights",
+        Some(&flight_body("one")),
+    )
+    .await;
     assert_eq!(s, StatusCode::CREATED, "{created}");
     assert_eq!(created["state"], "unavailable");
     assert_eq!(created["limits"]["allowable_tension_n"], 4000.0);
@@ -89,7 +114,14 @@ async fn a_flight_belongs_to_its_token_and_its_monitor_raises_and_latches() {
     let (_, list) = as_json(&app, "beta", "GET", "/api/v1/flights", None).await;
     assert_eq!(list["flights"], json!([]));
     for path in ["end", "telemetry", "alarms/acknowledge"] {
-        let (s, _) = send_body(&app, "beta", &format!("{uri}/{path}"), "application/json", "[]".into()).await;
+        let (s, _) = send_body(
+            &app,
+            "beta",
+            &format!("{uri}/{path}"),
+            "application/json",
+            "[]".into(),
+        )
+        .await;
         assert_eq!(s, StatusCode::NOT_FOUND, "{path}");
     }
     let (_, list) = as_json(&app, "alpha", "GET", "/api/v1/flights", None).await;
@@ -98,23 +130,64 @@ async fn a_flight_belongs_to_its_token_and_its_monitor_raises_and_latches() {
     // 1000 N for 2 s: normal; then 4400 N (past 4000: stop) for 2 s; then
     // 1000 N for 10 s: the stop clears after 5 s but stays latched
     let tele = format!("{uri}/telemetry");
-    let (s, a) = send_body(&app, "alpha", &tele, "application/json", batch(0.0, 20, |_| 1000.0).to_string()).await;
-    assert_eq!((s, a["accepted"].as_u64()), (StatusCode::OK, Some(20)), "{a}");
+    let (s, a) = send_body(
+        &app,
+        "alpha",
+        &tele,
+        "application/json",
+        batch(0.0, 20, |_| 1000.0).to_string(),
+    )
+    .await;
+    assert_eq!(
+        (s, a["accepted"].as_u64()),
+        (StatusCode::OK, Some(20)),
+        "{a}"
+    );
     assert_eq!(a["state"], "normal", "{a}");
-    let (_, a) = send_body(&app, "alpha", &tele, "application/json", batch(2.0, 20, |_| 4400.0).to_string()).await;
+    let (_, a) = send_body(
+        &app,
+        "alpha",
+        &tele,
+        "application/json",
+        batch(2.0, 20, |_| 4400.0).to_string(),
+    )
+    .await;
     assert_eq!(a["state"], "stop", "{a}");
-    let (_, a) = send_body(&app, "alpha", &tele, "application/json", batch(4.0, 100, |_| 1000.0).to_string()).await;
+    let (_, a) = send_body(
+        &app,
+        "alpha",
+        &tele,
+        "application/json",
+        batch(4.0, 100, |_| 1000.0).to_string(),
+    )
+    .await;
     assert_eq!(a["state"], "stop", "latched: {a}");
     let (_, f) = as_json(&app, "alpha", "GET", &uri, None).await;
     let tension = check(&f, "tension");
-    assert_eq!((tension["state"].as_str(), tension["stop_at"].as_f64()), (Some("stop"), Some(4000.0)));
-    let stop = f["alarms"].as_array().unwrap().iter().find(|a| a["level"] == "stop").unwrap().clone();
+    assert_eq!(
+        (tension["state"].as_str(), tension["stop_at"].as_f64()),
+        (Some("stop"), Some(4000.0))
+    );
+    let stop = f["alarms"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["level"] == "stop")
+        .unwrap()
+        .clone();
     assert_eq!(stop["raised_at_s"], 3.0);
     assert_eq!(stop["cleared_at_s"], 9.0);
     assert_eq!(stop["acknowledged_at_s"], Value::Null);
     assert_eq!(f["samples_received"], 140);
     assert_eq!(f["last_sample_time_s"], 13.9);
-    let (s, ack) = as_json(&app, "alpha", "POST", &format!("{uri}/alarms/acknowledge"), None).await;
+    let (s, ack) = as_json(
+        &app,
+        "alpha",
+        "POST",
+        &format!("{uri}/alarms/acknowledge"),
+        None,
+    )
+    .await;
     assert_eq!(s, StatusCode::OK);
     assert_eq!(ack["state"], "normal", "{ack}");
     assert_eq!(ack["acknowledged"], 2); // the caution and the stop
@@ -122,46 +195,86 @@ async fn a_flight_belongs_to_its_token_and_its_monitor_raises_and_latches() {
     // ended: telemetry refused
     let (s, _) = as_json(&app, "alpha", "POST", &format!("{uri}/end"), None).await;
     assert_eq!(s, StatusCode::OK);
-    let (s, _) = send_body(&app, "alpha", &tele, "application/json", batch(20.0, 1, |_| 1.0).to_string()).await;
+    let (s, _) = send_body(
+        &app,
+        "alpha",
+        &tele,
+        "application/json",
+        batch(20.0, 1, |_| 1.0).to_string(),
+    )
+    .await;
     assert_eq!(s, StatusCode::CONFLICT);
 }
 
 #[tokio::test]
 async fn a_repeated_batch_stores_nothing_twice_and_a_late_one_is_judged_in_time_order() {
     let (app, _) = app_with_tokens(&["alpha"]);
-    let (_, created) = as_json(&app, "alpha", "POST", "/api/v1/flights", Some(&flight_body("dup"))).await;
+    let (_, created) = as_json(
+        &app,
+        "alpha",
+        "POST",
+        "/api/v1/flights",
+        Some(&flight_body("dup")),
+    )
+    .await;
     let uri = format!("/api/v1/flights/{}", created["id"]);
     let tele = format!("{uri}/telemetry");
     // a caution (3500 N > 3200 N) from t = 5 to 7 s
-    let f = |t: f64| if (5.0..7.0).contains(&t) { 3500.0 } else { 1000.0 };
+    let f = |t: f64| {
+        if (5.0..7.0).contains(&t) {
+            3500.0
+        } else {
+            1000.0
+        }
+    };
     let b1 = batch(0.0, 50, f).to_string();
     let b2 = batch(5.0, 50, f).to_string();
     let (_, a) = send_body(&app, "alpha", &tele, "application/json", b2.clone()).await;
-    assert_eq!((a["accepted"].as_u64(), a["duplicates"].as_u64()), (Some(50), Some(0)));
+    assert_eq!(
+        (a["accepted"].as_u64(), a["duplicates"].as_u64()),
+        (Some(50), Some(0))
+    );
     // the earlier batch arrives late
     let (_, a) = send_body(&app, "alpha", &tele, "application/json", b1).await;
-    assert_eq!((a["accepted"].as_u64(), a["duplicates"].as_u64()), (Some(50), Some(0)));
+    assert_eq!(
+        (a["accepted"].as_u64(), a["duplicates"].as_u64()),
+        (Some(50), Some(0))
+    );
     let (_, a) = send_body(&app, "alpha", &tele, "application/json", b2).await;
-    assert_eq!((a["accepted"].as_u64(), a["duplicates"].as_u64()), (Some(0), Some(50)));
+    assert_eq!(
+        (a["accepted"].as_u64(), a["duplicates"].as_u64()),
+        (Some(0), Some(50))
+    );
     assert_eq!(a["samples_received"], 100);
     let (_, fl) = as_json(&app, "alpha", "GET", &uri, None).await;
     let alarms = fl["alarms"].as_array().unwrap();
     assert_eq!(alarms.len(), 1, "{fl}");
     assert_eq!(
-        (alarms[0]["check"].as_str(), alarms[0]["level"].as_str(), alarms[0]["raised_at_s"].as_f64()),
+        (
+            alarms[0]["check"].as_str(),
+            alarms[0]["level"].as_str(),
+            alarms[0]["raised_at_s"].as_f64()
+        ),
         (Some("tension"), Some("caution"), Some(6.0))
     );
     // CSV of the same names, one bad cell named by line and field
     let csv = "time_s,winch_tension_n,wind_speed_m_s\n10.0,1000,5\n10.1,lots,5\n10.2,1000,5\n";
     let (s, a) = send_body(&app, "alpha", &tele, "text/csv", csv.into()).await;
     assert_eq!(s, StatusCode::OK);
-    assert_eq!((a["accepted"].as_u64(), a["rejected"].as_u64()), (Some(2), Some(1)));
+    assert_eq!(
+        (a["accepted"].as_u64(), a["rejected"].as_u64()),
+        (Some(2), Some(1))
+    );
     assert_eq!(a["errors"][0]["line"], 3);
     assert_eq!(a["errors"][0]["field"], "winch_tension_n");
     // unknown fields are refused by name, the good samples kept
-    let body = json!([{"time_s": 11.0, "winch_tension_n": 1000.0}, {"time_s": 11.1, "tension_n": 3.0}]);
+    let body =
+        json!([{"time_s": 11.0, "winch_tension_n": 1000.0}, {"time_s": 11.1, "tension_n": 3.0}]);
     let (_, a) = send_body(&app, "alpha", &tele, "application/json", body.to_string()).await;
-    assert_eq!((a["accepted"].as_u64(), a["rejected"].as_u64()), (Some(1), Some(1)));
+    assert_eq!(
+        (a["accepted"].as_u64(), a["rejected"].as_u64()),
+        (Some(1), Some(1))
+    );
     assert_eq!(a["errors"][0]["field"], "tension_n");
     let (s, _) = send_body(&app, "alpha", &tele, "application/xml", "<a/>".into()).await;
     assert_eq!(s, StatusCode::UNSUPPORTED_MEDIA_TYPE);
@@ -175,27 +288,68 @@ fn nmea(body: &str) -> String {
 #[tokio::test]
 async fn nmea_v_is_not_used_and_knots_are_converted() {
     let (app, _) = app_with_tokens(&["alpha"]);
-    let (_, created) = as_json(&app, "alpha", "POST", "/api/v1/flights", Some(&flight_body("nmea"))).await;
+    let (_, created) = as_json(
+        &app,
+        "alpha",
+        "POST",
+        "/api/v1/flights",
+        Some(&flight_body("nmea")),
+    )
+    .await;
     let uri = format!("/api/v1/flights/{}", created["id"]);
     let lines = [
         format!("1.0,{}", nmea("WIMWV,090.0,R,20.0,N,V")), // 10.3 m/s, but flagged V
         format!("2.0,{}", nmea("WIMWV,090.0,R,10.0,N,A")),
     ];
-    let (s, a) = send_body(&app, "alpha", &format!("{uri}/telemetry"), "text/plain", lines.join("\n")).await;
+    let (s, a) = send_body(
+        &app,
+        "alpha",
+        &format!("{uri}/telemetry"),
+        "text/plain",
+        lines.join("\n"),
+    )
+    .await;
     assert_eq!(s, StatusCode::OK, "{a}");
-    assert_eq!((a["accepted"].as_u64(), a["rejected"].as_u64()), (Some(1), Some(1)), "{a}");
-    assert_eq!((a["errors"][0]["line"].as_u64(), a["errors"][0]["field"].as_str()), (Some(1), Some("data_valid")));
+    assert_eq!(
+        (a["accepted"].as_u64(), a["rejected"].as_u64()),
+        (Some(1), Some(1)),
+        "{a}"
+    );
+    assert_eq!(
+        (
+            a["errors"][0]["line"].as_u64(),
+            a["errors"][0]["field"].as_str()
+        ),
+        (Some(1), Some("data_valid"))
+    );
     let (_, f) = as_json(&app, "alpha", "GET", &uri, None).await;
     // the 10-minute mean of the one valid sample: 10 kn exactly
-    assert_eq!(check(&f, "wind")["value"].as_f64(), Some(10.0 * 1852.0 / 3600.0));
+    assert_eq!(
+        check(&f, "wind")["value"].as_f64(),
+        Some(10.0 * 1852.0 / 3600.0)
+    );
 }
 
 #[tokio::test]
 async fn events_replay_what_a_client_missed_after_last_event_id() {
     let (app, _) = app_with_tokens(&["alpha"]);
-    let (_, created) = as_json(&app, "alpha", "POST", "/api/v1/flights", Some(&flight_body("sse"))).await;
+    let (_, created) = as_json(
+        &app,
+        "alpha",
+        "POST",
+        "/api/v1/flights",
+        Some(&flight_body("sse")),
+    )
+    .await;
     let uri = format!("/api/v1/flights/{}", created["id"]);
-    send_body(&app, "alpha", &format!("{uri}/telemetry"), "application/json", batch(0.0, 10, |_| 900.0).to_string()).await;
+    send_body(
+        &app,
+        "alpha",
+        &format!("{uri}/telemetry"),
+        "application/json",
+        batch(0.0, 10, |_| 900.0).to_string(),
+    )
+    .await;
     let req = Request::builder()
         .uri(format!("{uri}/events"))
         .header(header::AUTHORIZATION, "Bearer alpha")
@@ -219,10 +373,18 @@ async fn events_replay_what_a_client_missed_after_last_event_id() {
     }
     let data = text
         .lines()
-        .find_map(|l| l.strip_prefix("data: ").filter(|d| d.contains("\"samples\"")))
+        .find_map(|l| {
+            l.strip_prefix("data: ")
+                .filter(|d| d.contains("\"samples\""))
+        })
         .unwrap_or_else(|| panic!("{text}"));
     let v: Value = serde_json::from_str(data).unwrap();
-    let seqs: Vec<i64> = v["samples"].as_array().unwrap().iter().map(|s| s["seq"].as_i64().unwrap()).collect();
+    let seqs: Vec<i64> = v["samples"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["seq"].as_i64().unwrap())
+        .collect();
     assert_eq!(seqs, vec![8, 9, 10]);
     assert!(text.contains("id: 10"), "{text}");
 }
@@ -230,12 +392,26 @@ async fn events_replay_what_a_client_missed_after_last_event_id() {
 #[tokio::test]
 async fn the_replan_starts_from_the_measured_length() {
     let (app, _) = app_with_tokens(&["alpha"]);
-    let (_, created) = as_json(&app, "alpha", "POST", "/api/v1/flights", Some(&flight_body("replan"))).await;
+    let (_, created) = as_json(
+        &app,
+        "alpha",
+        "POST",
+        "/api/v1/flights",
+        Some(&flight_body("replan")),
+    )
+    .await;
     let uri = format!("/api/v1/flights/{}", created["id"]);
     let (s, e) = send_as(&app, "alpha", "GET", &format!("{uri}/replan"), None).await;
     assert_eq!(s, StatusCode::UNPROCESSABLE_ENTITY, "{e}");
     let body = json!([{"time_s": 40.0, "tether_length_m": 100.0}]);
-    send_body(&app, "alpha", &format!("{uri}/telemetry"), "application/json", body.to_string()).await;
+    send_body(
+        &app,
+        "alpha",
+        &format!("{uri}/telemetry"),
+        "application/json",
+        body.to_string(),
+    )
+    .await;
     let (s, r) = as_json(&app, "alpha", "GET", &format!("{uri}/replan"), None).await;
     assert_eq!(s, StatusCode::OK, "{r}");
     assert_eq!(r["mode"], "continue", "{r}");
@@ -268,7 +444,10 @@ impl Server {
     fn send(&self, method: &str, path: &str, ct: &str, body: &[u8]) -> (u16, Value) {
         let s = connect(self.addr, Duration::from_secs(60));
         let r = exchange(s, method, path, &self.addr.to_string(), Some(ct), body);
-        (r.status, serde_json::from_str(&r.body).unwrap_or(Value::Null))
+        (
+            r.status,
+            serde_json::from_str(&r.body).unwrap_or(Value::Null),
+        )
     }
 }
 
@@ -281,7 +460,9 @@ impl Drop for Server {
 
 /// The flight without what depends on the server's clock.
 fn comparable(mut f: Value) -> Value {
-    f.as_object_mut().unwrap().remove("seconds_since_last_sample_s");
+    f.as_object_mut()
+        .unwrap()
+        .remove("seconds_since_last_sample_s");
     let checks = f["checks"].as_array_mut().unwrap();
     checks.retain(|c| c["name"] != "data");
     f
@@ -293,7 +474,12 @@ fn a_server_killed_with_sigkill_keeps_every_acknowledged_sample_and_its_state() 
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let mut server = Server::start(&dir);
-    let (s, created) = server.send("POST", "/api/v1/flights", "application/json", flight_body("kill").to_string().as_bytes());
+    let (s, created) = server.send(
+        "POST",
+        "/api/v1/flights",
+        "application/json",
+        flight_body("kill").to_string().as_bytes(),
+    );
     assert_eq!(s, 201, "{created}");
     let uri = format!("/api/v1/flights/{}", created["id"]);
     let tele = format!("{uri}/telemetry");
@@ -305,11 +491,21 @@ fn a_server_killed_with_sigkill_keeps_every_acknowledged_sample_and_its_state() 
     };
     let mut accepted = 0;
     for k in 0..8 {
-        let (s, a) = server.send("POST", &tele, "application/json", batch(2.0 * k as f64, 20, f).to_string().as_bytes());
+        let (s, a) = server.send(
+            "POST",
+            &tele,
+            "application/json",
+            batch(2.0 * k as f64, 20, f).to_string().as_bytes(),
+        );
         assert_eq!(s, 200, "{a}");
         accepted += a["accepted"].as_u64().unwrap();
         if k == 1 {
-            let (s, _) = server.send("POST", &format!("{uri}/alarms/acknowledge"), "application/json", b"");
+            let (s, _) = server.send(
+                "POST",
+                &format!("{uri}/alarms/acknowledge"),
+                "application/json",
+                b"",
+            );
             assert_eq!(s, 200);
         }
     }
@@ -325,8 +521,16 @@ fn a_server_killed_with_sigkill_keeps_every_acknowledged_sample_and_its_state() 
     assert_eq!(s, 200);
     assert_eq!(comparable(after.clone()), comparable(before.clone()));
     // and it goes on from there: the same batch again stores nothing
-    let (_, a) = server.send("POST", &tele, "application/json", batch(14.0, 20, f).to_string().as_bytes());
-    assert_eq!((a["accepted"].as_u64(), a["duplicates"].as_u64()), (Some(0), Some(20)));
+    let (_, a) = server.send(
+        "POST",
+        &tele,
+        "application/json",
+        batch(14.0, 20, f).to_string().as_bytes(),
+    );
+    assert_eq!(
+        (a["accepted"].as_u64(), a["duplicates"].as_u64()),
+        (Some(0), Some(20))
+    );
     drop(server);
     let _ = std::fs::remove_dir_all(&dir);
 }

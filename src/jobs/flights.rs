@@ -82,12 +82,22 @@ pub trait FlightStore: Send + Sync {
     fn end_flight(&self, id: i64, owner: &str) -> Result<bool, StoreError>;
     /// Stores the samples not stored yet (by `time_s`), in one transaction,
     /// and the arrival time.
-    fn insert_samples(&self, id: i64, samples: &[Sample], arrival_ms: i64) -> Result<StoredBatch, StoreError>;
+    fn insert_samples(
+        &self,
+        id: i64,
+        samples: &[Sample],
+        arrival_ms: i64,
+    ) -> Result<StoredBatch, StoreError>;
     /// The flight's samples in time order.
     fn samples_by_time(&self, id: i64) -> Result<Vec<Sample>, StoreError>;
     /// The samples stored after arrival number `after_seq`, in arrival
     /// order, with their numbers.
-    fn samples_after(&self, id: i64, after_seq: i64, limit: usize) -> Result<Vec<(i64, Sample)>, StoreError>;
+    fn samples_after(
+        &self,
+        id: i64,
+        after_seq: i64,
+        limit: usize,
+    ) -> Result<Vec<(i64, Sample)>, StoreError>;
     /// Stores an acknowledgement made at sample time `time_s`.
     fn add_acknowledgement(&self, id: i64, time_s: f64) -> Result<(), StoreError>;
     /// The acknowledgements' sample times, in the order made.

@@ -13,7 +13,9 @@ use std::time::Duration;
 
 use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
 
-use super::flights::{FlightEntry, FlightRow, FlightStore, MAX_FLIGHTS_PER_OWNER, NewFlight, StoredBatch};
+use super::flights::{
+    FlightEntry, FlightRow, FlightStore, MAX_FLIGHTS_PER_OWNER, NewFlight, StoredBatch,
+};
 use super::store::StoreError;
 use crate::numerics::monitor::Sample;
 
@@ -71,13 +73,20 @@ fn migrate(conn: &mut Connection) -> Result<(), StoreError> {
         |r| r.get(0),
     )?;
     let version: i64 = if exists {
-        tx.query_row("SELECT ifnull(max(version), 0) FROM flight_schema", [], |r| r.get(0))?
+        tx.query_row(
+            "SELECT ifnull(max(version), 0) FROM flight_schema",
+            [],
+            |r| r.get(0),
+        )?
     } else {
         0
     };
     if version < 1 {
         tx.execute_batch(SCHEMA_V1)?;
-        tx.execute("INSERT INTO flight_schema (version) VALUES (?1)", [FLIGHT_SCHEMA_VERSION])?;
+        tx.execute(
+            "INSERT INTO flight_schema (version) VALUES (?1)",
+            [FLIGHT_SCHEMA_VERSION],
+        )?;
     }
     tx.commit()?;
     Ok(())
@@ -123,14 +132,17 @@ fn sample_from(r: &rusqlite::Row<'_>, at: usize) -> rusqlite::Result<Sample> {
     })
 }
 
-const SAMPLE_COLUMNS: &str =
-    "time_s, tether_length_m, winch_rate_m_s, winch_tension_n, wind_speed_m_s, wind_height_m, aerostat_altitude_m";
+const SAMPLE_COLUMNS: &str = "time_s, tether_length_m, winch_rate_m_s, winch_tension_n, wind_speed_m_s, wind_height_m, aerostat_altitude_m";
 
 impl FlightStore for SqliteFlights {
     fn create_flight(&self, owner: &str, f: &NewFlight<'_>) -> Result<Option<i64>, StoreError> {
         let mut conn = self.conn();
         let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
-        let n: i64 = tx.query_row("SELECT count(*) FROM flights WHERE owner = ?1", [owner], |r| r.get(0))?;
+        let n: i64 = tx.query_row(
+            "SELECT count(*) FROM flights WHERE owner = ?1",
+            [owner],
+            |r| r.get(0),
+        )?;
         if n as usize >= MAX_FLIGHTS_PER_OWNER {
             return Ok(None);
         }
@@ -196,10 +208,17 @@ impl FlightStore for SqliteFlights {
         Ok(n == 1)
     }
 
-    fn insert_samples(&self, id: i64, samples: &[Sample], arrival_ms: i64) -> Result<StoredBatch, StoreError> {
+    fn insert_samples(
+        &self,
+        id: i64,
+        samples: &[Sample],
+        arrival_ms: i64,
+    ) -> Result<StoredBatch, StoreError> {
         let mut conn = self.conn();
         let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
-        let next: i64 = tx.query_row("SELECT next_seq FROM flights WHERE id = ?1", [id], |r| r.get(0))?;
+        let next: i64 = tx.query_row("SELECT next_seq FROM flights WHERE id = ?1", [id], |r| {
+            r.get(0)
+        })?;
         let mut seq = next;
         let mut out = StoredBatch::default();
         {
@@ -246,7 +265,12 @@ impl FlightStore for SqliteFlights {
         Ok(rows.collect::<Result<_, _>>()?)
     }
 
-    fn samples_after(&self, id: i64, after_seq: i64, limit: usize) -> Result<Vec<(i64, Sample)>, StoreError> {
+    fn samples_after(
+        &self,
+        id: i64,
+        after_seq: i64,
+        limit: usize,
+    ) -> Result<Vec<(i64, Sample)>, StoreError> {
         let conn = self.conn();
         let mut st = conn.prepare_cached(&format!(
             "SELECT seq, {SAMPLE_COLUMNS} FROM flight_samples
@@ -268,75 +292,10 @@ impl FlightStore for SqliteFlights {
 
     fn acknowledgements(&self, id: i64) -> Result<Vec<f64>, StoreError> {
         let conn = self.conn();
-        let mut st =
-            conn.prepare_cached("SELECT time_s FROM flight_acknowledgements WHERE flight_id = ?1 ORDER BY rowid")?;
+        let mut st = conn.prepare_cached(
+            "SELECT time_s FROM flight_acknowledgements WHERE flight_id = ?1 ORDER BY rowid",
+        )?;
         let rows = st.query_map([id], |r| r.get(0))?;
         Ok(rows.collect::<Result<_, _>>()?)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn flight() -> NewFlight<'static> {
-        NewFlight {
-            name: "f",
-            request: "{}",
-            plan: "{}",
-            limits: "{}",
-            ceiling: "{}",
-        }
-    }
-
-    #[test]
-    fn samples_are_stored_once_by_time_and_numbered_in_arrival_order() {
-        let s = SqliteFlights::open_in_memory().unwrap();
-        let id = s.create_flight("a", &flight()).unwrap().unwrap();
-        let batch: Vec<Sample> = [0.0, 0.2, 0.1].iter().map(|&t| Sample::at(t)).collect();
-        let b = s.insert_samples(id, &batch, 1000).unwrap();
-        assert_eq!((b.accepted, b.duplicates, b.last_seq), (3, 0, 3));
-        let b = s.insert_samples(id, &batch, 2000).unwrap();
-        assert_eq!((b.accepted, b.duplicates, b.last_seq), (0, 3, 3));
-        let b = s.insert_samples(id, &[Sample::at(0.15), Sample::at(0.2)], 3000).unwrap();
-        assert_eq!((b.accepted, b.duplicates, b.last_seq), (1, 1, 4));
-        let times: Vec<f64> = s.samples_by_time(id).unwrap().iter().map(|s| s.time_s).collect();
-        assert_eq!(times, vec![0.0, 0.1, 0.15, 0.2]);
-        let after: Vec<(i64, f64)> =
-            s.samples_after(id, 2, 10).unwrap().iter().map(|(q, s)| (*q, s.time_s)).collect();
-        assert_eq!(after, vec![(3, 0.1), (4, 0.15)]);
-        let row = s.get_flight(id, "a").unwrap().unwrap();
-        assert_eq!((row.samples, row.last_arrival_ms), (4, Some(3000)));
-    }
-
-    #[test]
-    fn another_owner_sees_nothing() {
-        let s = SqliteFlights::open_in_memory().unwrap();
-        let id = s.create_flight("a", &flight()).unwrap().unwrap();
-        assert!(s.get_flight(id, "b").unwrap().is_none());
-        assert!(s.list_flights("b").unwrap().is_empty());
-        assert!(!s.end_flight(id, "b").unwrap());
-        assert_eq!(s.list_flights("a").unwrap().len(), 1);
-        assert!(s.end_flight(id, "a").unwrap());
-        assert!(s.get_flight(id, "a").unwrap().unwrap().ended_at.is_some());
-    }
-
-    #[test]
-    fn the_schema_survives_a_reopen() {
-        let dir = std::env::temp_dir().join(format!("tp-flights-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("f.db");
-        let _ = std::fs::remove_file(&path);
-        let id = {
-            let s = SqliteFlights::open(&path).unwrap();
-            let id = s.create_flight("a", &flight()).unwrap().unwrap();
-            s.insert_samples(id, &[Sample::at(1.0)], 5).unwrap();
-            s.add_acknowledgement(id, 1.0).unwrap();
-            id
-        };
-        let s = SqliteFlights::open(&path).unwrap();
-        assert_eq!(s.samples_by_time(id).unwrap().len(), 1);
-        assert_eq!(s.acknowledgements(id).unwrap(), vec![1.0]);
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -84,7 +84,10 @@ pub async fn flight_events(
             loop {
                 let store = hub.store.clone();
                 let id = flight.id;
-                let rows = tokio::task::spawn_blocking(move || store.samples_after(id, sent, EVENT_SAMPLES)).await;
+                let rows = tokio::task::spawn_blocking(move || {
+                    store.samples_after(id, sent, EVENT_SAMPLES)
+                })
+                .await;
                 let Ok(Ok(rows)) = rows else { return };
                 let Some(&(last, _)) = rows.last() else { break };
                 let full = rows.len() == EVENT_SAMPLES;
@@ -106,7 +109,11 @@ pub async fn flight_events(
                         .collect(),
                 };
                 sent = last;
-                let Ok(ev) = Event::default().event("samples").id(last.to_string()).json_data(&body) else {
+                let Ok(ev) = Event::default()
+                    .event("samples")
+                    .id(last.to_string())
+                    .json_data(&body)
+                else {
                     return;
                 };
                 if tx.send(ev).await.is_err() {
@@ -117,7 +124,9 @@ pub async fn flight_events(
                 }
             }
             let state = flight.lock().output(flight.id, now_ms());
-            let Ok(ev) = Event::default().event("state").json_data(&state) else { return };
+            let Ok(ev) = Event::default().event("state").json_data(&state) else {
+                return;
+            };
             if tx.send(ev).await.is_err() {
                 return;
             }

@@ -33,7 +33,11 @@ fn parse_id(id: &str) -> Result<i64, ApiError> {
 }
 
 /// The live flight `id` of the caller, or 404.
-pub(super) async fn flight_of(app: &AppState, caller: &Caller, id: &str) -> Result<std::sync::Arc<LiveFlight>, ApiError> {
+pub(super) async fn flight_of(
+    app: &AppState,
+    caller: &Caller,
+    id: &str,
+) -> Result<std::sync::Arc<LiveFlight>, ApiError> {
     let id = parse_id(id)?;
     let hub = app.flights.clone();
     let owner = owner(caller);
@@ -111,7 +115,10 @@ fn text<T: serde::Serialize>(v: &T) -> String {
         (status = 500, description = "Store failure", body = ErrorBody),
     )
 )]
-pub async fn list_flights(State(app): State<AppState>, Extension(caller): Extension<Caller>) -> Result<Response, ApiError> {
+pub async fn list_flights(
+    State(app): State<AppState>,
+    Extension(caller): Extension<Caller>,
+) -> Result<Response, ApiError> {
     let hub = app.flights.clone();
     let owner = owner(&caller);
     let rows = blocking(move || hub.store.list_flights(&owner).map_err(ApiError::from)).await?;
@@ -245,7 +252,11 @@ pub async fn post_telemetry(
         accepted: stored.accepted,
         duplicates: stored.duplicates,
         rejected: parsed.rejected.len(),
-        errors: parsed.rejected.into_iter().take(MAX_LISTED_ERRORS).collect(),
+        errors: parsed
+            .rejected
+            .into_iter()
+            .take(MAX_LISTED_ERRORS)
+            .collect(),
         state: out.state,
         last_sample_time_s: out.last_sample_time_s,
         samples_received: out.samples_received,
@@ -273,7 +284,13 @@ pub async fn acknowledge_alarms(
     let g = f.clone();
     let acknowledged = blocking(move || hub.acknowledge(&g).map_err(ApiError::from)).await?;
     let state = f.lock().output(f.id, now_ms()).state;
-    Ok(json_response(StatusCode::OK, &AcknowledgeOutput { acknowledged, state }))
+    Ok(json_response(
+        StatusCode::OK,
+        &AcknowledgeOutput {
+            acknowledged,
+            state,
+        },
+    ))
 }
 
 /// Re-plan from now: from the current length in the measured wind, or the haul-down when that is NO-GO.
@@ -310,6 +327,7 @@ pub async fn replan_flight(
             "no tether length measured yet: send telemetry with tether_length_m first",
         ));
     };
-    let out = blocking(move || replan(&request, length, wind, height).map_err(ApiError::from)).await?;
+    let out =
+        blocking(move || replan(&request, length, wind, height).map_err(ApiError::from)).await?;
     Ok(json_response(StatusCode::OK, &out))
 }

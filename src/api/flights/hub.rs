@@ -54,7 +54,8 @@ pub struct LiveState {
 impl LiveState {
     /// Seconds since the last sample arrived at `now_ms`.
     pub fn since_last_s(&self, now_ms: i64) -> Option<f64> {
-        self.last_arrival_ms.map(|a| (now_ms - a).max(0) as f64 / 1000.0)
+        self.last_arrival_ms
+            .map(|a| (now_ms - a).max(0) as f64 / 1000.0)
     }
 
     /// The flight clock at `now_ms` (s), see the module's note.
@@ -104,15 +105,19 @@ pub struct FlightHub {
     live: Mutex<HashMap<i64, Arc<LiveFlight>>>,
 }
 
-fn parse_ms(created_at: &str) -> i64 {
-    // `YYYY-MM-DDTHH:MM:SS.sssZ` (SQLite's strftime) to ms since the epoch
+/// A stored `YYYY-MM-DDTHH:MM:SS.sssZ` (SQLite's strftime) as ms since
+/// the Unix epoch (the time now when it is not one).
+pub fn parse_ms(created_at: &str) -> i64 {
     let num = |a: usize, b: usize| created_at.get(a..b).and_then(|s| s.parse::<i64>().ok());
     let (Some(y), Some(mo), Some(d), Some(h), Some(mi)) =
         (num(0, 4), num(5, 7), num(8, 10), num(11, 13), num(14, 16))
     else {
         return now_ms();
     };
-    let sec: f64 = created_at.get(17..created_at.len().saturating_sub(1)).and_then(|s| s.parse().ok()).unwrap_or(0.0);
+    let sec: f64 = created_at
+        .get(17..created_at.len().saturating_sub(1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0.0);
     // days from civil (Howard Hinnant)
     let y = if mo <= 2 { y - 1 } else { y };
     let era = y.div_euclid(400);
@@ -134,7 +139,9 @@ impl FlightHub {
 
     /// Flights in memory only (tests, servers built without a store).
     pub fn in_memory() -> Self {
-        Self::new(Arc::new(SqliteFlights::open_in_memory().expect("an in-memory SQLite opens")))
+        Self::new(Arc::new(
+            SqliteFlights::open_in_memory().expect("an in-memory SQLite opens"),
+        ))
     }
 
     /// The flights of the job database: the SQLite file itself; with
@@ -144,7 +151,9 @@ impl FlightHub {
         let store = match config {
             StoreConfig::Sqlite(p) => SqliteFlights::open(p)?,
             StoreConfig::Postgres(_) => {
-                tracing::warn!("flights are kept in ./tetherplan-flights.db (SQLite) beside PostgreSQL jobs");
+                tracing::warn!(
+                    "flights are kept in ./tetherplan-flights.db (SQLite) beside PostgreSQL jobs"
+                );
                 SqliteFlights::open(std::path::Path::new("tetherplan-flights.db"))?
             }
         };
@@ -173,11 +182,16 @@ impl FlightHub {
     }
 
     fn load(&self, row: &FlightRow) -> Result<LiveState, StoreError> {
-        let bad = |what: &str, e: serde_json::Error| StoreError(format!("flight {}: stored {what}: {e}", row.id));
-        let limits: FlightLimitsOutput = serde_json::from_str(&row.limits).map_err(|e| bad("limits", e))?;
+        let bad = |what: &str, e: serde_json::Error| {
+            StoreError(format!("flight {}: stored {what}: {e}", row.id))
+        };
+        let limits: FlightLimitsOutput =
+            serde_json::from_str(&row.limits).map_err(|e| bad("limits", e))?;
         let plan: PlanResponse = serde_json::from_str(&row.plan).map_err(|e| bad("plan", e))?;
-        let table: StoredTable = serde_json::from_str(&row.ceiling).map_err(|e| bad("ceiling", e))?;
-        let request: serde_json::Value = serde_json::from_str(&row.request).map_err(|e| bad("request", e))?;
+        let table: StoredTable =
+            serde_json::from_str(&row.ceiling).map_err(|e| bad("ceiling", e))?;
+        let request: serde_json::Value =
+            serde_json::from_str(&row.request).map_err(|e| bad("request", e))?;
         let model = flight_model(&limits, &plan, &table);
         let monitor = self.replay(row.id, &model)?;
         // every stored sample took the next number from 1
@@ -199,7 +213,12 @@ impl FlightHub {
 
     /// The monitor of every stored sample and acknowledgement.
     fn replay(&self, id: i64, model: &FlightModel) -> Result<Monitor, StoreError> {
-        let mut events: Vec<Event> = self.store.samples_by_time(id)?.into_iter().map(Event::Sample).collect();
+        let mut events: Vec<Event> = self
+            .store
+            .samples_by_time(id)?
+            .into_iter()
+            .map(Event::Sample)
+            .collect();
         events.extend(
             self.store
                 .acknowledgements(id)?
@@ -211,7 +230,12 @@ impl FlightHub {
 
     /// Stores a batch and judges its new samples (in time order; a sample
     /// earlier than the monitor's latest replays the flight).
-    pub fn ingest(&self, flight: &LiveFlight, samples: &[Sample], arrival_ms: i64) -> Result<StoredBatch, StoreError> {
+    pub fn ingest(
+        &self,
+        flight: &LiveFlight,
+        samples: &[Sample],
+        arrival_ms: i64,
+    ) -> Result<StoredBatch, StoreError> {
         let mut st = flight.lock();
         let stored = self.store.insert_samples(flight.id, samples, arrival_ms)?;
         let mut fresh: Vec<Sample> = samples
@@ -263,16 +287,5 @@ impl FlightHub {
         drop(st);
         let _ = flight.changed.send(Changed { last_seq });
         Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::parse_ms;
-
-    #[test]
-    fn sqlite_timestamps_to_epoch_ms() {
-        assert_eq!(parse_ms("1970-01-01T00:00:00.000Z"), 0);
-        assert_eq!(parse_ms("2000-03-01T00:00:01.500Z"), 951_868_801_500);
     }
 }

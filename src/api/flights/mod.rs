@@ -16,11 +16,20 @@ use crate::api::AppState;
 /// The flight routes.
 pub fn routes() -> Router<AppState> {
     Router::new()
-        .route("/api/v1/flights", post(handlers::create_flight).get(handlers::list_flights))
+        .route(
+            "/api/v1/flights",
+            post(handlers::create_flight).get(handlers::list_flights),
+        )
         .route("/api/v1/flights/{id}", get(handlers::get_flight))
         .route("/api/v1/flights/{id}/end", post(handlers::end_flight))
-        .route("/api/v1/flights/{id}/telemetry", post(handlers::post_telemetry))
-        .route("/api/v1/flights/{id}/alarms/acknowledge", post(handlers::acknowledge_alarms))
+        .route(
+            "/api/v1/flights/{id}/telemetry",
+            post(handlers::post_telemetry),
+        )
+        .route(
+            "/api/v1/flights/{id}/alarms/acknowledge",
+            post(handlers::acknowledge_alarms),
+        )
         .route("/api/v1/flights/{id}/replan", get(handlers::replan_flight))
         .route("/api/v1/flights/{id}/events", get(events::flight_events))
 }

@@ -50,12 +50,22 @@ fn invalid(field: &str, reason: impl std::fmt::Display) -> RequestError {
     RequestError::Invalid(InvalidInput::new(field, reason))
 }
 
-fn bounded(field: &str, v: Option<f64>, default: f64, lo: f64, hi: f64, open_lo: bool) -> Result<f64, RequestError> {
+fn bounded(
+    field: &str,
+    v: Option<f64>,
+    default: f64,
+    lo: f64,
+    hi: f64,
+    open_lo: bool,
+) -> Result<f64, RequestError> {
     let Some(v) = v else { return Ok(default) };
     let ok = v.is_finite() && v <= hi && if open_lo { v > lo } else { v >= lo };
     if !ok {
         let lower = if open_lo { "above" } else { "at least" };
-        return Err(invalid(field, format!("must be {lower} {lo} and at most {hi}, got {v}")));
+        return Err(invalid(
+            field,
+            format!("must be {lower} {lo} and at most {hi}, got {v}"),
+        ));
     }
     Ok(v)
 }
@@ -68,20 +78,45 @@ pub fn resolve_limits(
 ) -> Result<FlightLimitsOutput, RequestError> {
     let l = input;
     let hd = req.haul_down.as_ref();
-    let wind = l.max_operating_wind_m_s.or(hd.map(|h| h.max_operating_wind_m_s));
+    let wind = l
+        .max_operating_wind_m_s
+        .or(hd.map(|h| h.max_operating_wind_m_s));
     let gust = l.max_gust_m_s.or(hd.and_then(|h| h.max_gust_m_s));
-    let net = plan.inputs.pointer("/aerostat/net_buoyancy_n").and_then(|v| v.as_f64());
+    let net = plan
+        .inputs
+        .pointer("/aerostat/net_buoyancy_n")
+        .and_then(|v| v.as_f64());
     let net_buoyancy_n = match (net, req.aerostat.net_buoyancy_n) {
         (Some(v), _) | (None, Some(v)) => v,
-        (None, None) => return Err(invalid("aerostat.net_buoyancy_n", "is needed for the slack check")),
+        (None, None) => {
+            return Err(invalid(
+                "aerostat.net_buoyancy_n",
+                "is needed for the slack check",
+            ));
+        }
     };
     Ok(FlightLimitsOutput {
         allowable_tension_n: plan.limits.allowable_tension_n,
         net_buoyancy_n,
-        max_operating_wind_m_s: Some(bounded("limits.max_operating_wind_m_s", wind, 0.0, 0.0, 150.0, true)?)
-            .filter(|_| wind.is_some()),
-        max_gust_m_s: Some(bounded("limits.max_gust_m_s", gust, 0.0, 0.0, 150.0, true)?).filter(|_| gust.is_some()),
-        anemometer_height_m: bounded("limits.anemometer_height_m", l.anemometer_height_m, 10.0, 0.0, 1e4, true)?,
+        max_operating_wind_m_s: Some(bounded(
+            "limits.max_operating_wind_m_s",
+            wind,
+            0.0,
+            0.0,
+            150.0,
+            true,
+        )?)
+        .filter(|_| wind.is_some()),
+        max_gust_m_s: Some(bounded("limits.max_gust_m_s", gust, 0.0, 0.0, 150.0, true)?)
+            .filter(|_| gust.is_some()),
+        anemometer_height_m: bounded(
+            "limits.anemometer_height_m",
+            l.anemometer_height_m,
+            10.0,
+            0.0,
+            1e4,
+            true,
+        )?,
         tension_caution_fraction_nondim: bounded(
             "limits.tension_caution_fraction_nondim",
             l.tension_caution_fraction_nondim,
@@ -90,7 +125,14 @@ pub fn resolve_limits(
             1.0,
             true,
         )?,
-        slack_fraction_nondim: bounded("limits.slack_fraction_nondim", l.slack_fraction_nondim, 0.05, 0.0, 1.0, false)?,
+        slack_fraction_nondim: bounded(
+            "limits.slack_fraction_nondim",
+            l.slack_fraction_nondim,
+            0.05,
+            0.0,
+            1.0,
+            false,
+        )?,
         wind_caution_fraction_nondim: bounded(
             "limits.wind_caution_fraction_nondim",
             l.wind_caution_fraction_nondim,
@@ -115,9 +157,30 @@ pub fn resolve_limits(
             10.0,
             true,
         )?,
-        stale_after_s: bounded("limits.stale_after_s", l.stale_after_s, 5.0, 0.0, 3600.0, true)?,
-        raise_after_s: bounded("limits.raise_after_s", l.raise_after_s, 1.0, 0.0, 600.0, false)?,
-        clear_after_s: bounded("limits.clear_after_s", l.clear_after_s, 5.0, 0.0, 3600.0, false)?,
+        stale_after_s: bounded(
+            "limits.stale_after_s",
+            l.stale_after_s,
+            5.0,
+            0.0,
+            3600.0,
+            true,
+        )?,
+        raise_after_s: bounded(
+            "limits.raise_after_s",
+            l.raise_after_s,
+            1.0,
+            0.0,
+            600.0,
+            false,
+        )?,
+        clear_after_s: bounded(
+            "limits.clear_after_s",
+            l.clear_after_s,
+            5.0,
+            0.0,
+            3600.0,
+            false,
+        )?,
         payout_ceiling: String::new(),
     })
 }
@@ -128,7 +191,10 @@ pub fn prepare(body: &[u8]) -> Result<PreparedFlight, RequestError> {
     let mut value: serde_json::Value =
         serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
     let Some(obj) = value.as_object_mut() else {
-        return Err(invalid("body", "must be a JSON object: a plan request with `name`"));
+        return Err(invalid(
+            "body",
+            "must be a JSON object: a plan request with `name`",
+        ));
     };
     let name = match obj.remove("name") {
         Some(serde_json::Value::String(s)) => s,
@@ -137,7 +203,10 @@ pub fn prepare(body: &[u8]) -> Result<PreparedFlight, RequestError> {
     };
     let chars = name.chars().count();
     if chars == 0 || chars > MAX_NAME_CHARS || name.chars().any(char::is_control) {
-        return Err(invalid("name", format!("must be 1 to {MAX_NAME_CHARS} characters without control characters")));
+        return Err(invalid(
+            "name",
+            format!("must be 1 to {MAX_NAME_CHARS} characters without control characters"),
+        ));
     }
     let limits: FlightLimitsInput = match obj.remove("limits") {
         None | Some(serde_json::Value::Null) => FlightLimitsInput::default(),
@@ -150,8 +219,13 @@ pub fn prepare(body: &[u8]) -> Result<PreparedFlight, RequestError> {
     let plan = plan(&req, &NoProgress)?;
     if !plan.feasible {
         return Err(invalid(
-            plan.binding_limit.as_deref().unwrap_or("target_elevation_m"),
-            format!("the plan is not feasible, so there is no schedule to fly: {}", plan.reason),
+            plan.binding_limit
+                .as_deref()
+                .unwrap_or("target_elevation_m"),
+            format!(
+                "the plan is not feasible, so there is no schedule to fly: {}",
+                plan.reason
+            ),
         ));
     }
     let mut limits = resolve_limits(&limits, &req, &plan)?;
@@ -205,7 +279,12 @@ pub fn ceiling_table(
     for &w in &winds {
         let mut r = req.clone();
         r.haul_down = None;
-        r.wind = Some(measured_wind(req.wind.as_ref(), limits.anemometer_height_m, w, None));
+        r.wind = Some(measured_wind(
+            req.wind.as_ref(),
+            limits.anemometer_height_m,
+            w,
+            None,
+        ));
         match rate_ceilings_m_s(&r, &lengths) {
             Ok(c) => columns.push(c),
             Err(_) if w > 0.0 && columns.len() == 1 => {
@@ -249,7 +328,11 @@ pub fn ceiling_table(
 }
 
 /// The monitor's references from what the store keeps.
-pub fn flight_model(limits: &FlightLimitsOutput, plan: &PlanResponse, table: &StoredTable) -> FlightModel {
+pub fn flight_model(
+    limits: &FlightLimitsOutput,
+    plan: &PlanResponse,
+    table: &StoredTable,
+) -> FlightModel {
     let mut l = Limits::new(limits.net_buoyancy_n);
     l.allowable_tension_n = limits.allowable_tension_n;
     l.tension_caution_fraction = limits.tension_caution_fraction_nondim;
@@ -265,7 +348,8 @@ pub fn flight_model(limits: &FlightLimitsOutput, plan: &PlanResponse, table: &St
         clear_after_s: limits.clear_after_s,
         ..Dwell::default()
     };
-    let (times, lengths): (Vec<f64>, Vec<f64>) = plan.schedule.iter().map(|s| (s.time_s, s.length_m)).unzip();
+    let (times, lengths): (Vec<f64>, Vec<f64>) =
+        plan.schedule.iter().map(|s| (s.time_s, s.length_m)).unzip();
     let ceiling = CeilingTable::new(
         table.lengths_m.clone(),
         table.winds_m_s.clone(),
@@ -290,12 +374,19 @@ fn unit(c: CheckName) -> &'static str {
 }
 
 fn sense(c: CheckName) -> Sense {
-    if c == CheckName::Slack { Sense::Below } else { Sense::Above }
+    if c == CheckName::Slack {
+        Sense::Below
+    } else {
+        Sense::Above
+    }
 }
 
 /// The monitor's state, checks and alarms as JSON, `since_s` after the
 /// last sample arrived.
-pub fn status_output(m: &Monitor, since_s: Option<f64>) -> (String, Vec<CheckOutput>, Vec<AlarmOutput>) {
+pub fn status_output(
+    m: &Monitor,
+    since_s: Option<f64>,
+) -> (String, Vec<CheckOutput>, Vec<AlarmOutput>) {
     let st = m.status(since_s);
     let checks = st
         .checks

@@ -44,15 +44,32 @@ pub fn replan(
     let mut req = base.clone();
     req.initial_length_m = current_length_m.max(0.0);
     if let Some((mean, gust)) = measured {
-        req.wind = Some(measured_wind(base.wind.as_ref(), anemometer_height_m, mean, Some(gust)));
+        req.wind = Some(measured_wind(
+            base.wind.as_ref(),
+            anemometer_height_m,
+            mean,
+            Some(gust),
+        ));
     }
-    let at_target = (req.initial_length_m - req.target_elevation_m).abs() < 1e-6 * req.target_elevation_m.max(1.0);
-    let forward = if at_target { None } else { Some(plan(&req, &NoProgress)?) };
+    let at_target = (req.initial_length_m - req.target_elevation_m).abs()
+        < 1e-6 * req.target_elevation_m.max(1.0);
+    let forward = if at_target {
+        None
+    } else {
+        Some(plan(&req, &NoProgress)?)
+    };
     let (mode, reason, out) = match forward {
-        Some(p) if p.feasible && p.go => ("continue", format!("GO from {:.1} m: {}", req.initial_length_m, p.reason), p),
+        Some(p) if p.feasible && p.go => (
+            "continue",
+            format!("GO from {:.1} m: {}", req.initial_length_m, p.reason),
+            p,
+        ),
         other => {
             let why = match &other {
-                Some(p) => format!("NO-GO to the target from {:.1} m ({}): haul down", req.initial_length_m, p.reason),
+                Some(p) => format!(
+                    "NO-GO to the target from {:.1} m ({}): haul down",
+                    req.initial_length_m, p.reason
+                ),
                 None => "at the target: the haul-down from here".to_string(),
             };
             let mut down = req.clone();

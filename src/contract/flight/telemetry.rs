@@ -103,7 +103,12 @@ pub enum Format {
 impl Format {
     /// From a `Content-Type` (parameters ignored); `None` when unknown.
     pub fn from_content_type(ct: &str) -> Option<Self> {
-        let essence = ct.split(';').next().unwrap_or("").trim().to_ascii_lowercase();
+        let essence = ct
+            .split(';')
+            .next()
+            .unwrap_or("")
+            .trim()
+            .to_ascii_lowercase();
         match essence.as_str() {
             "application/json" => Some(Self::Json),
             "text/csv" => Some(Self::Csv),
@@ -166,7 +171,11 @@ impl TelemetrySampleInput {
 
 /// Parses a batch. `arrival_time_s`: the flight time at which it arrived,
 /// for NMEA lines without a time.
-pub fn parse_batch(format: Format, body: &[u8], arrival_time_s: f64) -> Result<Parsed, RequestError> {
+pub fn parse_batch(
+    format: Format,
+    body: &[u8],
+    arrival_time_s: f64,
+) -> Result<Parsed, RequestError> {
     let parsed = match format {
         Format::Json => parse_json(body)?,
         Format::Csv => parse_csv(text(body)?)?,
@@ -194,7 +203,10 @@ fn parse_json(body: &[u8]) -> Result<Parsed, RequestError> {
     if items.len() > MAX_BATCH_SAMPLES {
         return Err(invalid(
             "body",
-            format!("at most {MAX_BATCH_SAMPLES} samples per batch, got {}", items.len()),
+            format!(
+                "at most {MAX_BATCH_SAMPLES} samples per batch, got {}",
+                items.len()
+            ),
         ));
     }
     let mut out = Parsed::default();
@@ -227,7 +239,10 @@ fn parse_csv(text: &str) -> Result<Parsed, RequestError> {
         let Some(i) = FIELDS.iter().position(|f| *f == name) else {
             return Err(invalid(
                 name,
-                format!("unknown column in the CSV header; the columns are {}", FIELDS.join(", ")),
+                format!(
+                    "unknown column in the CSV header; the columns are {}",
+                    FIELDS.join(", ")
+                ),
             ));
         };
         if columns.contains(&i) {
@@ -236,7 +251,10 @@ fn parse_csv(text: &str) -> Result<Parsed, RequestError> {
         columns.push(i);
     }
     if !columns.contains(&0) {
-        return Err(invalid("time_s", "the CSV header must name a time_s column"));
+        return Err(invalid(
+            "time_s",
+            "the CSV header must name a time_s column",
+        ));
     }
     let mut out = Parsed::default();
     for (i, l) in lines {
@@ -293,7 +311,8 @@ pub fn mwv_unit_m_s(letter: &str) -> Option<f64> {
 
 /// One `$--MWV` sentence to a wind speed (m/s); `Err((field, reason))`.
 pub fn mwv_speed_m_s(sentence: &str) -> Result<f64, (&'static str, String)> {
-    let parsed = nmea::parse_str(sentence).map_err(|e| ("sentence", format!("not NMEA 0183: {e}")))?;
+    let parsed =
+        nmea::parse_str(sentence).map_err(|e| ("sentence", format!("not NMEA 0183: {e}")))?;
     let nmea::ParseResult::MWV(data) = parsed else {
         return Err((
             "sentence",
@@ -304,7 +323,10 @@ pub fn mwv_speed_m_s(sentence: &str) -> Result<f64, (&'static str, String)> {
         ));
     };
     if !data.data_valid {
-        return Err(("data_valid", "flagged V (not valid) by the instrument: not used".into()));
+        return Err((
+            "data_valid",
+            "flagged V (not valid) by the instrument: not used".into(),
+        ));
     }
     // the fields again as text: direction, reference, speed, unit, status
     let body = nmea::parse_nmea_sentence(sentence)
@@ -324,7 +346,10 @@ pub fn mwv_speed_m_s(sentence: &str) -> Result<f64, (&'static str, String)> {
         .map_err(|_| ("wind_speed", format!("is not a number: {speed:?}")))?;
     let v = v * factor;
     if !(v.is_finite() && (0.0..=150.0).contains(&v)) {
-        return Err(("wind_speed", format!("must be between 0 and 150 m/s, got {v}")));
+        return Err((
+            "wind_speed",
+            format!("must be between 0 and 150 m/s, got {v}"),
+        ));
     }
     Ok(v)
 }
@@ -351,7 +376,13 @@ fn parse_nmea(text: &str, arrival_time_s: f64) -> Parsed {
                         .map_err(|_| ("time_s", format!("is not a number: {:?}", t.trim()))),
                     s.trim(),
                 ),
-                None => (Err(("sentence", "expected `time_s,$--MWV,…` or `$--MWV,…`".into())), l),
+                None => (
+                    Err((
+                        "sentence",
+                        "expected `time_s,$--MWV,…` or `$--MWV,…`".into(),
+                    )),
+                    l,
+                ),
             }
         };
         let result = time.and_then(|t| {
@@ -367,97 +398,4 @@ fn parse_nmea(text: &str, arrival_time_s: f64) -> Parsed {
         }
     }
     out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `$` + body + `*` + the XOR checksum, computed here.
-    fn nmea(body: &str) -> String {
-        let c = body.bytes().fold(0u8, |a, b| a ^ b);
-        format!("${body}*{c:02X}")
-    }
-
-    #[test]
-    fn json_keeps_the_good_samples_and_names_the_bad_ones() {
-        let body = br#"[
-            {"time_s": 0.0, "tether_length_m": 10, "winch_tension_n": 900},
-            {"time_s": 0.1, "wind_speed_m_s": -3},
-            {"tether_length_m": 11},
-            {"time_s": 0.3, "tension": 5},
-            {"time_s": "x"},
-            {"time_s": 0.5, "winch_rate_m_s": 1.5, "aerostat_altitude_m": 9.0}
-        ]"#;
-        let p = parse_batch(Format::Json, body, 0.0).unwrap();
-        assert_eq!(p.samples.len(), 2);
-        assert_eq!(p.samples[1].winch_rate_m_s, Some(1.5));
-        let named: Vec<(usize, &str)> = p.rejected.iter().map(|r| (r.line, r.field.as_str())).collect();
-        assert_eq!(
-            named,
-            vec![(2, "wind_speed_m_s"), (3, "time_s"), (4, "tension"), (5, "time_s")]
-        );
-        assert!(p.rejected[2].reason.contains("unknown"), "{:?}", p.rejected[2]);
-        assert!(matches!(parse_batch(Format::Json, b"{}", 0.0), Err(RequestError::Invalid(_))));
-        assert!(matches!(parse_batch(Format::Json, b"[", 0.0), Err(RequestError::Malformed(_))));
-    }
-
-    #[test]
-    fn csv_by_header_with_empty_cells_missing() {
-        let body = "time_s,winch_tension_n,wind_speed_m_s\n0,1000,5\n0.1,,5.5\n0.2,abc,5\n0.3,1000\n\n0.4,1001,6\n";
-        let p = parse_batch(Format::Csv, body.as_bytes(), 0.0).unwrap();
-        assert_eq!(p.samples.len(), 3);
-        assert_eq!(p.samples[1].winch_tension_n, None);
-        assert_eq!(p.samples[1].wind_speed_m_s, Some(5.5));
-        let named: Vec<(usize, &str)> = p.rejected.iter().map(|r| (r.line, r.field.as_str())).collect();
-        assert_eq!(named, vec![(4, "winch_tension_n"), (5, "line")]);
-        let Err(RequestError::Invalid(e)) =
-            parse_batch(Format::Csv, b"time_s,tension\n0,1\n", 0.0)
-        else {
-            panic!("an unknown column refuses the batch")
-        };
-        assert_eq!(e.field, "tension");
-        assert!(parse_batch(Format::Csv, b"winch_tension_n\n1\n", 0.0).is_err());
-    }
-
-    #[test]
-    fn nmea_knots_are_converted_exactly_and_the_v_flag_is_not_used() {
-        let lines = [
-            format!("12.5,{}", nmea("WIMWV,270.0,R,10.0,N,A")),
-            format!("12.6,{}", nmea("WIMWV,270.0,R,10.0,N,V")),
-            format!("12.7,{}", nmea("WIMWV,270.0,T,36.0,K,A")),
-            format!("12.8,{}", nmea("WIMWV,270.0,T,7.3,M,A")),
-            nmea("WIMWV,270.0,T,12.345678,N,A"),
-            "12.9,$WIMWV,270.0,R,10.0,N,A*00".to_string(),
-            format!("13.0,{}", nmea("GPGLL,4916.45,N,12311.12,W,225444,A")),
-        ];
-        let p = parse_batch(Format::Nmea, lines.join("\r\n").as_bytes(), 99.0).unwrap();
-        let got: Vec<(f64, f64)> = p
-            .samples
-            .iter()
-            .map(|s| (s.time_s, s.wind_speed_m_s.unwrap()))
-            .collect();
-        // 1 kn = 1852/3600 m/s exactly; f64 of the text, not the crate's f32
-        assert_eq!(
-            got,
-            vec![
-                (12.5, 10.0 * 1852.0 / 3600.0),
-                (12.7, 36.0 * 1000.0 / 3600.0),
-                (12.8, 7.3),
-                (99.0, 12.345678 * 1852.0 / 3600.0),
-            ]
-        );
-        assert_ne!(12.345678_f32 as f64 * 1852.0 / 3600.0, got[3].1);
-        let named: Vec<(usize, &str)> = p.rejected.iter().map(|r| (r.line, r.field.as_str())).collect();
-        assert_eq!(named, vec![(2, "data_valid"), (6, "sentence"), (7, "sentence")]);
-        assert!(p.rejected[1].reason.contains("hecksum"), "{:?}", p.rejected[1]);
-    }
-
-    #[test]
-    fn content_types() {
-        assert_eq!(Format::from_content_type("application/json; charset=utf-8"), Some(Format::Json));
-        assert_eq!(Format::from_content_type("Text/CSV"), Some(Format::Csv));
-        assert_eq!(Format::from_content_type("text/plain"), Some(Format::Nmea));
-        assert_eq!(Format::from_content_type("application/xml"), None);
-    }
 }

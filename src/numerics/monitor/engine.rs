@@ -130,7 +130,9 @@ pub enum Pushed {
 pub enum Event {
     Sample(Sample),
     /// Acknowledged when the last sample was at `time_s`.
-    Acknowledge { time_s: f64 },
+    Acknowledge {
+        time_s: f64,
+    },
 }
 
 impl Event {
@@ -253,7 +255,13 @@ impl Monitor {
                 n += self.update(CheckName::Tension, Sense::Above, t, tension, th);
             }
             let slack = l.slack_fraction * l.net_buoyancy_n;
-            n += self.update(CheckName::Slack, Sense::Below, t, tension, (None, Some(slack)));
+            n += self.update(
+                CheckName::Slack,
+                Sense::Below,
+                t,
+                tension,
+                (None, Some(slack)),
+            );
         }
         if s.wind_speed_m_s.is_some() {
             if let (Some((mean, gust)), Some(max)) = (self.wind_now, l.max_operating_wind_m_s) {
@@ -306,7 +314,10 @@ impl Monitor {
         c.stop_at = stop_at;
         let mut transitions = Vec::new();
         if let Some(th) = caution_at {
-            transitions.push((Level::Caution, c.caution.update(&dwell, sense, t, value, th)));
+            transitions.push((
+                Level::Caution,
+                c.caution.update(&dwell, sense, t, value, th),
+            ));
         }
         if let Some(th) = stop_at {
             transitions.push((Level::Stop, c.stop.update(&dwell, sense, t, value, th)));
@@ -362,7 +373,11 @@ impl Monitor {
     /// Acknowledges at sample time `time_s` (a replayed acknowledgement).
     pub fn acknowledge_at(&mut self, time_s: f64) -> usize {
         let mut n = 0;
-        for a in self.alarms.iter_mut().filter(|a| a.acknowledged_at_s.is_none()) {
+        for a in self
+            .alarms
+            .iter_mut()
+            .filter(|a| a.acknowledged_at_s.is_none())
+        {
             a.acknowledged_at_s = Some(time_s);
             n += 1;
         }
@@ -386,7 +401,11 @@ impl Monitor {
                     let stale = since_last_arrival_s.is_none_or(|s| !(s <= l.stale_after_s));
                     return CheckStatus {
                         name,
-                        state: if stale { Level::Unavailable } else { Level::Normal },
+                        state: if stale {
+                            Level::Unavailable
+                        } else {
+                            Level::Normal
+                        },
                         value: since_last_arrival_s,
                         caution_at: None,
                         stop_at: None,

@@ -22,6 +22,3 @@ pub use ceiling::{CeilingTable, RateCeiling};
 pub use engine::{Alarm, CheckStatus, Event, FlightModel, Monitor, Pushed, Status};
 pub use level::{Dwell, Sense};
 pub use sample::{CheckName, Level, Limits, PlanTrace, Sample};
-
-#[cfg(test)]
-mod tests;
