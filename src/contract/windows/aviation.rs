@@ -73,8 +73,9 @@ pub fn parse_metar(s: &str) -> Result<ParsedForecast, InvalidInput> {
             ));
         }
     };
+    // One observation never crosses a month end.
     let style = TimeStyle::Aviation {
-        month_days: i64::from(day0),
+        month_days: i64::MAX,
     };
     let start = axis(day0, t);
     Ok(ParsedForecast {
@@ -102,8 +103,18 @@ pub fn parse_taf(s: &str) -> Result<ParsedForecast, InvalidInput> {
         InvalidInput::new("forecast.data", "the TAF has no validity group (DDHH/DDHH)")
     })?;
     let day0 = taf.issued_at.as_ref().map_or(v.from_day, |i| i.day);
+    // Days before the issue day are in the next month (of `day0` days).
+    let mut days = vec![v.from_day, v.to_day];
+    for f in &taf.forecasts {
+        days.extend(f.from.map(|t| t.0));
+        days.extend(f.period.as_ref().map(|p| [p.from.0, p.to.0]).into_iter().flatten());
+    }
     let style = TimeStyle::Aviation {
-        month_days: i64::from(day0),
+        month_days: if days.iter().any(|d| *d < day0) {
+            i64::from(day0)
+        } else {
+            i64::MAX
+        },
     };
     let valid_from = axis(day0, (v.from_day, v.from_hour, 0));
     let valid_to = axis(day0, (v.to_day, v.to_hour, 0));

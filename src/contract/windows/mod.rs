@@ -10,11 +10,13 @@ mod aviation;
 mod csv;
 pub mod dto;
 mod open_meteo;
+pub mod points;
 pub mod run;
 pub mod source;
 pub mod time;
 
 pub use dto::{WindowsRequest, WindowsResponse};
+pub use points::haul_down_points;
 pub use run::{Prepared, prepare, windows};
 
 use crate::contract::RequestError;

@@ -206,10 +206,14 @@ pub fn prepare(req: &WindowsRequest) -> Result<Prepared, RequestError> {
     let mut plans = Vec::new();
     let mut plan_times = Vec::new();
     let mut cases = Vec::with_capacity(forecast.members.len());
+    let mut calm_gusts: Vec<String> = Vec::new();
     for member in &forecast.members {
         let mut mc = Vec::with_capacity(member.periods.len());
         for p in &member.periods {
             let fitted = fit_hour(&p.winds, p.gust, z0).map_err(|e| fit_error(p, e))?;
+            if p.gust.is_some_and(|g| g.1 > 0.0) && fitted.gust_at_reference_m_s.is_none() {
+                calm_gusts.push(format!("{} {}", member.name, p.time));
+            }
             let wind = wind_input(&fitted, rho);
             let u_t = fitted.flow.speed_m_s(target);
             let g_t = match (fitted.gust_ratio_nondim, fitted.gust_at_reference_m_s) {
@@ -224,6 +228,7 @@ pub fn prepare(req: &WindowsRequest) -> Result<Prepared, RequestError> {
                         wind_speed_m_s: u_t,
                         gust_m_s: h.max_gust_m_s.map(|_| g_t.unwrap_or(u_t)),
                     }],
+                    source: None,
                     max_operating_wind_m_s: h.max_operating_wind_m_s,
                     max_gust_m_s: h.max_gust_m_s,
                 },
@@ -233,6 +238,7 @@ pub fn prepare(req: &WindowsRequest) -> Result<Prepared, RequestError> {
                         wind_speed_m_s: u_t.min(NO_LIMIT_M_S),
                         gust_m_s: None,
                     }],
+                    source: None,
                     max_operating_wind_m_s: NO_LIMIT_M_S,
                     max_gust_m_s: None,
                 },
@@ -254,6 +260,13 @@ pub fn prepare(req: &WindowsRequest) -> Result<Prepared, RequestError> {
             });
         }
         cases.push(mc);
+    }
+    let mut forecast = forecast;
+    if !calm_gusts.is_empty() {
+        forecast.notes.push(format!(
+            "a gust over a calm period is left out (the §9 gust scales the mean flow, which is zero): {}",
+            calm_gusts.join(", ")
+        ));
     }
     Ok(Prepared {
         forecast,

@@ -17,7 +17,8 @@
 //! there when the hour has one, else the fitted flow's), at least 1; the
 //! gust profile is the mean profile times that ratio (SPEC §10), so the gust
 //! speed at the flow's reference height is `ratio × U(z_ref)`. A gust over
-//! a calm hour is a uniform gust of that speed.
+//! a calm hour (every speed zero) is left out: the §9 gust scales the mean
+//! flow and a calm flow has nothing to scale (the answer says so).
 
 /// A fitted steady flow (SI).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -174,7 +175,8 @@ pub fn fit_hour(
                 let r = (g / mean).max(1.0);
                 (Some(r), Some(r * flow.speed_m_s(flow.reference_height_m())))
             } else {
-                (None, Some(g))
+                // Calm: the §9 gust scales the mean, so there is nothing to scale.
+                (None, None)
             }
         }
     };
@@ -251,7 +253,7 @@ mod tests {
     fn calm_hours_and_falling_winds() {
         let h = fit_hour(&[(10.0, 0.0), (80.0, 0.0)], Some((10.0, 4.0)), 0.03).unwrap();
         assert_eq!(h.flow, FittedFlow::Uniform { speed_m_s: 0.0 });
-        assert_eq!(h.gust_at_reference_m_s, Some(4.0));
+        assert_eq!(h.gust_at_reference_m_s, None);
         let h = fit_hour(&[(10.0, 8.0), (80.0, 2.0)], None, 0.03).unwrap();
         assert!(h.exponent_clamped);
         // p = 0: the geometric mean, √(8·2) = 4.
