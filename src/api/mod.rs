@@ -15,6 +15,7 @@ pub mod auth_doc;
 pub mod bands;
 pub mod dynamics;
 pub mod error;
+pub mod flights;
 pub mod guard;
 pub mod jobs;
 pub mod openapi;
@@ -51,6 +52,8 @@ pub struct AppState {
     solves: Arc<Semaphore>,
     /// API tokens (none: open).
     pub tokens: Arc<auth::Tokens>,
+    /// Live flights (in memory until [`Self::with_flights`]).
+    pub flights: Arc<flights::hub::FlightHub>,
 }
 
 impl AppState {
@@ -62,7 +65,14 @@ impl AppState {
             limits,
             solves,
             tokens: Arc::new(auth::Tokens::default()),
+            flights: Arc::new(flights::hub::FlightHub::in_memory()),
         }
+    }
+
+    /// The same, keeping its flights in `hub`.
+    pub fn with_flights(mut self, hub: flights::hub::FlightHub) -> Self {
+        self.flights = Arc::new(hub);
+        self
     }
 
     /// The same, requiring one of `tokens` on every `/api` route.
@@ -178,6 +188,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
             "/api/v1/jobs/{id}",
             get(jobs::get_job).delete(jobs::delete_job),
         )
+        .merge(flights::routes())
         .route("/api", any(api_not_found))
         .route("/api/{*rest}", any(api_not_found))
         .method_not_allowed_fallback(method_not_allowed)
@@ -212,7 +223,11 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
     ));
     // TETHERPLAN_JOB_THREADS=0: jobs are left to `tetherplan worker` processes.
     let worker = (config.job_threads > 0).then(|| queue.spawn_worker());
-    let state = AppState::new(queue.clone()).with_tokens(&config.api_tokens);
+    let flights = flights::hub::FlightHub::open(&config.store)
+        .map_err(|e| format!("cannot open the flights of {}: {e}", config.store.describe()))?;
+    let state = AppState::new(queue.clone())
+        .with_tokens(&config.api_tokens)
+        .with_flights(flights);
     let listener = tokio::net::TcpListener::bind(config.addr)
         .await
         .map_err(|e| format!("cannot listen on {}: {e}", config.addr))?;

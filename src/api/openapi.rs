@@ -85,7 +85,9 @@ fn get_openapi() {}
 /// The document, with the request examples, the cable's two forms and the
 /// synchronous limits ([`crate::api::spec`]).
 pub fn openapi() -> utoipa::openapi::OpenApi {
-    crate::api::spec::refine(ApiDoc::openapi())
+    let mut doc = ApiDoc::openapi();
+    doc.merge(crate::api::flights::FlightsDoc::openapi());
+    crate::api::spec::refine(doc)
 }
 
 /// The document as committed in `openapi/openapi.json` (pretty, newline-terminated).

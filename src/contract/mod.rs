@@ -8,6 +8,7 @@ pub mod dynamics;
 pub mod envelope;
 pub mod equilibrium;
 pub mod error;
+pub mod flight;
 pub mod finite;
 pub mod ge;
 pub mod json;

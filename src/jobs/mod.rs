@@ -19,6 +19,8 @@ pub mod chunks;
 pub mod dynamics;
 pub mod windows;
 pub mod estimate;
+pub mod flights;
+pub mod flights_sqlite;
 pub mod kinds;
 pub mod lease;
 pub mod plan;

@@ -9,6 +9,7 @@ pub mod forecast;
 pub mod ge;
 pub mod ge_reduced;
 pub mod mesh;
+pub mod monitor;
 pub mod newmark;
 pub mod params;
 pub mod plan;

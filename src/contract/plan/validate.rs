@@ -91,7 +91,7 @@ pub(super) fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
 /// `resolve`: find the wind target (equilibria; with the GE criterion its
 /// table). Without it (job submission) a GE request's target is only
 /// range-checked.
-fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidInput> {
+pub(super) fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidInput> {
     let system_input = SystemInput {
         cable: req.cable.clone(),
         aerostat: req.aerostat.clone(),
