@@ -223,6 +223,8 @@ impl Progress for Bar {
 /// Runs the server on a multi-threaded tokio runtime (I/O only: solves
 /// run on rayon).
 fn serve(args: ServeArgs) -> ExitCode {
+    // Before any thread starts: memory comes back after a load (api::memory).
+    tetherplan::api::memory::tune_allocator();
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),

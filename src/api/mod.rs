@@ -13,11 +13,13 @@ pub mod assets;
 pub mod auth;
 pub mod auth_doc;
 pub mod bands;
+pub mod body;
 pub mod dynamics;
 pub mod error;
 pub mod flights;
 pub mod guard;
 pub mod jobs;
+pub mod memory;
 pub mod openapi;
 pub mod server;
 pub mod solve;
@@ -50,6 +52,8 @@ pub struct AppState {
     pub queue: Arc<JobQueue>,
     pub limits: Limits,
     solves: Arc<Semaphore>,
+    /// Priced synchronous work running now (`crate::price`).
+    priced: Arc<crate::price::InFlight>,
     /// API tokens (none: open).
     pub tokens: Arc<auth::Tokens>,
     /// Live flights (in memory until [`Self::with_flights`]).
@@ -64,6 +68,7 @@ impl AppState {
             queue,
             limits,
             solves,
+            priced: Arc::new(crate::price::InFlight::default()),
             tokens: Arc::new(auth::Tokens::default()),
             flights: Arc::new(flights::hub::FlightHub::in_memory()),
         }
