@@ -12,6 +12,11 @@
 //! The stream is fed by a task that reads the store after each change of
 //! the flight (a broadcast that only says "changed": a slow client
 //! cannot make the store lose anything, it reads from where it was).
+//!
+//! A client that does not accept `text/event-stream` (no `Accept` naming
+//! it, as browsers' `EventSource` always sends) gets what is stored and
+//! one `state` event, and the stream ends: a snapshot in the same form,
+//! for tools that read a response to its end.
 
 use std::convert::Infallible;
 use std::time::Duration;
@@ -74,6 +79,11 @@ pub async fn flight_events(
         .and_then(|v| v.trim().parse().ok())
         .filter(|n: &i64| *n >= 0)
         .unwrap_or(0);
+    let follow = headers
+        .get_all(axum::http::header::ACCEPT)
+        .iter()
+        .filter_map(|v| v.to_str().ok())
+        .any(|v| v.to_ascii_lowercase().contains("text/event-stream"));
     let mut changed = flight.changed.subscribe();
     let (tx, rx) = tokio::sync::mpsc::channel::<Event>(8);
     let hub = app.flights.clone();
@@ -127,7 +137,7 @@ pub async fn flight_events(
             let Ok(ev) = Event::default().event("state").json_data(&state) else {
                 return;
             };
-            if tx.send(ev).await.is_err() {
+            if tx.send(ev).await.is_err() || !follow {
                 return;
             }
             tokio::select! {
