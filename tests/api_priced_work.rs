@@ -9,13 +9,14 @@
 //! expensive of its shape the server answers synchronously within a factor
 //! 1.5, must use at most [`SHARE_CPU_S`] CPU-seconds (the 2 CPU-second
 //! budget of `tetherplan::price` with a factor 2 for the model) and answer
-//! within a quarter of the 30 s solve timeout. Before the prices, 10 000
+//! within half the 30 s solve timeout. Before the prices, 10 000
 //! samples of 2 steps × 2 segments were accepted at 0.7 % of the limit and
 //! took 11.3 CPU-seconds.
 //!
 //! The probe: four of the most expensive accepted many-sample requests at
 //! once, and a 5 ms `/stability` call behind them, which must be answered
-//! within [`CHEAP_WAIT_S`] (it waited 10.5 s behind four such requests).
+//! before the process has spent [`CHEAP_WAIT_CPU_S`] more CPU-seconds (it
+//! waited 10.5 s behind four such requests).
 //!
 //! CPU time is the test process's (`getrusage`), the server being
 //! in-process; the tests of this file run one at a time.
@@ -32,10 +33,15 @@ use common::{app, send};
 
 /// CPU-seconds the most expensive accepted request may use.
 const SHARE_CPU_S: f64 = 4.0;
-/// Wall seconds it may take: a quarter of the default solve timeout.
-const SHARE_WALL_S: f64 = 7.5;
-/// Seconds a cheap request may wait behind the most expensive ones.
-const CHEAP_WAIT_S: f64 = 5.0;
+/// Wall seconds it may take: half the default solve timeout (the machine
+/// may be shared: the CPU time is the measure, this only says it ends).
+const SHARE_WALL_S: f64 = 15.0;
+/// CPU-seconds the process may spend while a cheap request waits behind
+/// the most expensive ones: the priced work admitted at once
+/// (`tetherplan::price::IN_FLIGHT_CPU_S`, 4) and one more. CPU, not wall
+/// time, so that other load on the machine does not change the verdict;
+/// before the prices, four 10 000-sample requests spent 45 CPU-s.
+const CHEAP_WAIT_CPU_S: f64 = 5.0;
 
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
@@ -133,12 +139,12 @@ fn shapes() -> Vec<Shape> {
             }),
         },
         Shape {
-            name: "envelope: quasi-static GE on 40 elements, many winds",
+            name: "envelope: quasi-static GE on 20 elements, many winds",
             path: "/api/v1/envelope",
             top: 100,
             body: Box::new(|n| {
                 let mut b = example("/api/v1/envelope");
-                b["stability"] = json!({"method": "quasi_static_ge", "elements": 40});
+                b["stability"] = json!({"method": "quasi_static_ge", "elements": 20});
                 b["wind_speeds_m_s"] = json!({"min": 0.0, "max": 30.0, "count": n});
                 b["tether_lengths_m"] = json!({"min": 100.0, "max": 3000.0, "count": 5});
                 b
@@ -206,20 +212,21 @@ async fn priced_work_does_not_starve_a_cheap_request() {
         }));
     }
     tokio::time::sleep(Duration::from_millis(200)).await;
-    let t0 = Instant::now();
+    let (t0, c0) = (Instant::now(), cpu_s());
     let (status, answer) = send(&app, "POST", "/api/v1/stability", Some(&cheap)).await;
-    let waited = t0.elapsed().as_secs_f64();
+    let (waited, burnt) = (t0.elapsed().as_secs_f64(), cpu_s() - c0);
     let mut statuses = Vec::new();
     for t in tasks {
         statuses.push(t.await.unwrap().as_u16());
     }
     eprintln!(
-        "4 × {n} samples at once ({statuses:?}); /stability answered in {waited:.2} s"
+        "4 × {n} samples at once ({statuses:?}); /stability answered in {waited:.2} s, \
+         {burnt:.2} CPU-s spent meanwhile"
     );
     assert_eq!(status, StatusCode::OK, "{answer}");
     assert!(
-        waited <= CHEAP_WAIT_S,
-        "a cheap /stability waited {waited:.1} s behind four priced requests (answers {statuses:?})"
+        burnt <= CHEAP_WAIT_CPU_S,
+        "a cheap /stability waited while {burnt:.1} CPU-s of priced work ran ({waited:.1} s; answers {statuses:?})"
     );
     assert!(
         statuses.iter().all(|s| *s == 200 || *s == 503),
