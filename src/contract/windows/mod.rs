@@ -9,6 +9,7 @@
 mod aviation;
 mod csv;
 pub mod dto;
+pub mod forecast;
 mod open_meteo;
 pub mod points;
 pub mod run;
