@@ -232,6 +232,14 @@ fn every_route_is_documented_with_its_statuses() {
             "flight_events",
             &["200", "401", "404"],
         ),
+        (
+            "post",
+            "/api/v1/windows",
+            "compute_windows",
+            &[
+                "200", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
+        ),
         ("get", "/api/v1/presets", "list_presets", &["200", "401"]),
         ("get", "/healthz", "get_health", &["200"]),
         ("get", "/openapi.json", "get_openapi", &["200"]),
@@ -284,6 +292,14 @@ fn numeric_fields_name_their_unit() {
     ];
     // Counts, ids and fractions; RateGrid's bounds are described in m/s by its parent `rates_m_s`.
     const UNITLESS: &[&str] = &[
+        // Launch windows (issue 32 names `probability_go`): shares of
+        // ensemble members and their Wilson bounds, member and plan counts.
+        "probability",
+        "probability_go",
+        "probability_go_low",
+        "probability_go_high",
+        "members",
+        "plans_computed",
         "elements",
         "check_elements",
         "finest_elements",
