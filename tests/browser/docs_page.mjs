@@ -24,7 +24,12 @@ check(csp.includes("default-src 'self'"), "/docs/ carries the CSP");
 await page.waitForSelector(".opblock-post", { timeout: 20000 });
 const ops = await page.$$eval(".opblock-post", (els) => els.map((e) => e.id));
 check(ops.length >= 7, `${ops.length} POST operations listed`);
+// The actions on one flight (`/flights/{id}/…`) need a flight's id in the
+// path, which the document cannot give as an example: tests/api_flights.rs
+// and tests/api_examples.rs post them on a flight they create.
+const needsFlightId = (id) => id.startsWith("operations-flights-") && id !== "operations-flights-create_flight";
 for (const id of ops) {
+  if (needsFlightId(id)) continue;
   phase = id;
   const block = page.locator(`#${id}`);
   await block.locator(".opblock-summary").first().click();
