@@ -12,7 +12,8 @@ use tetherplan::contract::windows::{WindowsRequest, windows};
 
 /// A reproducible factor in [0.7, 1.3) for (member, hour).
 fn spread(member: u64, hour: u64) -> f64 {
-    let mut z = member.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ hour.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    let mut z =
+        member.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ hour.wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^= z >> 31;
@@ -26,10 +27,18 @@ fn forecast(members: u64) -> Value {
     units.insert("time".into(), json!("iso8601"));
     hourly.insert(
         "time".into(),
-        json!((0..hours).map(|h| format!("2026-12-{:02}T{:02}:00", 3 + h / 24, h % 24)).collect::<Vec<_>>()),
+        json!(
+            (0..hours)
+                .map(|h| format!("2026-12-{:02}T{:02}:00", 3 + h / 24, h % 24))
+                .collect::<Vec<_>>()
+        ),
     );
     for m in 0..members {
-        let suffix = if m == 0 { String::new() } else { format!("_member{m:02}") };
+        let suffix = if m == 0 {
+            String::new()
+        } else {
+            format!("_member{m:02}")
+        };
         let base = |h: u64| 8.0 + 30.0 * (std::f64::consts::PI * h as f64 / 24.0).sin().powi(2);
         for (z, a) in [(10.0, 0.0), (80.0, 0.16), (120.0, 0.15), (180.0, 0.14)] {
             let key = format!("wind_speed_{z}m{suffix}");
@@ -40,7 +49,9 @@ fn forecast(members: u64) -> Value {
             units.insert(key, json!("km/h"));
         }
         let key = format!("wind_gusts_10m{suffix}");
-        let v: Vec<f64> = (0..hours).map(|h| (base(h) * spread(m, h) * 16.0).round() / 10.0).collect();
+        let v: Vec<f64> = (0..hours)
+            .map(|h| (base(h) * spread(m, h) * 16.0).round() / 10.0)
+            .collect();
         hourly.insert(key.clone(), json!(v));
         units.insert(key, json!("km/h"));
     }

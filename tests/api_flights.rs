@@ -393,16 +393,34 @@ async fn events_replay_what_a_client_missed_after_last_event_id() {
 #[tokio::test]
 async fn a_client_that_does_not_accept_an_event_stream_gets_a_snapshot_that_ends() {
     let (app, _) = app_with_tokens(&["alpha"]);
-    let (_, created) = as_json(&app, "alpha", "POST", "/api/v1/flights", Some(&flight_body("snap"))).await;
+    let (_, created) = as_json(
+        &app,
+        "alpha",
+        "POST",
+        "/api/v1/flights",
+        Some(&flight_body("snap")),
+    )
+    .await;
     let uri = format!("/api/v1/flights/{}", created["id"]);
-    send_body(&app, "alpha", &format!("{uri}/telemetry"), "application/json", batch(0.0, 3, |_| 900.0).to_string()).await;
+    send_body(
+        &app,
+        "alpha",
+        &format!("{uri}/telemetry"),
+        "application/json",
+        batch(0.0, 3, |_| 900.0).to_string(),
+    )
+    .await;
     let (req, body) = common::json_request("GET", &format!("{uri}/events"), None);
     let req = req.header(header::AUTHORIZATION, "Bearer alpha");
     let a = tokio::time::timeout(Duration::from_secs(10), request(&app, req, body))
         .await
         .expect("the snapshot ends");
     assert_eq!(a.status, StatusCode::OK);
-    assert!(a.text.contains("event: samples") && a.text.contains("id: 3"), "{}", a.text);
+    assert!(
+        a.text.contains("event: samples") && a.text.contains("id: 3"),
+        "{}",
+        a.text
+    );
     assert_eq!(a.text.matches("event: state").count(), 1, "{}", a.text);
 }
 

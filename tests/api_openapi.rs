@@ -193,7 +193,12 @@ fn every_route_is_documented_with_its_statuses() {
             "create_flight",
             &["201", "400", "401", "413", "415", "422", "500"],
         ),
-        ("get", "/api/v1/flights", "list_flights", &["200", "401", "500"]),
+        (
+            "get",
+            "/api/v1/flights",
+            "list_flights",
+            &["200", "401", "500"],
+        ),
         (
             "get",
             "/api/v1/flights/{id}",

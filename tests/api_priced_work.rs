@@ -155,7 +155,10 @@ fn shapes() -> Vec<Shape> {
 
 /// Steps the count down from the top by factors of 1.5 until the server
 /// answers; returns the count, the answer's status, CPU and wall seconds.
-async fn most_expensive_accepted(app: &axum::Router, shape: &Shape) -> (usize, StatusCode, f64, f64) {
+async fn most_expensive_accepted(
+    app: &axum::Router,
+    shape: &Shape,
+) -> (usize, StatusCode, f64, f64) {
     let mut n = shape.top;
     loop {
         let body = (shape.body)(n);
@@ -164,7 +167,11 @@ async fn most_expensive_accepted(app: &axum::Router, shape: &Shape) -> (usize, S
         let (cpu, wall) = (cpu_s() - c0, t0.elapsed().as_secs_f64());
         if status == StatusCode::UNPROCESSABLE_ENTITY && answer["error"]["code"] == "too_large" {
             assert!(wall < 1.0, "{}: a refusal took {wall:.1} s", shape.name);
-            assert!(n > 1, "{}: even a count of 1 is refused: {answer}", shape.name);
+            assert!(
+                n > 1,
+                "{}: even a count of 1 is refused: {answer}",
+                shape.name
+            );
             n = (n as f64 / 1.5) as usize;
             continue;
         }
@@ -180,7 +187,10 @@ async fn the_most_expensive_accepted_request_of_each_shape_stays_within_its_shar
     let mut report = Vec::new();
     for shape in shapes() {
         let (n, _, cpu, wall) = most_expensive_accepted(&app, &shape).await;
-        eprintln!("{}: count {n} accepted, {cpu:.2} CPU-s, {wall:.2} s", shape.name);
+        eprintln!(
+            "{}: count {n} accepted, {cpu:.2} CPU-s, {wall:.2} s",
+            shape.name
+        );
         report.push((shape.name, n, cpu, wall));
     }
     for (name, n, cpu, wall) in report {
@@ -208,7 +218,9 @@ async fn priced_work_does_not_starve_a_cheap_request() {
     for _ in 0..4 {
         let (app, body) = (app.clone(), heavy.clone());
         tasks.push(tokio::spawn(async move {
-            send(&app, "POST", "/api/v1/dynamics/peaks", Some(&body)).await.0
+            send(&app, "POST", "/api/v1/dynamics/peaks", Some(&body))
+                .await
+                .0
         }));
     }
     tokio::time::sleep(Duration::from_millis(200)).await;

@@ -72,7 +72,11 @@ async fn stored_systems_replay_against_their_published_schema() {
         let uri = format!("/api/v1/systems/s{i}");
         let (status, answer) = send(&app, "PUT", &uri, Some(body)).await;
         assert_eq!(status, StatusCode::CREATED, "{body}: {answer}");
-        assert_eq!(errors(&view, &answer), Vec::<String>::new(), "PUT {body} answered {answer}");
+        assert_eq!(
+            errors(&view, &answer),
+            Vec::<String>::new(),
+            "PUT {body} answered {answer}"
+        );
         assert_eq!(
             errors(&body_schema, body),
             Vec::<String>::new(),
@@ -80,7 +84,11 @@ async fn stored_systems_replay_against_their_published_schema() {
         );
         let (status, answer) = send(&app, "GET", &uri, None).await;
         assert_eq!(status, StatusCode::OK);
-        assert_eq!(errors(&view, &answer), Vec::<String>::new(), "GET {uri} answered {answer}");
+        assert_eq!(
+            errors(&view, &answer),
+            Vec::<String>::new(),
+            "GET {uri} answered {answer}"
+        );
     }
     let (_, listed) = send(&app, "GET", "/api/v1/systems", None).await;
     assert_eq!(errors(&list, &listed), Vec::<String>::new());
@@ -123,10 +131,7 @@ async fn names_that_read_as_paths_are_refused() {
         assert_eq!(status, StatusCode::CREATED, "{name}: {answer}");
     }
     for name in PATH_LIKE {
-        let encoded: String = name
-            .bytes()
-            .map(|b| format!("%{b:02X}"))
-            .collect();
+        let encoded: String = name.bytes().map(|b| format!("%{b:02X}")).collect();
         for uri in [
             format!("/api/v1/systems/{encoded}"),
             format!("/api/v1/systems/{name}"),
@@ -135,16 +140,27 @@ async fn names_that_read_as_paths_are_refused() {
                 continue; // a second path segment is another route (404)
             }
             let (status, answer) = send(&app, "PUT", &uri, Some(&body)).await;
-            assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "PUT {uri}: {answer}");
+            assert_eq!(
+                status,
+                StatusCode::UNPROCESSABLE_ENTITY,
+                "PUT {uri}: {answer}"
+            );
             assert_eq!(answer["error"]["field"], "name", "{uri}: {answer}");
             assert!(
-                answer["error"]["message"].as_str().unwrap().contains("name"),
+                answer["error"]["message"]
+                    .as_str()
+                    .unwrap()
+                    .contains("name"),
                 "{answer}"
             );
         }
         let request = with(example("/api/v1/equilibrium"), json!({"system": name}));
         let (status, answer) = send(&app, "POST", "/api/v1/equilibrium", Some(&request)).await;
-        assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "system {name}: {answer}");
+        assert_eq!(
+            status,
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "system {name}: {answer}"
+        );
         assert_eq!(answer["error"]["field"], "system", "{name}: {answer}");
     }
 }
@@ -161,7 +177,18 @@ fn the_published_name_rule_is_the_servers() {
     let long_ok = "a".repeat(MAX_NAME_LEN);
     let long_bad = "a".repeat(MAX_NAME_LEN + 1);
     let mut names: Vec<&str> = PATH_LIKE.iter().chain(GOOD.iter()).copied().collect();
-    names.extend(["", "-a", "_a", "a-", "a_", "a b", "é", "a.-b", long_ok.as_str(), long_bad.as_str()]);
+    names.extend([
+        "",
+        "-a",
+        "_a",
+        "a-",
+        "a_",
+        "a b",
+        "é",
+        "a.-b",
+        long_ok.as_str(),
+        long_bad.as_str(),
+    ]);
     for name in names {
         assert_eq!(
             schema.is_valid(&json!(name)),
@@ -182,7 +209,10 @@ async fn a_null_preset_is_refused() {
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{answer}");
     assert_eq!(answer["error"]["field"], "cable.preset", "{answer}");
     assert!(
-        answer["error"]["message"].as_str().unwrap().contains("null"),
+        answer["error"]["message"]
+            .as_str()
+            .unwrap()
+            .contains("null"),
         "{answer}"
     );
     let schema = validator("CableInput");
@@ -200,7 +230,11 @@ async fn dynamics_refuses_a_shape_count_beside_shape_times() {
             json!({"shape_count": count, "shape_times_s": times, "duration_s": 2.0}),
         );
         let (status, answer) = send(&app, "POST", "/api/v1/dynamics", Some(&request)).await;
-        assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{count} {times}: {answer}");
+        assert_eq!(
+            status,
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "{count} {times}: {answer}"
+        );
         assert_eq!(answer["error"]["field"], "shape_count", "{answer}");
         // As a job too (nothing stored).
         let job = json!({"kind": "dynamics", "request": request});
@@ -220,12 +254,20 @@ async fn envelope_checks_the_flow_speed_beside_a_grid() {
         let mut request = base.clone();
         request["wind"]["flow"]["speed_m_s"] = json!(speed);
         let (status, answer) = send(&app, "POST", "/api/v1/envelope", Some(&request)).await;
-        assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{speed}: {answer}");
+        assert_eq!(
+            status,
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "{speed}: {answer}"
+        );
         assert_eq!(answer["error"]["field"], "wind.flow.speed_m_s", "{answer}");
     }
     let mut request = base.clone();
-    request["wind"]["flow"] = json!({"kind": "power_law", "coefficient_m_s": -3.0, "exponent_nondim": 0.14});
+    request["wind"]["flow"] =
+        json!({"kind": "power_law", "coefficient_m_s": -3.0, "exponent_nondim": 0.14});
     let (status, answer) = send(&app, "POST", "/api/v1/envelope", Some(&request)).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{answer}");
-    assert_eq!(answer["error"]["field"], "wind.flow.coefficient_m_s", "{answer}");
+    assert_eq!(
+        answer["error"]["field"], "wind.flow.coefficient_m_s",
+        "{answer}"
+    );
 }

@@ -227,7 +227,10 @@ fn healthz_answers_through_a_reconnect_storm() {
          peak {peak:.1} MB, {after:.1} MB after",
         opened.load(Ordering::Relaxed)
     );
-    assert_eq!(failures, 0, "/healthz failed {failures} of {probes} times in the storm");
+    assert_eq!(
+        failures, 0,
+        "/healthz failed {failures} of {probes} times in the storm"
+    );
     assert!(after - before < 100.0, "{before:.1} → {after:.1} MB");
     assert!(server.healthy(Duration::from_secs(5)));
 }

@@ -61,8 +61,16 @@ async fn assert_hour_is_plan(h: &Value, wind: &Value) {
     let verdict = if p["go"] == true { "go" } else { "no-go" };
     assert_eq!(h["verdict"], verdict, "{}: {}", h["time"], h["reason"]);
     assert_eq!(h["reason"], p["reason"], "{}", h["time"]);
-    assert_eq!(h["max_altitude_m"], p["wind"]["reachable_altitude_m"], "{}", h["time"]);
-    assert_eq!(h["peak_tension_n"], p["limits"]["peak_tension_n"], "{}", h["time"]);
+    assert_eq!(
+        h["max_altitude_m"], p["wind"]["reachable_altitude_m"],
+        "{}",
+        h["time"]
+    );
+    assert_eq!(
+        h["peak_tension_n"], p["limits"]["peak_tension_n"],
+        "{}",
+        h["time"]
+    );
     assert_eq!(
         h["safety_factor_nondim"], p["limits"]["min_safety_factor_nondim"],
         "{}",
@@ -73,7 +81,11 @@ async fn assert_hour_is_plan(h: &Value, wind: &Value) {
 
 #[tokio::test]
 async fn open_meteo_hours_are_the_plan_of_their_echoed_wind() {
-    let (s, r) = post("/api/v1/windows", &windows_request("open_meteo", open_meteo_file())).await;
+    let (s, r) = post(
+        "/api/v1/windows",
+        &windows_request("open_meteo", open_meteo_file()),
+    )
+    .await;
     assert_eq!(s, StatusCode::OK, "{r}");
     let hours = r["hours"].as_array().unwrap();
     assert_eq!(hours.len(), 24);
@@ -87,11 +99,24 @@ async fn open_meteo_hours_are_the_plan_of_their_echoed_wind() {
     // its 2 km/h gust left out (and said so).
     assert_eq!(hours[5]["wind"]["flow"]["kind"], "power_law");
     assert_eq!(hours[5]["wind"]["flow"]["reference_height_m"], 10.0);
-    assert_eq!(hours[2]["wind"]["flow"], json!({"kind": "uniform", "speed_m_s": 0.0}));
+    assert_eq!(
+        hours[2]["wind"]["flow"],
+        json!({"kind": "uniform", "speed_m_s": 0.0})
+    );
     assert!(hours[2]["wind"].get("gust").is_none());
-    assert!(r["notes"].to_string().contains("2026-12-03T02:00"), "{}", r["notes"]);
-    let verdicts: Vec<&str> = hours.iter().map(|h| h["verdict"].as_str().unwrap()).collect();
-    assert!(verdicts.contains(&"go") && verdicts.contains(&"no-go"), "{verdicts:?}");
+    assert!(
+        r["notes"].to_string().contains("2026-12-03T02:00"),
+        "{}",
+        r["notes"]
+    );
+    let verdicts: Vec<&str> = hours
+        .iter()
+        .map(|h| h["verdict"].as_str().unwrap())
+        .collect();
+    assert!(
+        verdicts.contains(&"go") && verdicts.contains(&"no-go"),
+        "{verdicts:?}"
+    );
     // The windows are the runs of in-limit hours long enough for the
     // deployment, an hour aloft and the haul-down.
     let ws = r["windows"].as_array().unwrap();
@@ -104,14 +129,21 @@ async fn open_meteo_hours_are_the_plan_of_their_echoed_wind() {
                     && h["time"].as_str().unwrap() < w["end"].as_str().unwrap()
             })
             .collect();
-        assert!(inside.iter().all(|h| h["in_window_limits"] == true && h["verdict"] == "go"));
+        assert!(
+            inside
+                .iter()
+                .all(|h| h["in_window_limits"] == true && h["verdict"] == "go")
+        );
         let need = inside
             .iter()
             .map(|h| h["deployment_s"].as_f64().unwrap() + h["haul_down_s"].as_f64().unwrap())
             .fold(0.0, f64::max)
             + 3600.0;
         assert_eq!(w["required_s"].as_f64().unwrap(), need);
-        assert_eq!(w["duration_s"].as_f64().unwrap(), 3600.0 * inside.len() as f64);
+        assert_eq!(
+            w["duration_s"].as_f64().unwrap(),
+            3600.0 * inside.len() as f64
+        );
         assert!(w["duration_s"].as_f64().unwrap() >= need);
     }
 }
@@ -128,11 +160,18 @@ async fn a_uniform_hour_in_knots_is_the_plan_for_that_speed() {
     assert_eq!(s, StatusCode::OK, "{r}");
     let u = 15.0 * 1852.0 / 3600.0;
     let h = &r["hours"][0];
-    assert_eq!(h["wind"]["flow"], json!({"kind": "uniform", "speed_m_s": u}));
+    assert_eq!(
+        h["wind"]["flow"],
+        json!({"kind": "uniform", "speed_m_s": u})
+    );
     assert_eq!(h["wind_at_target_m_s"], u);
     assert_hour_is_plan(h, &json!({"flow": {"kind": "uniform", "speed_m_s": u}})).await;
     // The calm hour is the plan in calm (zero-speed) air.
-    assert_hour_is_plan(&r["hours"][1], &json!({"flow": {"kind": "uniform", "speed_m_s": 0.0}})).await;
+    assert_hour_is_plan(
+        &r["hours"][1],
+        &json!({"flow": {"kind": "uniform", "speed_m_s": 0.0}}),
+    )
+    .await;
 }
 
 #[tokio::test]
@@ -206,8 +245,14 @@ async fn taf_gives_one_period_per_change_group() {
             ("tempo", "031800Z", "032200Z", 7.0 * 3600.0),
         ]
     );
-    assert_eq!(hours[1]["wind"]["flow"]["speed_m_s"], 20.0 * 1852.0 / 3600.0);
-    assert_eq!(hours[2]["wind"]["flow"]["speed_m_s"], 30.0 * 1852.0 / 3600.0);
+    assert_eq!(
+        hours[1]["wind"]["flow"]["speed_m_s"],
+        20.0 * 1852.0 / 3600.0
+    );
+    assert_eq!(
+        hours[2]["wind"]["flow"]["speed_m_s"],
+        30.0 * 1852.0 / 3600.0
+    );
     for h in hours {
         assert_hour_is_plan(h, &h["wind"]).await;
     }
@@ -252,13 +297,30 @@ async fn an_ensemble_of_equal_members_is_the_single_forecast() {
     assert_eq!(s, StatusCode::OK, "{r}");
     assert_eq!(r["members"], 4);
     assert_eq!(r["plans_computed"], single["plans_computed"]);
-    for (h, one) in r["hours"].as_array().unwrap().iter().zip(single["hours"].as_array().unwrap()) {
-        for k in ["time", "wind", "verdict", "reason", "max_altitude_m", "peak_tension_n", "in_window_limits"] {
+    for (h, one) in r["hours"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(single["hours"].as_array().unwrap())
+    {
+        for k in [
+            "time",
+            "wind",
+            "verdict",
+            "reason",
+            "max_altitude_m",
+            "peak_tension_n",
+            "in_window_limits",
+        ] {
             assert_eq!(h[k], one[k], "{k} at {}", h["time"]);
         }
         let p = if h["verdict"] == "go" { 1.0 } else { 0.0 };
         assert_eq!(h["probability_go"], p);
-        for k in ["max_altitude_p10_m", "max_altitude_p50_m", "max_altitude_p90_m"] {
+        for k in [
+            "max_altitude_p10_m",
+            "max_altitude_p50_m",
+            "max_altitude_p90_m",
+        ] {
             assert_eq!(h[k], h["max_altitude_m"], "{k}");
         }
         assert!(one.get("probability_go").is_none());
@@ -287,8 +349,14 @@ async fn members_split_three_to_one_give_three_quarters() {
     let h = &r["hours"][8];
     assert_eq!(h["verdict"], "go", "{}", h["reason"]);
     assert_eq!(h["probability_go"], 0.75);
-    let (lo, hi) = (h["probability_go_low"].as_f64().unwrap(), h["probability_go_high"].as_f64().unwrap());
-    assert!(lo < 0.75 && hi > 0.75 && lo >= 0.0 && hi <= 1.0, "{lo} {hi}");
+    let (lo, hi) = (
+        h["probability_go_low"].as_f64().unwrap(),
+        h["probability_go_high"].as_f64().unwrap(),
+    );
+    assert!(
+        lo < 0.75 && hi > 0.75 && lo >= 0.0 && hi <= 1.0,
+        "{lo} {hi}"
+    );
     // The stormy member's altitude is the lowest: the 10 % point is below the median.
     assert!(h["max_altitude_p10_m"].as_f64().unwrap() < h["max_altitude_p50_m"].as_f64().unwrap());
 }
@@ -307,7 +375,11 @@ async fn haul_down_limits_make_windy_hours_no_go_and_say_so() {
             assert_eq!(h["verdict"], "no-go", "{}", h["time"]);
             // A plan that flies says the haul-down binds; one that cannot fly says why.
             if h["deployment_s"].is_number() {
-                assert!(h["reason"].as_str().unwrap().contains("haul-down"), "{}", h["reason"]);
+                assert!(
+                    h["reason"].as_str().unwrap().contains("haul-down"),
+                    "{}",
+                    h["reason"]
+                );
             }
         }
         // Within a window only with α × the limit.
@@ -326,7 +398,10 @@ async fn refused(body: &Value) -> (String, String) {
     assert_eq!(s, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
     (
         r["error"]["field"].as_str().unwrap_or_default().to_string(),
-        r["error"]["message"].as_str().unwrap_or_default().to_string(),
+        r["error"]["message"]
+            .as_str()
+            .unwrap_or_default()
+            .to_string(),
     )
 }
 
@@ -335,17 +410,33 @@ async fn bad_forecasts_are_refused_naming_field_and_key_or_line() {
     let om = |hourly: Value, units: Value| json!({"hourly": hourly, "hourly_units": units});
     let t = json!(["2026-12-03T00:00", "2026-12-03T01:00", "2026-12-03T02:00"]);
     let cases: Vec<(&str, Value, &str, &str)> = vec![
-        ("open_meteo", json!("not an object"), "forecast.data", "JSON object"),
-        ("open_meteo", json!({"latitude": 1.0}), "forecast.data.hourly", "required"),
         (
             "open_meteo",
-            om(json!({"time": t, "wind_speed_10m": [1, 2, 3]}), json!({"wind_speed_10m": "furlong/fortnight"})),
+            json!("not an object"),
+            "forecast.data",
+            "JSON object",
+        ),
+        (
+            "open_meteo",
+            json!({"latitude": 1.0}),
+            "forecast.data.hourly",
+            "required",
+        ),
+        (
+            "open_meteo",
+            om(
+                json!({"time": t, "wind_speed_10m": [1, 2, 3]}),
+                json!({"wind_speed_10m": "furlong/fortnight"}),
+            ),
             "forecast.data.hourly_units.wind_speed_10m",
             "unknown unit",
         ),
         (
             "open_meteo",
-            om(json!({"time": t, "temperature_2m": [1, 2, 3]}), json!({"temperature_2m": "°C"})),
+            om(
+                json!({"time": t, "temperature_2m": [1, 2, 3]}),
+                json!({"temperature_2m": "°C"}),
+            ),
             "forecast.data.hourly",
             "no wind",
         ),
@@ -360,23 +451,37 @@ async fn bad_forecasts_are_refused_naming_field_and_key_or_line() {
         ),
         (
             "open_meteo",
-            om(json!({"time": t, "wind_speed_10m": [1, "x", 3]}), json!({"wind_speed_10m": "m/s"})),
+            om(
+                json!({"time": t, "wind_speed_10m": [1, "x", 3]}),
+                json!({"wind_speed_10m": "m/s"}),
+            ),
             "forecast.data.hourly.wind_speed_10m[1]",
             "number",
         ),
         (
             "open_meteo",
-            om(json!({"time": t, "wind_speed_10m": [1, 2]}), json!({"wind_speed_10m": "m/s"})),
+            om(
+                json!({"time": t, "wind_speed_10m": [1, 2]}),
+                json!({"wind_speed_10m": "m/s"}),
+            ),
             "forecast.data.hourly.wind_speed_10m",
             "2 values for 3 times",
         ),
         (
             "open_meteo",
-            om(json!({"time": t, "wind_speed_10m": [null, null, null]}), json!({"wind_speed_10m": "m/s"})),
+            om(
+                json!({"time": t, "wind_speed_10m": [null, null, null]}),
+                json!({"wind_speed_10m": "m/s"}),
+            ),
             "forecast.data",
             "no wind",
         ),
-        ("csv", json!("when,where\n"), "forecast.data line 1", "header"),
+        (
+            "csv",
+            json!("when,where\n"),
+            "forecast.data line 1",
+            "header",
+        ),
         (
             "csv",
             json!("time,height_m,speed_m_s,gust_m_s\n2026-12-03T00:00,10,abc,\n"),
@@ -385,15 +490,32 @@ async fn bad_forecasts_are_refused_naming_field_and_key_or_line() {
         ),
         (
             "csv",
-            json!("time,height_m,speed_m_s,gust_m_s\n2026-12-03T01:00,10,3,\n\n2026-12-03T00:00,10,4,\n"),
+            json!(
+                "time,height_m,speed_m_s,gust_m_s\n2026-12-03T01:00,10,3,\n\n2026-12-03T00:00,10,4,\n"
+            ),
             "forecast.data line 4",
             "time order",
         ),
-        ("csv", json!("time,height_m,speed_m_s,gust_m_s\n"), "forecast.data", "no wind"),
+        (
+            "csv",
+            json!("time,height_m,speed_m_s,gust_m_s\n"),
+            "forecast.data",
+            "no wind",
+        ),
         ("csv", json!({"rows": []}), "forecast.data", "JSON string"),
         ("metar", json!("HELLO"), "forecast.data", "METAR"),
-        ("metar", json!("METAR EDDB 031250Z CAVOK 08/02 Q1012"), "forecast.data", "no wind"),
-        ("taf", json!("TAF EDDB 031100Z 0312/0412 9999 SCT030"), "forecast.data", "no wind"),
+        (
+            "metar",
+            json!("METAR EDDB 031250Z CAVOK 08/02 Q1012"),
+            "forecast.data",
+            "no wind",
+        ),
+        (
+            "taf",
+            json!("TAF EDDB 031100Z 0312/0412 9999 SCT030"),
+            "forecast.data",
+            "no wind",
+        ),
     ];
     for (format, data, field, words) in cases {
         let (f, m) = refused(&windows_request(format, data.clone())).await;
@@ -401,13 +523,22 @@ async fn bad_forecasts_are_refused_naming_field_and_key_or_line() {
         assert!(m.contains(words), "{format} {data}: {m}");
     }
     // The request's own fields.
-    let mut b = windows_request("csv", json!("time,height_m,speed_m_s\n2026-12-03T00:00,10,3\n"));
+    let mut b = windows_request(
+        "csv",
+        json!("time,height_m,speed_m_s\n2026-12-03T00:00,10,3\n"),
+    );
     b["forecast"]["format"] = json!("grib");
     assert_eq!(refused(&b).await.0, "forecast.format");
-    let mut b = windows_request("csv", json!("time,height_m,speed_m_s\n2026-12-03T00:00,10,3\n"));
+    let mut b = windows_request(
+        "csv",
+        json!("time,height_m,speed_m_s\n2026-12-03T00:00,10,3\n"),
+    );
     b["operation_s"] = json!(-1.0);
     assert_eq!(refused(&b).await.0, "operation_s");
-    let mut b = windows_request("csv", json!("time,height_m,speed_m_s\n2026-12-03T00:00,10,3\n"));
+    let mut b = windows_request(
+        "csv",
+        json!("time,height_m,speed_m_s\n2026-12-03T00:00,10,3\n"),
+    );
     b["wind"] = json!({"flow": {"kind": "uniform", "speed_m_s": 3.0}});
     assert_eq!(refused(&b).await.0, "wind.flow");
     // A wind the plan refuses names the period.

@@ -69,7 +69,10 @@ fn a_gust_in_the_dynamics_model_raises_the_caution_in_time_and_it_clears_after_t
     let gusty = fly(true);
     let steady = calm[0].1;
     let peak = gusty.iter().map(|s| s.1).fold(f64::MIN, f64::max);
-    assert!(peak > 1.2 * steady, "the gust loads the tether: {steady} → {peak} N");
+    assert!(
+        peak > 1.2 * steady,
+        "the gust loads the tether: {steady} → {peak} N"
+    );
     let caution = steady + 0.5 * (peak - steady);
     let allowed = caution / 0.8;
 
@@ -104,8 +107,15 @@ fn a_gust_in_the_dynamics_model_raises_the_caution_in_time_and_it_clears_after_t
     assert_eq!(alarms.len(), 1, "{alarms:?}");
     let a = alarms[0];
     assert_eq!((a.check, a.level), (CheckName::Tension, Level::Caution));
-    assert!((a.raised_at_s - raise).abs() < 1e-9, "{} vs {raise}", a.raised_at_s);
-    assert!(a.raised_at_s - t_exceed <= 1.0 + DT + 1e-9, "within 1 s of sample time");
+    assert!(
+        (a.raised_at_s - raise).abs() < 1e-9,
+        "{} vs {raise}",
+        a.raised_at_s
+    );
+    assert!(
+        a.raised_at_s - t_exceed <= 1.0 + DT + 1e-9,
+        "within 1 s of sample time"
+    );
     assert_eq!(a.cleared_at_s, Some(clear));
     assert_eq!(m.status(Some(0.0)).state, Level::Normal);
 

@@ -384,7 +384,10 @@ fn sqlite_file_shrinks_after_a_purge() {
         assert_eq!(purged, 8);
         let after = sqlite_bytes(&path);
         eprintln!("old file {old_file}: {full} bytes with the jobs, {after} after the purge");
-        assert!(after < 2 << 20, "{after} bytes after the purge (was {full})");
+        assert!(
+            after < 2 << 20,
+            "{after} bytes after the purge (was {full})"
+        );
         let c = rusqlite::Connection::open(&path).unwrap();
         let mode: i64 = c.query_row("PRAGMA auto_vacuum", [], |r| r.get(0)).unwrap();
         assert_eq!(mode, 2, "incremental");

@@ -117,15 +117,30 @@ fn run_to_end(subcommand: &str, url: &str) -> (Option<i32>, String) {
         std::thread::sleep(Duration::from_millis(20));
     };
     let mut err = String::new();
-    child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
     (status.code(), err)
 }
 
 fn assert_plain_failure(what: &str, code: Option<i32>, err: &str, expected: &[&str]) {
-    assert_eq!(code, Some(1), "{what}: exit status 1 expected, stderr:\n{err}");
+    assert_eq!(
+        code,
+        Some(1),
+        "{what}: exit status 1 expected, stderr:\n{err}"
+    );
     assert!(!err.contains("panicked"), "{what}: a panic:\n{err}");
-    assert!(!err.contains("db error"), "{what}: \"db error\" says nothing:\n{err}");
-    assert!(!err.contains("migrated"), "{what}: a migration logged as done:\n{err}");
+    assert!(
+        !err.contains("db error"),
+        "{what}: \"db error\" says nothing:\n{err}"
+    );
+    assert!(
+        !err.contains("migrated"),
+        "{what}: a migration logged as done:\n{err}"
+    );
     for e in expected {
         assert!(err.contains(e), "{what}: {e:?} not in stderr:\n{err}");
     }
@@ -149,7 +164,10 @@ fn a_table_it_did_not_make_stops_the_start_and_changes_nothing() {
             sub,
             code,
             &err,
-            &["a table `systems` that tetherplan did not make", "nothing was changed"],
+            &[
+                "a table `systems` that tetherplan did not make",
+                "nothing was changed",
+            ],
         );
         assert_eq!(db.relations(), before, "{sub} left the database changed");
     }
@@ -223,9 +241,15 @@ fn a_wrong_password_says_authentication_failed() {
         "serve",
         code,
         &err,
-        &["authentication failed", "password authentication failed for user"],
+        &[
+            "authentication failed",
+            "password authentication failed for user",
+        ],
     );
-    assert!(!err.contains("not-the-password-x9"), "the password shown:\n{err}");
+    assert!(
+        !err.contains("not-the-password-x9"),
+        "the password shown:\n{err}"
+    );
 }
 
 /// Nothing listening: "connection refused", and where.

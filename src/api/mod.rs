@@ -228,8 +228,12 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
     ));
     // TETHERPLAN_JOB_THREADS=0: jobs are left to `tetherplan worker` processes.
     let worker = (config.job_threads > 0).then(|| queue.spawn_worker());
-    let flights = flights::hub::FlightHub::open(&config.store)
-        .map_err(|e| format!("cannot open the flights of {}: {e}", config.store.describe()))?;
+    let flights = flights::hub::FlightHub::open(&config.store).map_err(|e| {
+        format!(
+            "cannot open the flights of {}: {e}",
+            config.store.describe()
+        )
+    })?;
     let state = AppState::new(queue.clone())
         .with_tokens(&config.api_tokens)
         .with_flights(flights);

@@ -419,12 +419,19 @@ mod tests {
             let post = &paths[p]["post"];
             // Actions on a flight (`end`, `alarms/acknowledge`) take no body.
             if post.get("requestBody").is_none() {
-                assert!(p.starts_with("/api/v1/flights/{id}/"), "{p} has no request body");
+                assert!(
+                    p.starts_with("/api/v1/flights/{id}/"),
+                    "{p} has no request body"
+                );
                 continue;
             }
             let ex = &post["requestBody"]["content"]["application/json"]["example"];
             // Telemetry is a JSON array of samples; every analysis takes an object.
-            let fits = if p.ends_with("/telemetry") { ex.is_array() } else { ex.is_object() };
+            let fits = if p.ends_with("/telemetry") {
+                ex.is_array()
+            } else {
+                ex.is_object()
+            };
             assert!(fits, "{p} has no request example");
         }
         let cable = &doc["components"]["schemas"]["CableInput"];

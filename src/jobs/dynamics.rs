@@ -38,14 +38,11 @@ impl JobKind for DynamicsRequest {
         to_json(&dynamics::dynamics(self, progress)?)
     }
     fn estimate(&self) -> Estimate {
-        let shapes = self
-            .shape_times_s
-            .as_ref()
-            .map_or(
-                self.shape_count
-                    .unwrap_or(crate::contract::dynamics::dto::DEFAULT_SHAPE_COUNT),
-                Vec::len,
-            ) as u64;
+        let shapes = self.shape_times_s.as_ref().map_or(
+            self.shape_count
+                .unwrap_or(crate::contract::dynamics::dto::DEFAULT_SHAPE_COUNT),
+            Vec::len,
+        ) as u64;
         let nodes = shapes.saturating_mul(self.numerics.segments as u64 + 1);
         E::new(
             "sample_count",

@@ -17,7 +17,6 @@
 pub mod bands;
 pub mod chunks;
 pub mod dynamics;
-pub mod windows;
 pub mod estimate;
 pub mod flights;
 pub mod flights_sqlite;
@@ -28,6 +27,7 @@ pub mod postgres;
 pub mod sqlite;
 pub mod store;
 pub mod tether;
+pub mod windows;
 pub mod worker;
 
 use std::collections::HashMap;

@@ -27,8 +27,12 @@ impl JobKind for WindowsRequest {
         // The answer lists the first member's periods (parsing is cheap;
         // an unparsable forecast is refused by `validate`).
         let periods = windows::source::parse_forecast(&self.forecast)
-            .map_or(0, |f| f.members.first().map_or(0, |m| m.periods.len())) as u64;
-        Estimate::new("forecast.data", est::SMALL_ANSWER + periods.saturating_mul(PER_PERIOD))
+            .map_or(0, |f| f.members.first().map_or(0, |m| m.periods.len()))
+            as u64;
+        Estimate::new(
+            "forecast.data",
+            est::SMALL_ANSWER + periods.saturating_mul(PER_PERIOD),
+        )
     }
 }
 

@@ -48,7 +48,11 @@ fn wind_of(w: &Wind, what: &str) -> Result<(Vec<(f64, f64)>, Option<(f64, f64)>)
 /// Day, hour and minute on the report's axis (s); days before `day0` are in
 /// the next month of `day0` days.
 fn axis(day0: u8, (d, h, m): (u8, u8, u8)) -> f64 {
-    let d = if d < day0 { i64::from(d) + i64::from(day0) } else { i64::from(d) };
+    let d = if d < day0 {
+        i64::from(d) + i64::from(day0)
+    } else {
+        i64::from(d)
+    };
     (d * 86_400 + i64::from(h) * 3600 + i64::from(m) * 60) as f64
 }
 
@@ -57,11 +61,13 @@ fn text(style: TimeStyle, t: f64) -> String {
 }
 
 pub fn parse_metar(s: &str) -> Result<ParsedForecast, InvalidInput> {
-    let m = metar_taf_parser::parse_metar(s.trim()).map_err(|e| {
-        InvalidInput::new("forecast.data", format!("is not a METAR report: {e}"))
-    })?;
+    let m = metar_taf_parser::parse_metar(s.trim())
+        .map_err(|e| InvalidInput::new("forecast.data", format!("is not a METAR report: {e}")))?;
     let w = m.wind.as_ref().ok_or_else(|| {
-        InvalidInput::new("forecast.data", "has no wind: the METAR has no wind group (dddffKT)")
+        InvalidInput::new(
+            "forecast.data",
+            "has no wind: the METAR has no wind group (dddffKT)",
+        )
     })?;
     let (winds, gust) = wind_of(w, "METAR")?;
     let (day0, t) = match &m.time {
@@ -107,7 +113,13 @@ pub fn parse_taf(s: &str) -> Result<ParsedForecast, InvalidInput> {
     let mut days = vec![v.from_day, v.to_day];
     for f in &taf.forecasts {
         days.extend(f.from.map(|t| t.0));
-        days.extend(f.period.as_ref().map(|p| [p.from.0, p.to.0]).into_iter().flatten());
+        days.extend(
+            f.period
+                .as_ref()
+                .map(|p| [p.from.0, p.to.0])
+                .into_iter()
+                .flatten(),
+        );
     }
     let style = TimeStyle::Aviation {
         month_days: if days.iter().any(|d| *d < day0) {

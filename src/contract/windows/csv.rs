@@ -22,7 +22,10 @@ fn number(line: usize, name: &str, s: &str) -> Result<f64, InvalidInput> {
         .parse()
         .map_err(|_| err(line, format!("{name} `{}` is not a number", s.trim())))?;
     if !v.is_finite() || v < 0.0 {
-        return Err(err(line, format!("{name} must be a finite number ≥ 0, got {v}")));
+        return Err(err(
+            line,
+            format!("{name} must be a finite number ≥ 0, got {v}"),
+        ));
     }
     Ok(v)
 }
@@ -54,7 +57,11 @@ pub fn parse(text: &str) -> Result<ParsedForecast, InvalidInput> {
         if f.len() != cols.len() && !(cols.len() == 4 && f.len() == 3) {
             return Err(err(
                 n,
-                format!("expected {} comma-separated values, got {}", cols.len(), f.len()),
+                format!(
+                    "expected {} comma-separated values, got {}",
+                    cols.len(),
+                    f.len()
+                ),
             ));
         }
         let t = match parse_iso(f[0]) {
@@ -87,7 +94,10 @@ pub fn parse(text: &str) -> Result<ParsedForecast, InvalidInput> {
         match rows.last_mut() {
             Some(last) if last.1 == t => {
                 if last.3.iter().any(|w| w.0 == z) {
-                    return Err(err(n, format!("height {z} m is given twice at time {}", f[0])));
+                    return Err(err(
+                        n,
+                        format!("height {z} m is given twice at time {}", f[0]),
+                    ));
                 }
                 last.3.push((z, u));
                 if let Some(g) = g

@@ -49,12 +49,18 @@ fn classify(key: &str) -> Option<(Series, String)> {
     if !(h.is_finite() && h > 0.0) {
         return None;
     }
-    if member != "control"
-        && !(member.len() > 6 && member[6..].bytes().all(|b| b.is_ascii_digit()))
+    if member != "control" && !(member.len() > 6 && member[6..].bytes().all(|b| b.is_ascii_digit()))
     {
         return None;
     }
-    Some((if kind == 0 { Series::Speed(h) } else { Series::Gust(h) }, member))
+    Some((
+        if kind == 0 {
+            Series::Speed(h)
+        } else {
+            Series::Gust(h)
+        },
+        member,
+    ))
 }
 
 pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
@@ -69,16 +75,21 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
             "forecast.data.error",
             format!(
                 "the forecast is an Open-Meteo error: {}",
-                obj.get("reason").and_then(Value::as_str).unwrap_or("no reason given")
+                obj.get("reason")
+                    .and_then(Value::as_str)
+                    .unwrap_or("no reason given")
             ),
         ));
     }
-    let hourly = obj.get("hourly").and_then(Value::as_object).ok_or_else(|| {
-        InvalidInput::new(
-            field(".hourly"),
-            "is required: the object of hourly series (`time`, `wind_speed_10m`, …)",
-        )
-    })?;
+    let hourly = obj
+        .get("hourly")
+        .and_then(Value::as_object)
+        .ok_or_else(|| {
+            InvalidInput::new(
+                field(".hourly"),
+                "is required: the object of hourly series (`time`, `wind_speed_10m`, …)",
+            )
+        })?;
     let units = match obj.get("hourly_units") {
         None => None,
         Some(Value::Object(u)) => Some(u),
@@ -93,16 +104,25 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
     if units.is_none() {
         notes.push("hourly_units absent: speeds read in km/h, Open-Meteo's default".to_string());
     }
-    let times = hourly.get("time").and_then(Value::as_array).ok_or_else(|| {
-        InvalidInput::new(field(".hourly.time"), "is required: the list of the hours' times")
-    })?;
+    let times = hourly
+        .get("time")
+        .and_then(Value::as_array)
+        .ok_or_else(|| {
+            InvalidInput::new(
+                field(".hourly.time"),
+                "is required: the list of the hours' times",
+            )
+        })?;
     let mut style = TimeStyle::Iso;
     let mut ts = Vec::with_capacity(times.len());
     for (i, t) in times.iter().enumerate() {
         let f = || field(&format!(".hourly.time[{i}]"));
         let v = match t {
             Value::String(s) => parse_iso(s).ok_or_else(|| {
-                InvalidInput::new(f(), format!("`{s}` is not an ISO 8601 date-time (2026-12-03T14:00)"))
+                InvalidInput::new(
+                    f(),
+                    format!("`{s}` is not an ISO 8601 date-time (2026-12-03T14:00)"),
+                )
             })?,
             Value::Number(n) => {
                 style = TimeStyle::Unix;
@@ -122,11 +142,7 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
         {
             return Err(InvalidInput::new(
                 f(),
-                format!(
-                    "times must increase: {} is not after {}",
-                    t,
-                    times[i - 1]
-                ),
+                format!("times must increase: {} is not after {}", t, times[i - 1]),
             ));
         }
         ts.push(v);
@@ -139,7 +155,10 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
             continue;
         };
         let arr = v.as_array().ok_or_else(|| {
-            InvalidInput::new(field(&format!(".hourly.{key}")), "must be a list of numbers (or null)")
+            InvalidInput::new(
+                field(&format!(".hourly.{key}")),
+                "must be a list of numbers (or null)",
+            )
         })?;
         if arr.len() != ts.len() {
             return Err(InvalidInput::new(
@@ -169,12 +188,15 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
             values.push(match x {
                 Value::Null => None,
                 Value::Number(n) => {
-                    let s = n.as_f64().filter(|s| s.is_finite() && *s >= 0.0).ok_or_else(|| {
-                        InvalidInput::new(
-                            field(&format!(".hourly.{key}[{i}]")),
-                            format!("must be a speed ≥ 0, got {n}"),
-                        )
-                    })?;
+                    let s = n
+                        .as_f64()
+                        .filter(|s| s.is_finite() && *s >= 0.0)
+                        .ok_or_else(|| {
+                            InvalidInput::new(
+                                field(&format!(".hourly.{key}[{i}]")),
+                                format!("must be a speed ≥ 0, got {n}"),
+                            )
+                        })?;
                     Some(unit.to_m_s(s))
                 }
                 other => {
@@ -198,7 +220,10 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
         ));
     }
     if ts.is_empty() {
-        return Err(InvalidInput::new(field(".hourly.time"), "has no wind: no hours"));
+        return Err(InvalidInput::new(
+            field(".hourly.time"),
+            "has no wind: no hours",
+        ));
     }
     let mut out = Vec::new();
     // The control first, then the members in order.
@@ -246,7 +271,9 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
             });
         }
         if skipped > 0 {
-            notes.push(format!("{name}: {skipped} hour(s) with no wind speed at any height left out"));
+            notes.push(format!(
+                "{name}: {skipped} hour(s) with no wind speed at any height left out"
+            ));
         }
         out.push(Member { name, periods });
     }

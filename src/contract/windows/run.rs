@@ -95,7 +95,10 @@ fn base_plan(req: &WindowsRequest) -> Result<PlanRequest, RequestError> {
         ("initial_length_m", req.initial_length_m),
         ("gravity_m_s2", req.gravity_m_s2),
         ("lift_reserve_nondim", req.lift_reserve_nondim),
-        ("required_safety_factor_nondim", req.required_safety_factor_nondim),
+        (
+            "required_safety_factor_nondim",
+            req.required_safety_factor_nondim,
+        ),
         ("min_altitude_m", req.min_altitude_m),
     ] {
         if let Some(v) = v {
@@ -184,7 +187,12 @@ pub fn prepare(req: &WindowsRequest) -> Result<Prepared, RequestError> {
     let factor = match &req.lead_time_factor {
         None => LeadTimeFactor::default(),
         Some(f) => LeadTimeFactor {
-            per_hour: bounded("lead_time_factor.per_hour_nondim", f.per_hour_nondim, 0.0, 1.0)?,
+            per_hour: bounded(
+                "lead_time_factor.per_hour_nondim",
+                f.per_hour_nondim,
+                0.0,
+                1.0,
+            )?,
             floor: bounded("lead_time_factor.min_nondim", f.min_nondim, 0.0, 1.0)?,
         },
     };
@@ -379,7 +387,10 @@ fn reason(req: &WindowsRequest, plan: &PlanResponse) -> String {
 }
 
 /// Answers a windows request.
-pub fn windows(req: &WindowsRequest, progress: &dyn Progress) -> Result<WindowsResponse, RequestError> {
+pub fn windows(
+    req: &WindowsRequest,
+    progress: &dyn Progress,
+) -> Result<WindowsResponse, RequestError> {
     let started = Instant::now();
     let prepared = prepare(req)?;
     answer(req, &prepared, progress, started)
@@ -458,7 +469,10 @@ pub fn answer(
         };
         if ensemble {
             let key = p.start_s.to_bits();
-            let members: Vec<&Judged> = by_start.iter().filter_map(|m| m.get(&key).copied()).collect();
+            let members: Vec<&Judged> = by_start
+                .iter()
+                .filter_map(|m| m.get(&key).copied())
+                .collect();
             let go: Vec<bool> = members.iter().map(|m| m.go).collect();
             let s = share_go(&go);
             let alts: Vec<f64> = members.iter().map(|m| m.max_altitude_m).collect();

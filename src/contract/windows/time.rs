@@ -135,7 +135,10 @@ mod tests {
         assert_eq!(format_iso(t), "2026-12-03T14:00");
         assert_eq!(parse_iso("2026-12-03T15:00+01:00"), Some(t));
         assert_eq!(parse_iso("2026-12-03T14:00:00Z"), Some(t));
-        assert_eq!(parse_iso("2024-02-29T00:00").map(format_iso).as_deref(), Some("2024-02-29T00:00"));
+        assert_eq!(
+            parse_iso("2024-02-29T00:00").map(format_iso).as_deref(),
+            Some("2024-02-29T00:00")
+        );
         assert_eq!(parse_iso("2026-02-29T00:00"), None);
         assert_eq!(parse_iso("2026-12-03 14:00"), None);
         assert_eq!(parse_iso("yesterday"), None);

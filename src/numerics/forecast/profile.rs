@@ -98,7 +98,10 @@ pub enum FitError {
     /// A height or speed that is not a finite number ≥ 0 (height > 0).
     Invalid { index: usize, what: &'static str },
     /// The one height of a log law at or below the roughness length.
-    BelowRoughness { height_m: f64, roughness_length_m: f64 },
+    BelowRoughness {
+        height_m: f64,
+        roughness_length_m: f64,
+    },
 }
 
 /// Largest power-law exponent (SPEC §9 bounds of `exponent_nondim`).
@@ -117,10 +120,16 @@ pub fn fit_hour(
     }
     for (i, &(z, u)) in winds.iter().enumerate() {
         if !(z.is_finite() && z > 0.0) {
-            return Err(FitError::Invalid { index: i, what: "height" });
+            return Err(FitError::Invalid {
+                index: i,
+                what: "height",
+            });
         }
         if !(u.is_finite() && u >= 0.0) {
-            return Err(FitError::Invalid { index: i, what: "speed" });
+            return Err(FitError::Invalid {
+                index: i,
+                what: "speed",
+            });
         }
     }
     let mut positive: Vec<(f64, f64)> = winds.iter().copied().filter(|w| w.1 > 0.0).collect();
@@ -166,10 +175,7 @@ pub fn fit_hour(
                     what: "gust",
                 });
             }
-            let measured = winds
-                .iter()
-                .find(|w| w.0 == zg && w.1 > 0.0)
-                .map(|w| w.1);
+            let measured = winds.iter().find(|w| w.0 == zg && w.1 > 0.0).map(|w| w.1);
             let mean = measured.unwrap_or_else(|| flow.speed_m_s(zg));
             if mean > 0.0 {
                 let r = (g / mean).max(1.0);
