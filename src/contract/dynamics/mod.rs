@@ -15,6 +15,7 @@
 //! * [`peaks`]: the Monte Carlo, chunked by sample for the job queue.
 
 pub mod dto;
+pub mod kind;
 pub mod peaks;
 pub mod run;
 pub mod validate;

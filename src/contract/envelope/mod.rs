@@ -5,6 +5,7 @@
 
 pub mod chunks;
 pub mod dto;
+pub mod kind;
 pub mod stability;
 
 use crate::contract::equilibrium::dto::WindFlowInput;

@@ -5,6 +5,7 @@
 
 pub mod dto;
 pub mod ge;
+pub mod kind;
 mod output;
 pub mod run;
 mod validate;
