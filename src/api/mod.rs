@@ -13,6 +13,7 @@ pub mod assets;
 pub mod auth;
 pub mod auth_doc;
 pub mod error;
+pub mod flights;
 pub mod guard;
 pub mod health;
 pub mod jobs;
@@ -80,6 +81,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
             "/api/v1/jobs/{id}",
             get(jobs::get_job).delete(jobs::delete_job),
         )
+        .merge(flights::routes())
         .route("/api", any(api_not_found))
         .route("/api/{*rest}", any(api_not_found))
         .method_not_allowed_fallback(method_not_allowed)
@@ -114,7 +116,11 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
     ));
     // TETHERPLAN_JOB_THREADS=0: jobs are left to `tetherplan worker` processes.
     let worker = (config.job_threads > 0).then(|| queue.spawn_worker());
-    let state = AppState::new(queue.clone()).with_tokens(&config.api_tokens);
+    let flights = flights::hub::FlightHub::open(&config.store)
+        .map_err(|e| format!("cannot open the flights of {}: {e}", config.store.describe()))?;
+    let state = AppState::new(queue.clone())
+        .with_tokens(&config.api_tokens)
+        .with_flights(flights);
     let listener = tokio::net::TcpListener::bind(config.addr)
         .await
         .map_err(|e| format!("cannot listen on {}: {e}", config.addr))?;

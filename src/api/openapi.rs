@@ -53,6 +53,7 @@ macro_rules! api_doc {
             Health, crate::contract::bands::BandsResponse,
             crate::contract::bands::PlanBandsResponse, crate::contract::bands::EnvelopeBandsResponse,
             crate::contract::dynamics::DynamicsResponse, crate::contract::dynamics::DynamicsPeaksResponse,
+            crate::contract::windows::WindowsResponse,
         )),
         modifiers(&BearerTokens),
         tags(
@@ -87,6 +88,7 @@ pub fn openapi() -> utoipa::openapi::OpenApi {
             op.description = None;
         }
     }
+    doc.merge(crate::api::flights::FlightsDoc::openapi());
     crate::api::spec::refine(doc)
 }
 

@@ -1,11 +1,12 @@
 //! The handlers' shared state: the job queue, the limits, the permits of
-//! the synchronous solves and the API tokens.
+//! the synchronous solves, the API tokens and the live flights.
 
 use std::sync::Arc;
 
 use tokio::sync::Semaphore;
 
 use crate::api::auth;
+use crate::api::flights::hub::FlightHub;
 use crate::config::Limits;
 use crate::jobs::JobQueue;
 
@@ -17,6 +18,8 @@ pub struct AppState {
     pub(crate) solves: Arc<Semaphore>,
     /// API tokens (none: open).
     pub tokens: Arc<auth::Tokens>,
+    /// Live flights (in memory until [`Self::with_flights`]).
+    pub flights: Arc<FlightHub>,
 }
 
 impl AppState {
@@ -28,7 +31,14 @@ impl AppState {
             limits,
             solves,
             tokens: Arc::new(auth::Tokens::default()),
+            flights: Arc::new(FlightHub::in_memory()),
         }
+    }
+
+    /// The same, keeping its flights in `hub`.
+    pub fn with_flights(mut self, hub: FlightHub) -> Self {
+        self.flights = Arc::new(hub);
+        self
     }
 
     /// The same, requiring one of `tokens` on every `/api` route.

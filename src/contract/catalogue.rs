@@ -85,6 +85,11 @@ macro_rules! for_each_kind {
                 crate::contract::dynamics::DynamicsPeaksRequest
                     => crate::contract::dynamics::DynamicsPeaksResponse
             ) "/api/v1/dynamics/peaks" run_dynamics_peaks,
+            /// `POST /api/v1/windows`: launch windows from a forecast (progress in plans).
+            Windows(
+                crate::contract::windows::WindowsRequest
+                    => crate::contract::windows::WindowsResponse
+            ) "/api/v1/windows" compute_windows,
         }
     };
 }

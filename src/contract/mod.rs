@@ -11,6 +11,7 @@ pub mod envelope;
 pub mod equilibrium;
 pub mod error;
 pub mod estimate;
+pub mod flight;
 pub mod finite;
 pub mod ge;
 pub mod json;
@@ -21,6 +22,7 @@ pub mod ranges;
 pub mod string;
 pub mod system;
 pub mod transient;
+pub mod windows;
 
 // The old paths of the modules that moved into their domain folders, kept
 // for the API, the jobs, the CLI and the tests.

@@ -520,9 +520,13 @@ mod tests {
             "envelope_bands",
             "dynamics",
             "dynamics_peaks",
+            "windows",
         ];
         if by_example.contains(&kind) {
             return schema_example(kind).expect("the schema has an example");
+        }
+        if let Some(v) = crate::jobs::windows::example_request(kind) {
+            return v;
         }
         let mut v = json!({"cable": {"mass_per_length_kg_m": 0.078}, "aerostat": {"net_buoyancy_n": 1000.0}});
         let extra = match kind {

@@ -18,6 +18,8 @@ pub mod backend;
 pub mod chunks;
 pub mod estimate;
 pub mod execute;
+pub mod flights;
+pub mod flights_sqlite;
 pub mod kinds;
 pub mod lease;
 pub mod postgres;

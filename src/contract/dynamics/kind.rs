@@ -77,7 +77,11 @@ impl Analysis for DynamicsRequest {
         let shapes = self
             .shape_times_s
             .as_ref()
-            .map_or(self.shape_count, Vec::len) as u64;
+            .map_or(
+                self.shape_count
+                    .unwrap_or(crate::contract::dynamics::dto::DEFAULT_SHAPE_COUNT),
+                Vec::len,
+            ) as u64;
         let nodes = shapes.saturating_mul(self.numerics.segments as u64 + 1);
         Estimate::new(
             "sample_count",
