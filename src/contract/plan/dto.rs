@@ -40,7 +40,7 @@ pub struct HaulDownInput {
     /// period's flow read at `target_elevation_m`, its gust by its gust ratio,
     /// times from its first period (an ensemble: its first member).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub source: Option<crate::contract::windows::dto::ForecastInput>,
+    pub source: Option<crate::contract::windows::forecast::ForecastInput>,
     /// Largest wind in which the aerostat may stay aloft (m/s).
     #[schema(example = 12.0, exclusive_minimum = 0.0, maximum = 200.0)]
     pub max_operating_wind_m_s: f64,

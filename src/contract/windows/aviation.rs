@@ -14,7 +14,7 @@
 use metar_taf_parser::metar::models::wind::{Wind, WindUnit};
 use metar_taf_parser::taf::models::forecast::TafForecastKind;
 
-use crate::contract::windows::source::{Member, ParsedForecast, RawPeriod};
+use crate::contract::windows::forecast::{Member, ParsedForecast, RawPeriod};
 use crate::contract::windows::time::TimeStyle;
 use crate::numerics::forecast::units::SpeedUnit;
 use crate::numerics::params::InvalidInput;

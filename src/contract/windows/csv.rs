@@ -6,7 +6,7 @@
 //! before it, an hour when alone); its gust is the one of its lowest height
 //! that has one.
 
-use crate::contract::windows::source::{Member, ParsedForecast, RawPeriod, field};
+use crate::contract::windows::forecast::{Member, ParsedForecast, RawPeriod, field};
 use crate::contract::windows::time::{TimeStyle, parse_iso};
 use crate::numerics::params::InvalidInput;
 

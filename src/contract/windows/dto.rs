@@ -6,53 +6,13 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::contract::dto::{AerostatInput, CableInput};
+pub use crate::contract::windows::forecast::{ForecastFormat, ForecastInput};
 use crate::contract::plan::dto::PlanStabilityInput;
 use crate::contract::system::{WinchInput, WindInput};
-
-/// The source format of `forecast.data`.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub enum ForecastFormat {
-    /// The JSON object of an Open-Meteo hourly forecast (or of its ensemble API).
-    OpenMeteo,
-    /// The text of one METAR report.
-    Metar,
-    /// The text of one TAF report.
-    Taf,
-    /// CSV text: `time,height_m,speed_m_s,gust_m_s` rows.
-    Csv,
-}
-
-impl ForecastFormat {
-    pub fn describe(self) -> &'static str {
-        match self {
-            Self::OpenMeteo => "Open-Meteo forecast",
-            Self::Metar => "METAR report",
-            Self::Taf => "TAF report",
-            Self::Csv => "CSV forecast",
-        }
-    }
-}
 
 /// Default roughness length of the log law through one height (m): open
 /// terrain (WMO class "open", Davenport's 0.03 m).
 pub const DEFAULT_ROUGHNESS_LENGTH_M: f64 = 0.03;
-
-/// A forecast as it comes.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct ForecastInput {
-    pub format: ForecastFormat,
-    /// `open_meteo`: the JSON object as the API returns it; `metar`, `taf`,
-    /// `csv`: the text, as a JSON string.
-    #[schema(value_type = Object)]
-    pub data: serde_json::Value,
-    /// Roughness length z0 of the log law through an hour with one height
-    /// (m); default 0.03 (open terrain).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(example = 0.03, minimum = 0.000001, maximum = 10.0)]
-    pub roughness_length_m: Option<f64>,
-}
 
 /// Wind limits of the operation: an hour whose wind (or gust) at the target
 /// altitude passes them is no-go.

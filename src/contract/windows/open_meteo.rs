@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 
 use serde_json::Value;
 
-use crate::contract::windows::source::{Member, ParsedForecast, RawPeriod, field};
+use crate::contract::windows::forecast::{Member, ParsedForecast, RawPeriod, field};
 use crate::contract::windows::time::{TimeStyle, parse_iso};
 use crate::numerics::forecast::units::SpeedUnit;
 use crate::numerics::params::InvalidInput;
