@@ -7,10 +7,9 @@ use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::time::Duration;
 
-pub use crate::api::server::ConnectionLimits;
 pub use crate::jobs::store::StoreConfig;
 pub use crate::jobs::worker::WorkerConfig;
-pub use crate::limits::Limits;
+pub use crate::limits::{ConnectionLimits, Limits};
 
 /// `tetherplan serve` flags.
 #[derive(Clone, Debug, clap::Args)]
@@ -179,7 +178,7 @@ impl From<ServeArgs> for Config {
             db: a.db,
             static_dir: a.static_dir,
             job_threads,
-            api_tokens: crate::api::auth::parse_tokens(a.jobs.api_tokens.as_deref()),
+            api_tokens: parse_tokens(a.jobs.api_tokens.as_deref()),
             limits: Limits {
                 max_body_bytes: a.max_body_bytes,
                 max_in_flight: a.max_in_flight,
@@ -207,4 +206,15 @@ impl From<ServeArgs> for Config {
             allowed_hosts: a.allowed_hosts,
         }
     }
+}
+
+/// Tokens from `TETHERPLAN_API_TOKENS`: comma-separated, blanks trimmed,
+/// empty entries ignored.
+pub fn parse_tokens(s: Option<&str>) -> Vec<String> {
+    s.unwrap_or("")
+        .split(',')
+        .map(str::trim)
+        .filter(|t| !t.is_empty())
+        .map(str::to_string)
+        .collect()
 }

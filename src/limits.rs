@@ -2,7 +2,9 @@
 //! (body size, requests in flight, synchronous work) and the job queue's
 //! (pending jobs, leases, attempts, run time, answer size, retention).
 //! A plain struct below both: `config` fills it from the flags, the job
-//! queue carries it, and the HTTP state reads it from the queue.
+//! queue carries it, and the HTTP state reads it from the queue. The
+//! connection limits ([`ConnectionLimits`]: timeouts and caps of the HTTP
+//! server's connections) likewise, for `config` and `api::server`.
 
 use std::time::Duration;
 
@@ -57,6 +59,47 @@ impl Default for Limits {
             max_job_result_bytes: 64 << 20,
             job_retention: Duration::from_secs(7 * 24 * 3600),
             max_stored_bytes_per_token: 1 << 30,
+        }
+    }
+}
+
+/// Timeouts and the connection cap.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConnectionLimits {
+    /// Time allowed for a request head to arrive (also the idle keep-alive
+    /// timeout).
+    pub header_timeout: Duration,
+    /// Time allowed between two frames of a request body.
+    pub body_timeout: Duration,
+    /// Connections open at once (before the file-limit clamp).
+    pub max_connections: usize,
+    /// How long a connection asked to close may take to finish its answer.
+    pub close_grace: Duration,
+    /// Time allowed for a whole request body, from its head on (a body
+    /// trickling a byte at a time is dropped at this deadline).
+    pub body_deadline: Duration,
+    /// Time allowed for writing a whole answer (a client that does not
+    /// read it is dropped at this deadline, and the answer freed).
+    pub write_deadline: Duration,
+    /// Largest request body; a larger `Content-Length` is 413 at once,
+    /// before any `100 Continue` and without reading a byte.
+    pub max_body_bytes: usize,
+    /// Request-body bytes held at once over all connections (read and not
+    /// yet answered); a body that would exceed it is refused (503).
+    pub body_budget_bytes: usize,
+}
+
+impl Default for ConnectionLimits {
+    fn default() -> Self {
+        Self {
+            header_timeout: Duration::from_secs(5),
+            body_timeout: Duration::from_secs(10),
+            max_connections: 10_000,
+            close_grace: Duration::from_secs(60),
+            body_deadline: Duration::from_secs(30),
+            write_deadline: Duration::from_secs(120),
+            max_body_bytes: 1 << 20,
+            body_budget_bytes: 64 << 20,
         }
     }
 }

@@ -1,20 +1,20 @@
 //! The `tetherplan` binary: `serve` (the default with no subcommand) runs
-//! the HTTP service; the other subcommands answer one request over the JSON
+//! the HTTP service, `worker` runs jobs; the other subcommands, one per
+//! analysis kind of the catalogue, answer one request over the JSON
 //! contract: each reads a request (file or stdin), prints the JSON answer
-//! on stdout, and on bad input prints the error body and exits with status 2.
+//! on stdout (a progress bar on stderr), and on bad input prints the error
+//! body and exits with status 2.
 
 use std::io::Read;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use tetherplan::config::ServeArgs;
-use tetherplan::contract::{
-    self, Progress, RequestError, dto, ge_charts, ge_critical, run, simulate, transient,
-};
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::contract::catalogue::{KINDS, Kind};
+use tetherplan::contract::{self, Progress, RequestError, dto};
 
 #[derive(Parser)]
 #[command(
@@ -85,6 +85,9 @@ fn resolve_system(arg: &InputArg, body: Vec<u8>) -> Result<Vec<u8>, RequestError
     Ok(resolved.unwrap_or(body))
 }
 
+/// `serve`, `worker`; the analysis subcommands (one per kind of the
+/// catalogue, [`tetherplan::contract::catalogue::KINDS`]) are added to the
+/// parser at run time.
 #[derive(Subcommand)]
 enum Command {
     /// Run the HTTP service (the default).
@@ -92,39 +95,6 @@ enum Command {
     /// Run jobs only, from the same job store as `serve` (SQLite on this
     /// host, or `--database-url postgres://…` on any host), until SIGTERM.
     Worker(tetherplan::config::WorkerArgs),
-    /// Eigenvalues and stability verdict at one state.
-    Stability(InputArg),
-    /// Critical time and maximum safe elevation of a deployment profile.
-    Critical(InputArg),
-    /// Largest safe constant rate for a target elevation.
-    SafeRate(InputArg),
-    /// Deployment chart: t* and h* against rate, one series per buoyancy
-    /// (`model.kind = "geometrically_exact"`: and per stiffness ratio).
-    Chart(InputArg),
-    /// Transient run (linear string, or `"model": {"kind": "geometrically_exact"}`).
-    Simulate(InputArg),
-    /// Response against forcing frequency: wind on the linear string, or
-    /// `"excitation": "base"` (shaken platform, GE cable).
-    FrequencyResponse(InputArg),
-    /// Static tether in a steady wind: altitude, blow-down, tensions, shape.
-    Equilibrium(InputArg),
-    /// Operating envelope over wind speed × tether length.
-    Envelope(InputArg),
-    /// The fastest safe deployment (or retrieval) schedule, with the haul-down deadline.
-    Plan(InputArg),
-    /// Uncertainty bands of a deployment chart: 5/50/95 % of h* and t*
-    /// per rate under uncertain inputs (seeded Monte Carlo).
-    Bands(InputArg),
-    /// The tether in time through a gust or turbulence, from rest in the
-    /// static equilibrium of `wind.flow` (progress bar in time steps).
-    Dynamics(InputArg),
-    /// The largest tension over an exposure, Monte Carlo over turbulence
-    /// seeds (progress bar in samples).
-    DynamicsPeaks(InputArg),
-    /// Launch windows by the hour from a forecast (Open-Meteo JSON, METAR,
-    /// TAF or CSV): each period judged as the plan judges its wind
-    /// (progress bar in plans).
-    Windows(InputArg),
 }
 
 /// A progress bar on standard error for `total` units of `what`.
@@ -158,8 +128,12 @@ fn read_input(arg: &InputArg) -> Result<Vec<u8>, String> {
 /// Prints the JSON answer on stdout. A reader that has gone away (`… | head
 /// -1`) is not an error: the process exits quietly with status 0.
 fn print_json(value: &impl Serialize) {
+    print_text(&serde_json::to_string_pretty(value).expect("responses serialise"));
+}
+
+/// Prints `text` and a newline on stdout (see [`print_json`]).
+fn print_text(text: &str) {
     use std::io::Write;
-    let text = serde_json::to_string_pretty(value).expect("responses serialise");
     let mut out = std::io::stdout().lock();
     if let Err(e) = writeln!(out, "{text}").and_then(|()| out.flush()) {
         if e.kind() == std::io::ErrorKind::BrokenPipe {
@@ -170,18 +144,10 @@ fn print_json(value: &impl Serialize) {
     }
 }
 
-fn answer<Req: dto::SystemRequest, Resp: Serialize>(
-    arg: &InputArg,
-    run: impl FnOnce(&Req) -> Result<Resp, RequestError>,
-) -> ExitCode {
-    answer_with(arg, contract::parse::<Req>, run)
-}
-
-fn answer_with<Req, Resp: Serialize>(
-    arg: &InputArg,
-    parse: impl FnOnce(&[u8]) -> Result<Req, RequestError>,
-    run: impl FnOnce(&Req) -> Result<Resp, RequestError>,
-) -> ExitCode {
+/// Answers one request of `kind` read from `arg`: the pretty JSON answer
+/// on stdout (status 0), or the error body (status 2 for bad input, 1 for
+/// a failure on valid input).
+fn answer_kind(kind: &Kind, arg: &InputArg) -> ExitCode {
     let body = match read_input(arg) {
         Ok(b) => b,
         Err(msg) => {
@@ -189,12 +155,14 @@ fn answer_with<Req, Resp: Serialize>(
             return ExitCode::from(2);
         }
     };
-    match contract::json_keys::reject_duplicate_keys(&body)
+    let bar = progress_bar(0, kind.name);
+    let out = contract::json_keys::reject_duplicate_keys(&body)
         .and_then(|()| resolve_system(arg, body))
-        .and_then(|body| parse(&body).and_then(|req| run(&req)))
-    {
-        Ok(resp) => {
-            print_json(&resp);
+        .and_then(|body| (kind.run_pretty)(&body, &bar));
+    bar.0.finish_and_clear();
+    match out {
+        Ok(text) => {
+            print_text(&text);
             ExitCode::SUCCESS
         }
         Err(e) => {
@@ -208,6 +176,11 @@ fn answer_with<Req, Resp: Serialize>(
             )
         }
     }
+}
+
+/// The subcommand of a kind: its name with `-` for `_`.
+fn subcommand_name(kind: &Kind) -> &'static str {
+    Box::leak(kind.name.replace('_', "-").into_boxed_str())
 }
 
 /// A progress bar on standard error.
@@ -273,108 +246,27 @@ fn worker(args: tetherplan::config::WorkerArgs) -> ExitCode {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    let Some(command) = cli.command else {
-        return serve(cli.serve);
-    };
-    match &command {
-        Command::Bands(arg) => answer_with(arg, contract::bands::parse_bands, |req| {
-            let bar = progress_bar(req.params.uncertainty.samples as u64, "samples");
-            let out = contract::bands::bands(req, Parallelism::Rayon, &bar);
-            bar.0.finish_and_clear();
-            out
-        }),
-        Command::Dynamics(arg) => answer_with(arg, contract::dynamics::parse_dynamics, |req| {
-            let prepared = req.prepare()?;
-            let bar = progress_bar(prepared.steps as u64, "time steps");
-            let out = contract::dynamics::run::run_prepared(&prepared, &bar)
-                .map(|ran| contract::dynamics::run::response(req, &prepared, &ran));
-            bar.0.finish_and_clear();
-            out
-        }),
-        Command::DynamicsPeaks(arg) => answer_with(arg, contract::dynamics::parse_peaks, |req| {
-            req.prepare()?;
-            let bar = progress_bar(req.samples as u64, "samples");
-            let out = contract::dynamics::peaks::peaks(req, Parallelism::Rayon, &bar);
-            bar.0.finish_and_clear();
-            out
-        }),
-        Command::Windows(arg) => answer_with(arg, contract::windows::parse_windows, |req| {
-            let started = std::time::Instant::now();
-            let prepared = contract::windows::prepare(req)?;
-            let bar = progress_bar(prepared.plan_count() as u64, "plans");
-            let out = contract::windows::run::answer(req, &prepared, &bar, started);
-            bar.0.finish_and_clear();
-            out
-        }),
-        Command::Serve(args) => serve(args.clone()),
-        Command::Worker(args) => worker(args.clone()),
-        Command::Stability(arg) => answer_with(
-            arg,
-            ge_critical::parse_stability,
-            ge_critical::stability_any,
-        ),
-        Command::Critical(arg) => answer_with(arg, ge_critical::parse_critical, |req| {
-            ge_critical::critical_any(req, &contract::run::NoProgress)
-        }),
-        Command::SafeRate(arg) => answer(arg, run::safe_rate),
-        Command::Chart(arg) => answer_with(arg, ge_charts::parse_chart, |req| match req {
-            ge_charts::AnyChartRequest::LinearString(req) => {
-                let bar = progress_bar(run::chart_points(req) as u64, "chart points");
-                let out = run::chart(req, Parallelism::Rayon, &bar);
-                bar.0.finish_and_clear();
-                out.map(ge_charts::AnyChartResponse::LinearString)
-            }
-            ge_charts::AnyChartRequest::GeometricallyExact(req) => {
-                let bar = progress_bar(ge_charts::chart_points(req) as u64, "chart points");
-                let out = ge_charts::ge_chart(req, Parallelism::Rayon, &bar);
-                bar.0.finish_and_clear();
-                out.map(ge_charts::AnyChartResponse::GeometricallyExact)
-            }
-        }),
-        Command::Simulate(arg) => answer_with(arg, simulate::parse_simulate, |req| {
-            let bar = progress_bar(0, "steps");
-            let out = simulate::simulate_any(req, &bar);
-            bar.0.finish_and_clear();
-            out
-        }),
-        Command::Equilibrium(arg) => answer_with(
-            arg,
-            contract::parse_plain::<contract::equilibrium::dto::EquilibriumRequest>,
-            contract::equilibrium::equilibrium,
-        ),
-        Command::Envelope(arg) => answer_with(
-            arg,
-            contract::parse_plain::<contract::envelope::dto::EnvelopeRequest>,
-            |req| {
-                req.validate()?;
-                let bar = progress_bar(
-                    req.wind_speeds_m_s.as_ref().map_or(1, |g| g.count()) as u64,
-                    "wind speeds",
-                );
-                let out = contract::envelope::envelope(req, Parallelism::Rayon, &bar);
-                bar.0.finish_and_clear();
-                out
-            },
-        ),
-        Command::Plan(arg) => answer_with(arg, contract::plan::parse_plan, |req| {
-            contract::plan::plan(req, &run::NoProgress)
-        }),
-        Command::FrequencyResponse(arg) => {
-            answer_with(arg, ge_charts::parse_frequency_response, |req| {
-                let runs = match req {
-                    ge_charts::AnyFrequencyResponseRequest::Wind(r) => {
-                        transient::frequency_response_runs(r)
-                    }
-                    ge_charts::AnyFrequencyResponseRequest::Base(r) => {
-                        r.frequencies_rad_s.count() + 1
-                    }
-                };
-                let bar = progress_bar(runs as u64, "frequencies");
-                let out = ge_charts::frequency_response_any(req, Parallelism::Rayon, &bar);
-                bar.0.finish_and_clear();
-                out
-            })
-        }
+    let kinds: Vec<(&'static str, &'static Kind)> =
+        KINDS.iter().map(|k| (subcommand_name(k), k)).collect();
+    let mut parser = Cli::command();
+    for (name, kind) in &kinds {
+        parser = parser.subcommand(InputArg::augment_args(
+            clap::Command::new(*name).about(kind.about),
+        ));
+    }
+    let matches = parser.get_matches();
+    if let Some((name, sub)) = matches.subcommand()
+        && let Some((_, kind)) = kinds.iter().find(|(n, _)| *n == name)
+    {
+        return match InputArg::from_arg_matches(sub) {
+            Ok(arg) => answer_kind(kind, &arg),
+            Err(e) => e.exit(),
+        };
+    }
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    match cli.command {
+        None => serve(cli.serve),
+        Some(Command::Serve(args)) => serve(args),
+        Some(Command::Worker(args)) => worker(args),
     }
 }

@@ -1,4 +1,5 @@
-//! Every job kind's finished answer matches the published `JobView` schema
+//! Every job kind's finished answer (every kind of the catalogue, each
+//! model) matches the published `JobView` schema
 //! of the generated OpenAPI document (validated with the `jsonschema`
 //! crate, JSON Schema 2020-12 as OpenAPI 3.1 uses), and so do lists,
 //! failures and cancellations. POST /jobs links to GET and DELETE /jobs/{id}.
@@ -6,6 +7,7 @@
 use axum::http::StatusCode;
 use serde_json::{Value, json};
 use tetherplan::api::openapi::openapi;
+use tetherplan::contract::catalogue::KINDS;
 use tetherplan::jobs::store::JobStatus;
 use tetherplan::jobs::try_execute_next;
 
@@ -21,8 +23,54 @@ fn string(elements: usize) -> Value {
     })
 }
 
-/// One small request of every kind and model.
+/// One small request of every kind of the catalogue and of each model;
+/// the kinds without one written here run their route's published example.
 fn requests() -> Vec<(&'static str, Value)> {
+    let mut requests = written_requests();
+    let examples = tetherplan::api::spec::request_examples();
+    for kind in KINDS {
+        if requests.iter().any(|(k, _)| *k == kind.name) {
+            continue;
+        }
+        let (_, example) = examples
+            .iter()
+            .find(|(path, _)| *path == kind.path)
+            .unwrap_or_else(|| panic!("no request for the kind {} ({})", kind.name, kind.path));
+        requests.push((kind.name, example.clone()));
+    }
+    requests
+}
+
+/// Every kind of the catalogue has a request here: a new kind is checked
+/// against the published `JobView` as soon as it is in the list.
+#[test]
+fn every_kind_of_the_catalogue_is_checked() {
+    let kinds: Vec<&str> = requests().iter().map(|(k, _)| *k).collect();
+    assert_eq!(KINDS.len(), 15, "the catalogue's kinds");
+    for kind in KINDS {
+        assert!(kinds.contains(&kind.name), "{} has no request", kind.name);
+    }
+    // JobView.result and BatchItemOutcome.result list the same answers
+    let doc = serde_json::to_value(openapi()).unwrap();
+    let refs = |schema: &str| -> Vec<String> {
+        doc["components"]["schemas"][schema]["properties"]["result"]["oneOf"]
+            .as_array()
+            .unwrap_or_else(|| panic!("{schema}.result is a oneOf"))
+            .iter()
+            .map(|r| r["$ref"].as_str().unwrap().to_string())
+            .collect()
+    };
+    let (job, item) = (refs("JobView"), refs("BatchItemOutcome"));
+    assert_eq!(job[..job.len() - 1], item[..], "JobView.result vs BatchItemOutcome.result");
+    assert_eq!(job.last().unwrap(), "#/components/schemas/BatchOutcome");
+    assert_eq!(item.len(), KINDS.len());
+    for name in ["DynamicsResponse", "DynamicsPeaksResponse"] {
+        assert!(job.contains(&format!("#/components/schemas/{name}")), "{job:?}");
+    }
+}
+
+/// The requests written for this test: small ones, and both models.
+fn written_requests() -> Vec<(&'static str, Value)> {
     let scale = (0.078f64 / 1000.0).sqrt();
     vec![
         (

@@ -8,7 +8,7 @@
 //! too_large`, answered before any work). That request, the most
 //! expensive of its shape the server answers synchronously within a factor
 //! 1.5, must use at most [`SHARE_CPU_S`] CPU-seconds (the 2 CPU-second
-//! budget of `tetherplan::price` with a factor 2 for the model) and answer
+//! budget of `tetherplan::contract::price` with a factor 2 for the model) and answer
 //! within half the 30 s solve timeout. Before the prices, 10 000
 //! samples of 2 steps × 2 segments were accepted at 0.7 % of the limit and
 //! took 11.3 CPU-seconds.
@@ -38,7 +38,7 @@ const SHARE_CPU_S: f64 = 4.0;
 const SHARE_WALL_S: f64 = 15.0;
 /// CPU-seconds the process may spend while a cheap request waits behind
 /// the most expensive ones: the priced work admitted at once
-/// (`tetherplan::price::IN_FLIGHT_CPU_S`, 4) and one more. CPU, not wall
+/// (`tetherplan::contract::price::IN_FLIGHT_CPU_S`, 4) and one more. CPU, not wall
 /// time, so that other load on the machine does not change the verdict;
 /// before the prices, four 10 000-sample requests spent 45 CPU-s.
 const CHEAP_WAIT_CPU_S: f64 = 5.0;

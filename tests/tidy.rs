@@ -54,19 +54,28 @@ fn module_files(root: &Path) -> Vec<ModuleFile> {
     rust_files(root, &mut files);
     files
         .into_iter()
+        .filter(|file| {
+            // binaries are crates of their own: `main.rs`, `bin/`
+            let rel = file.strip_prefix(root).unwrap();
+            rel != Path::new("main.rs") && !rel.starts_with("bin")
+        })
         .map(|file| {
             let rel = file.strip_prefix(root).unwrap().with_extension("");
             let mut module: Vec<String> = rel
                 .components()
                 .map(|c| c.as_os_str().to_string_lossy().into_owned())
                 .collect();
-            let is_dir_module = module.last().is_some_and(|m| m == "mod");
+            // `lib.rs` is the crate's root module, a `mod.rs` of `src/`
+            let is_dir_module = module.last().is_some_and(|m| m == "mod")
+                || module == ["lib"];
             if is_dir_module {
                 module.pop();
             }
             let mut text = std::fs::read_to_string(&file).unwrap();
-            if let Some(i) = text.find("#[cfg(test)]\nmod ") {
-                text.truncate(i);
+            for tests in ["#[cfg(test)]\nmod ", "#[cfg(test)]\npub(crate) mod "] {
+                if let Some(i) = text.find(tests) {
+                    text.truncate(i);
+                }
             }
             let text = text
                 .lines()
@@ -156,7 +165,9 @@ fn use_tree(prefix: &[String], tree: &str) -> Vec<(Vec<String>, String)> {
 /// `crate::<crate_path>::…`, `super::…`, `self::…` paths, and a `mod.rs`'s
 /// paths into its children). A `pub use` is a re-export: a path through it
 /// is followed to the file that defines the item, and the re-export itself
-/// is not an import of the file holding it.
+/// is an import of the file holding it (it cannot build without the file it
+/// re-exports from: a circle through a `pub use` is a circle).
+/// `crate_path` empty: the tree is the whole crate (`crate::…`).
 fn import_graph(root: &Path, crate_path: &str) -> (Vec<String>, Vec<Vec<usize>>) {
     let files = module_files(root);
     let index: std::collections::HashMap<Vec<String>, usize> = files
@@ -164,7 +175,11 @@ fn import_graph(root: &Path, crate_path: &str) -> (Vec<String>, Vec<Vec<usize>>)
         .enumerate()
         .map(|(i, f)| (f.module.clone(), i))
         .collect();
-    let absolute = format!("crate::{crate_path}::");
+    let absolute = if crate_path.is_empty() {
+        "crate::".to_string()
+    } else {
+        format!("crate::{crate_path}::")
+    };
     // the module a path starts from, and the rest of the path
     let starts = |f: &ModuleFile, text: &str, at: usize| -> Option<(Vec<String>, usize)> {
         let before = text[..at].chars().next_back();
@@ -243,6 +258,17 @@ fn import_graph(root: &Path, crate_path: &str) -> (Vec<String>, Vec<Vec<usize>>)
     for (i, f) in files.iter().enumerate() {
         let mut text = f.text.clone();
         for (start, end) in reexports(f) {
+            // the re-export's own path goes to the file defining the item
+            let tree = &f.text[start..end];
+            let (base, skip) = starts(f, tree, 0).unwrap_or((f.module.clone(), 0));
+            for (path, _) in use_tree(&base, &tree[skip..]) {
+                if let Some(j) = resolve(&path)
+                    && j != i
+                    && !edges[i].contains(&j)
+                {
+                    edges[i].push(j);
+                }
+            }
             text.replace_range(start..end, &" ".repeat(end - start));
         }
         for (at, _) in text.char_indices() {
@@ -316,10 +342,19 @@ fn cycles(names: &[String], edges: &[Vec<usize>]) -> Vec<String> {
                         z = prev[z];
                     }
                     path.push(v);
-                    let n = path.len();
-                    path[1..n - 1].reverse();
+                    let len = path.len();
+                    path[1..len - 1].reverse();
                     let shown: Vec<&str> = path.iter().map(|&k| names[k].as_str()).collect();
-                    out.push(shown.join(" -> "));
+                    let part: Vec<&str> = (0..n)
+                        .filter(|&w| reaches[v][w] && reaches[w][v] && !path.contains(&w))
+                        .map(|w| names[w].as_str())
+                        .collect();
+                    let mut cycle = shown.join(" -> ");
+                    if !part.is_empty() {
+                        // the rest of the strongly connected part
+                        cycle += &format!(" (with {})", part.join(", "));
+                    }
+                    out.push(cycle);
                     break 'bfs;
                 }
                 if !seen[y] {
@@ -372,8 +407,96 @@ fn the_cycle_finder_sees_a_cycle() {
     assert_eq!(files.first(), files.last(), "{found:?}");
     files.pop();
     files.sort_unstable();
-    // d.rs only re-exports a.rs's item: not an import of d.rs
+    // c.rs's path through d.rs's re-export goes to a.rs; d.rs imports
+    // a.rs, but nothing imports d.rs's own items, so it is off the circle
     assert_eq!(files, ["a.rs", "b/c.rs", "b/mod.rs"], "{found:?}");
+}
+
+#[test]
+fn the_cycle_finder_sees_a_cycle_through_a_reexport() {
+    // x.rs re-exports y.rs's item and y.rs imports x.rs's own: a circle
+    // that no `use` line shows as one (contract/ge/critical ↔ stability).
+    let dir = std::env::temp_dir().join(format!("tidy-reexport-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |p: &str, s: &str| std::fs::write(dir.join(p), s).unwrap();
+    write("lib.rs", "pub mod x;\npub mod y;\npub mod z;\n");
+    write("x.rs", "pub use super::y::T;\npub struct U;\n");
+    write("y.rs", "use crate::x::U;\npub struct T;\n");
+    write("z.rs", "use crate::x::T;\n");
+    write("main.rs", "use crate::z;\n");
+    let (names, edges) = import_graph(&dir, "");
+    let found = cycles(&names, &edges);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(found, ["x.rs -> y.rs -> x.rs"], "{names:?} {edges:?}");
+    // z.rs's import through the re-export is an arrow to y.rs
+    let z = names.iter().position(|n| n == "z.rs").unwrap();
+    assert_eq!(edges[z].iter().map(|&j| names[j].as_str()).collect::<Vec<_>>(), ["y.rs"]);
+}
+
+/// The crate's file-level import graph (`src/`, binaries left out).
+fn crate_graph() -> (Vec<String>, Vec<Vec<usize>>) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    import_graph(&root, "")
+}
+
+#[test]
+fn src_files_import_each_other_without_cycles() {
+    // every folder of src/ (and across folders): no file reaches itself
+    // through `use`, paths or `pub use` re-exports
+    let (names, edges) = crate_graph();
+    assert!(names.len() >= 140, "found {} files", names.len());
+    let arrows: usize = edges.iter().map(Vec::len).sum();
+    assert!(
+        arrows >= 600,
+        "found only {arrows} imports: is the parser blind?"
+    );
+    let found = cycles(&names, &edges);
+    assert!(
+        found.is_empty(),
+        "{} circles of files importing each other in src/:\n  {}",
+        found.len(),
+        found.join("\n  ")
+    );
+}
+
+/// The layers of the crate, bottom first: a file imports only its own
+/// layer or those below (`numerics` pure; `contract` JSON ↔ numerics; the
+/// job engine and catalogue; `config` the flags; `api` the HTTP service).
+const LAYERS: [&[&str]; 5] = [
+    &["numerics", "limits", "shutdown"],
+    &["contract"],
+    &["jobs"],
+    &["config"],
+    &["api"],
+];
+
+#[test]
+fn no_arrow_runs_back_up() {
+    let (names, edges) = crate_graph();
+    let layer = |name: &str| -> usize {
+        let top = name.split(['/', '.']).next().unwrap();
+        if name == "mod.rs" {
+            return LAYERS.len(); // lib.rs: the crate root, above all
+        }
+        LAYERS
+            .iter()
+            .position(|l| l.contains(&top))
+            .unwrap_or_else(|| panic!("src/{name}: its top module {top} has no layer in tidy.rs"))
+    };
+    let mut up = Vec::new();
+    for (i, out) in edges.iter().enumerate() {
+        for &j in out {
+            if layer(&names[j]) > layer(&names[i]) {
+                up.push(format!("{} -> {}", names[i], names[j]));
+            }
+        }
+    }
+    assert!(
+        up.is_empty(),
+        "imports running up the layers:\n  {}",
+        up.join("\n  ")
+    );
 }
 
 #[test]

@@ -35,17 +35,6 @@ pub struct Caller {
     pub owner: Option<String>,
 }
 
-/// Tokens from `TETHERPLAN_API_TOKENS`: comma-separated, blanks trimmed,
-/// empty entries ignored.
-pub fn parse_tokens(s: Option<&str>) -> Vec<String> {
-    s.unwrap_or("")
-        .split(',')
-        .map(str::trim)
-        .filter(|t| !t.is_empty())
-        .map(str::to_string)
-        .collect()
-}
-
 fn hash(token: &str) -> [u8; 32] {
     Sha256::digest(token.as_bytes()).into()
 }
@@ -146,6 +135,7 @@ pub async fn require_token(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::parse_tokens;
 
     #[test]
     fn tokens_are_parsed_hashed_and_matched() {

@@ -28,8 +28,7 @@ use std::sync::Arc;
 pub struct JobView {
     /// Job id (path of `GET /api/v1/jobs/{id}`).
     pub id: i64,
-    /// `stability`, `critical`, `safe_rate`, `chart`, `simulate`,
-    /// `frequency_response` or `batch`.
+    /// The kind of its request (one of `JobItem`'s `kind`s) or `batch`.
     pub kind: String,
     pub status: JobStatus,
     /// Fraction done, 0 to 1 (updated about every 0.2 s while running).
@@ -57,30 +56,16 @@ pub struct JobView {
 }
 
 /// The schemas a finished job's `result` may have: the answer of every
-/// synchronous route a job kind stands for, and a batch's outcome.
-pub const JOB_RESULT_SCHEMAS: &[&str] = &[
-    "AnyStabilityResponse",
-    "AnyCriticalResponse",
-    "SafeRateResponse",
-    "AnyChartResponse",
-    "AnySimulateResponse",
-    "AnyFrequencyResponseResponse",
-    "EquilibriumResponse",
-    "EnvelopeResponse",
-    "BandsResponse",
-    "PlanResponse",
-    "PlanBandsResponse",
-    "EnvelopeBandsResponse",
-    "BatchOutcome",
-];
-
+/// kind (the same list as a batch item's, [`crate::contract::catalogue`])
+/// and a batch's outcome.
 pub(crate) fn job_result_schema()
 -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {
     use utoipa::openapi::schema::{OneOfBuilder, Ref};
     let mut one_of = OneOfBuilder::new();
-    for name in JOB_RESULT_SCHEMAS {
-        one_of = one_of.item(Ref::from_schema_name(*name));
+    for name in crate::contract::catalogue::response_schemas() {
+        one_of = one_of.item(Ref::from_schema_name(name));
     }
+    one_of = one_of.item(Ref::from_schema_name("BatchOutcome"));
     one_of.description(Some(
         "The answer, when `done`; absent otherwise and in lists.",
     ))

@@ -12,125 +12,37 @@
 pub mod assets;
 pub mod auth;
 pub mod auth_doc;
-pub mod bands;
 pub mod body;
-pub mod dynamics;
 pub mod error;
 pub mod flights;
 pub mod guard;
+pub mod health;
 pub mod jobs;
+pub mod kinds;
 pub mod memory;
 pub mod openapi;
 pub mod server;
 pub mod solve;
 pub mod spec;
+pub mod state;
 pub mod systems;
-pub mod tether;
-pub mod windows;
 
 use std::path::Path;
 use std::sync::Arc;
 
 use axum::Router;
 use axum::extract::DefaultBodyLimit;
-use axum::http::{StatusCode, Uri, header};
-use axum::response::{IntoResponse, Response};
+use axum::http::{StatusCode, Uri};
 use axum::routing::{any, get, post};
-use serde::Serialize;
-use tokio::sync::Semaphore;
 use tower_http::trace::TraceLayer;
-use utoipa::ToSchema;
 use utoipa_swagger_ui::SwaggerUi;
 
-use crate::config::{Config, Limits};
+use crate::config::Config;
 use crate::jobs::JobQueue;
+use crate::shutdown::shutdown_signal;
 use error::ApiError;
-
-/// Shared state of the handlers.
-#[derive(Clone)]
-pub struct AppState {
-    pub queue: Arc<JobQueue>,
-    pub limits: Limits,
-    solves: Arc<Semaphore>,
-    /// Priced synchronous work running now (`crate::price`).
-    priced: Arc<crate::price::InFlight>,
-    /// API tokens (none: open).
-    pub tokens: Arc<auth::Tokens>,
-    /// Live flights (in memory until [`Self::with_flights`]).
-    pub flights: Arc<flights::hub::FlightHub>,
-}
-
-impl AppState {
-    pub fn new(queue: Arc<JobQueue>) -> Self {
-        let limits = queue.limits().clone();
-        let solves = Arc::new(Semaphore::new(limits.max_in_flight));
-        Self {
-            queue,
-            limits,
-            solves,
-            priced: Arc::new(crate::price::InFlight::default()),
-            tokens: Arc::new(auth::Tokens::default()),
-            flights: Arc::new(flights::hub::FlightHub::in_memory()),
-        }
-    }
-
-    /// The same, keeping its flights in `hub`.
-    pub fn with_flights(mut self, hub: flights::hub::FlightHub) -> Self {
-        self.flights = Arc::new(hub);
-        self
-    }
-
-    /// The same, requiring one of `tokens` on every `/api` route.
-    pub fn with_tokens(mut self, tokens: &[String]) -> Self {
-        self.tokens = Arc::new(auth::Tokens::new(tokens));
-        self
-    }
-}
-
-/// Liveness.
-#[derive(Debug, Serialize, ToSchema)]
-pub struct Health {
-    /// Always `ok` when the server answers.
-    pub status: String,
-    /// Version of the server.
-    pub version: String,
-    /// The job store: `sqlite` or `postgres`.
-    pub store: String,
-    /// Job workers (API processes with job threads and `tetherplan worker`
-    /// processes) whose heartbeat is recent; absent when the store did not
-    /// answer within a second.
-    #[schema(minimum = 0)]
-    pub live_workers: Option<usize>,
-}
-
-/// Liveness, the job store and its live workers (the solver is not touched;
-/// the store is asked at most one second).
-#[utoipa::path(
-    get, path = "/healthz", operation_id = "get_health", tag = "meta",
-    responses((status = 200, description = "The server is up", body = Health))
-)]
-pub async fn get_health(axum::extract::State(app): axum::extract::State<AppState>) -> Response {
-    let queue = app.queue.clone();
-    let live = tokio::task::spawn_blocking(move || {
-        queue.store.live_workers(crate::jobs::PRESENCE_TIMEOUT).ok()
-    });
-    let live_workers = tokio::time::timeout(std::time::Duration::from_secs(1), live)
-        .await
-        .ok()
-        .and_then(Result::ok)
-        .flatten();
-    let body = Health {
-        status: "ok".into(),
-        version: env!("CARGO_PKG_VERSION").into(),
-        store: app.queue.store.store_kind().into(),
-        live_workers,
-    };
-    (
-        [(header::CONTENT_TYPE, "application/json")],
-        serde_json::to_vec(&body).expect("serialises"),
-    )
-        .into_response()
-}
+pub use health::{Health, get_health};
+pub use state::AppState;
 
 async fn api_not_found(uri: Uri) -> ApiError {
     ApiError::not_found(format!("no route {}", uri.path()))
@@ -157,29 +69,7 @@ pub fn router(state: AppState, static_dir: &Path) -> Router {
 pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
     let body_limit = state.limits.max_body_bytes;
     let tokens = state.tokens.clone();
-    let routes = Router::new()
-        .route("/healthz", get(get_health))
-        .route("/api/v1/stability", post(solve::compute_stability))
-        .route("/api/v1/critical", post(solve::compute_critical))
-        .route("/api/v1/safe-rate", post(solve::compute_safe_rate))
-        .route("/api/v1/charts", post(solve::create_chart))
-        .route("/api/v1/simulate", post(solve::run_simulation))
-        .route(
-            "/api/v1/frequency-response",
-            post(solve::compute_frequency_response),
-        )
-        .route("/api/v1/equilibrium", post(tether::compute_equilibrium))
-        .route("/api/v1/envelope", post(tether::compute_envelope))
-        .route("/api/v1/plan", post(solve::compute_plan))
-        .route("/api/v1/bands", post(solve::compute_bands))
-        .route("/api/v1/plan/bands", post(bands::compute_plan_bands))
-        .route(
-            "/api/v1/envelope/bands",
-            post(bands::compute_envelope_bands),
-        )
-        .route("/api/v1/dynamics", post(dynamics::run_dynamics))
-        .route("/api/v1/dynamics/peaks", post(dynamics::run_dynamics_peaks))
-        .route("/api/v1/windows", post(windows::compute_windows))
+    let routes = kinds::routes(Router::new().route("/healthz", get(get_health)))
         .route("/api/v1/systems", get(systems::list_systems))
         .route(
             "/api/v1/systems/{name}",
@@ -315,24 +205,3 @@ fn warn_if_exposed(addr: std::net::SocketAddr) {
     }
 }
 
-/// Resolves at SIGINT or SIGTERM.
-pub async fn shutdown_signal() {
-    let ctrl_c = async {
-        let _ = tokio::signal::ctrl_c().await;
-    };
-    #[cfg(unix)]
-    let terminate = async {
-        match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
-            Ok(mut s) => {
-                s.recv().await;
-            }
-            Err(_) => std::future::pending::<()>().await,
-        }
-    };
-    #[cfg(not(unix))]
-    let terminate = std::future::pending::<()>();
-    tokio::select! {
-        _ = ctrl_c => tracing::info!("SIGINT received"),
-        _ = terminate => tracing::info!("SIGTERM received"),
-    }
-}

@@ -52,7 +52,7 @@ use hyper::server::conn::http1;
 use hyper_util::rt::{TokioIo, TokioTimer};
 use hyper_util::service::TowerToHyperService;
 
-use crate::api::error::ApiError;
+use crate::api::error::{ApiError, BodyRefusal};
 use tokio::net::TcpListener;
 use tokio::sync::{Notify, OwnedSemaphorePermit, Semaphore, watch};
 
@@ -64,46 +64,7 @@ const PRESSURE_YIELDS: usize = 8;
 /// logs, the listener).
 pub const RESERVED_FDS: u64 = 64;
 
-/// Timeouts and the connection cap.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ConnectionLimits {
-    /// Time allowed for a request head to arrive (also the idle keep-alive
-    /// timeout).
-    pub header_timeout: Duration,
-    /// Time allowed between two frames of a request body.
-    pub body_timeout: Duration,
-    /// Connections open at once (before the file-limit clamp).
-    pub max_connections: usize,
-    /// How long a connection asked to close may take to finish its answer.
-    pub close_grace: Duration,
-    /// Time allowed for a whole request body, from its head on (a body
-    /// trickling a byte at a time is dropped at this deadline).
-    pub body_deadline: Duration,
-    /// Time allowed for writing a whole answer (a client that does not
-    /// read it is dropped at this deadline, and the answer freed).
-    pub write_deadline: Duration,
-    /// Largest request body; a larger `Content-Length` is 413 at once,
-    /// before any `100 Continue` and without reading a byte.
-    pub max_body_bytes: usize,
-    /// Request-body bytes held at once over all connections (read and not
-    /// yet answered); a body that would exceed it is refused (503).
-    pub body_budget_bytes: usize,
-}
-
-impl Default for ConnectionLimits {
-    fn default() -> Self {
-        Self {
-            header_timeout: Duration::from_secs(5),
-            body_timeout: Duration::from_secs(10),
-            max_connections: 10_000,
-            close_grace: Duration::from_secs(60),
-            body_deadline: Duration::from_secs(30),
-            write_deadline: Duration::from_secs(120),
-            max_body_bytes: 1 << 20,
-            body_budget_bytes: 64 << 20,
-        }
-    }
-}
+pub use crate::limits::ConnectionLimits;
 
 /// An `rlim_t` as `u64`.
 // The cast is a no-op where `rlim_t` is `u64` (64-bit Linux, macOS), which
@@ -219,7 +180,7 @@ pub async fn run(
     cap: usize,
     shutdown: impl Future<Output = ()>,
 ) {
-    crate::api::error::install_panic_hook();
+    crate::shutdown::install_panic_hook();
     let registry = Arc::new(Registry {
         live: AtomicUsize::new(0),
         open: std::sync::Mutex::new(VecDeque::new()),
@@ -431,25 +392,6 @@ impl ConnState {
         }
     }
 }
-
-/// Why the server stopped reading a body.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum BodyRefusal {
-    /// The bytes held over all connections reached the budget.
-    Busy,
-}
-
-impl std::fmt::Display for BodyRefusal {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Self::Busy => f.write_str(
-                "the server holds as many request bytes as it accepts at once; retry shortly",
-            ),
-        }
-    }
-}
-
-impl std::error::Error for BodyRefusal {}
 
 /// The service of one connection: the application, with each request's
 /// body counted against the byte budget and the connection's phase kept.

@@ -24,6 +24,10 @@ pub enum RequestError {
     /// The work was cancelled through its progress handle.
     #[error("cancelled")]
     Cancelled,
+    /// Too large for a synchronous answer: the field and why (HTTP 422
+    /// `too_large`; the request is a valid job).
+    #[error("too large: {0}")]
+    TooLarge(InvalidInput),
 }
 
 impl From<QepError> for RequestError {
@@ -68,6 +72,14 @@ impl RequestError {
             ),
             Self::Numerical(e) => ErrorBody::new("internal", None, e.to_string()),
             Self::Cancelled => ErrorBody::new("cancelled", None, "the work was cancelled"),
+            Self::TooLarge(e) => ErrorBody::new(
+                "too_large",
+                Some(e.field.clone()),
+                format!(
+                    "{}: {}; submit it as a batch job instead: POST /api/v1/jobs",
+                    e.field, e.reason
+                ),
+            ),
         }
     }
 }

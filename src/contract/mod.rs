@@ -3,11 +3,14 @@
 //! conversion to the numerical core, and one function per request kind
 //! ([`run`]). Everything here is synchronous and CPU-bound.
 
+pub mod analysis;
 pub mod bands;
+pub mod catalogue;
 pub mod dynamics;
 pub mod envelope;
 pub mod equilibrium;
 pub mod error;
+pub mod estimate;
 pub mod finite;
 pub mod flight;
 pub mod ge;
@@ -15,6 +18,7 @@ pub mod json;
 pub mod json_keys;
 pub mod parse;
 pub mod plan;
+pub mod price;
 pub mod ranges;
 pub mod string;
 pub mod system;

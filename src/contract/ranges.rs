@@ -10,7 +10,8 @@ use crate::contract::ge::simulate::{
 use crate::contract::ge_charts::{
     self, GeBaseFrequencyResponseRequest, GeChartRequest, GeWindInput,
 };
-use crate::contract::ge_critical::{GeCriticalRequest, GeStabilityRequest};
+use crate::contract::ge::stability::GeStabilityRequest;
+use crate::contract::ge_critical::GeCriticalRequest;
 use crate::contract::transient::aero::{
     AeroBodyInput, AirFlowInput, FlowPointInput, ForceModelInput, SteadyFlowInput,
 };

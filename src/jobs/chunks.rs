@@ -28,98 +28,20 @@
 //! coordinators' deaths. A job that ends (failed, cancelled) hands its
 //! running chunks back to `pending`, where nothing claims them.
 
-use std::ops::Range;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
+pub use super::backend::{ChunkLease, ChunkState, ClaimedChunk};
+use super::backend::{ClaimPolicy, JobStatus, StoreError};
 use super::kinds::JobSubmission;
-use super::store::{ClaimPolicy, JobStatus, StoreError};
-use super::{JobQueue, error_json};
+pub use super::split::{
+    CHUNK_TARGET_S, ChunkPlan, MAX_ITEMS_PER_CHUNK, MIN_CHUNKS, MIN_SPLIT_JOB_S,
+};
+use super::queue::{JobQueue, error_json};
 use crate::contract::dto::ErrorBody;
 use crate::contract::{Progress, RequestError};
 
-/// A claim on one chunk: fenced chunk writes carry it.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ChunkLease {
-    pub job_id: i64,
-    pub index: usize,
-    pub owner: String,
-    pub epoch: i64,
-}
-
-/// A chunk taken by a worker, with its job's request.
-#[derive(Clone, Debug)]
-pub struct ClaimedChunk {
-    pub lease: ChunkLease,
-    /// The job's submitted body, JSON text.
-    pub request: String,
-    /// Claims of this chunk so far, this one included.
-    pub attempts: u32,
-}
-
-/// How far the chunks of one job are.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct ChunkState {
-    pub total: usize,
-    pub done: usize,
-    /// The error body (JSON text) of the first failed chunk, if any.
-    pub failed: Option<String>,
-}
-
-/// How a job's items are cut: `items` in chunks of `per_chunk`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ChunkPlan {
-    pub items: usize,
-    pub per_chunk: usize,
-}
-
-impl ChunkPlan {
-    /// The plan of `items` items costing about `item_cost_s` seconds each:
-    /// chunks of about [`CHUNK_TARGET_S`] seconds, and at least
-    /// [`MIN_CHUNKS`] chunks (when there are as many items) once the whole
-    /// job is estimated above [`MIN_SPLIT_JOB_S`], so that several workers
-    /// share it; a shorter job is one chunk.
-    pub fn for_cost(items: usize, item_cost_s: f64) -> Self {
-        let cost = item_cost_s.max(1e-9);
-        if items as f64 * cost < MIN_SPLIT_JOB_S {
-            return Self {
-                items,
-                per_chunk: items.max(1),
-            };
-        }
-        let per = (CHUNK_TARGET_S / cost).floor();
-        let by_cost = if per.is_finite() {
-            (per as usize).clamp(1, MAX_ITEMS_PER_CHUNK)
-        } else {
-            MAX_ITEMS_PER_CHUNK
-        };
-        let by_count = items.div_ceil(MIN_CHUNKS).max(1);
-        Self {
-            items,
-            per_chunk: by_cost.min(by_count),
-        }
-    }
-
-    pub fn count(&self) -> usize {
-        self.items.div_ceil(self.per_chunk.max(1))
-    }
-
-    /// The items of chunk `index`.
-    pub fn range(&self, index: usize) -> Range<usize> {
-        let start = (index * self.per_chunk).min(self.items);
-        start..(start + self.per_chunk).min(self.items)
-    }
-}
-
-/// Seconds of work aimed at per chunk.
-pub const CHUNK_TARGET_S: f64 = 3.0;
-/// Chunks of a split job at least (when it has as many items).
-pub const MIN_CHUNKS: usize = 8;
-/// Jobs estimated below this many seconds are not split.
-pub const MIN_SPLIT_JOB_S: f64 = 0.5;
-/// Items of one chunk at most (bounds a chunk's result size).
-pub const MAX_ITEMS_PER_CHUNK: usize = 4096;
 /// How often a running chunk looks at its job's status between lease
 /// renewals (one `SELECT status` by primary key): a cancelled job's
 /// running chunks stop within about this long, on any store and in any
@@ -134,7 +56,7 @@ const COORDINATOR_POLL: Duration = Duration::from_millis(50);
 /// the answer is `Err(Cancelled)`.
 pub(super) fn coordinate(
     queue: &JobQueue,
-    lease: &super::store::Lease,
+    lease: &super::lease::Lease,
     submission: &JobSubmission,
     plan: ChunkPlan,
     progress: &dyn Progress,

@@ -14,7 +14,7 @@
 
 use crate::numerics::monitor::Sample;
 
-pub use super::store::StoreError;
+pub use super::backend::StoreError;
 
 /// A flight to store: its JSON parts as committed.
 #[derive(Clone, Debug)]

@@ -16,7 +16,7 @@ use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
 use super::flights::{
     FlightEntry, FlightRow, FlightStore, MAX_FLIGHTS_PER_OWNER, NewFlight, StoredBatch,
 };
-use super::store::StoreError;
+use super::backend::StoreError;
 use crate::numerics::monitor::Sample;
 
 const SCHEMA_V1: &str = "

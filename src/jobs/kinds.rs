@@ -1,12 +1,15 @@
 //! What a job computes: one request of a known kind, or a batch of them.
+//! The catalogue of kinds as the job engine sees it: [`JobItem`] is made
+//! from the one list of kinds ([`crate::contract::catalogue`]), and each
+//! kind's checks, run, answer size and chunking are its
+//! [`Analysis`] impl (in its `contract/<kind>/` folder). Nothing here, nor
+//! in the engine (`queue.rs`, `execute.rs`, `chunks.rs`), names a kind.
 //!
 //! A submission is `{"kind": K, "request": {...}}` with `K` one of
 //! [`JobItem::KINDS`] and the request the same JSON as `POST /api/v1/<K>`,
 //! or `{"kind": "batch", "request": [{"kind": K, "request": {...}}, ...]}`.
-//!
-//! Adding a kind: implement [`JobKind`] for its request type and add one
-//! line to the `job_kinds!` invocation below.
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
@@ -15,485 +18,23 @@ use serde_json::Value;
 use serde_json::value::RawValue;
 use utoipa::ToSchema;
 
-use crate::contract::dto::*;
-use crate::contract::ge_charts::{self, AnyChartRequest, AnyFrequencyResponseRequest};
-use crate::contract::ge_critical::{self, AnyCriticalRequest, AnyStabilityRequest};
-use crate::contract::run::{self, MAX_MODES};
-use crate::contract::simulate::{self, AnySimulateRequest};
-use crate::contract::transient::{self, FrequencyResponseRequest};
-use crate::contract::{self, Progress, RequestError};
+use super::split::ChunkPlan;
+use crate::contract::analysis::{Analysis, to_json};
+use crate::contract::catalogue::{self, for_each_kind};
+use crate::contract::error::ErrorBody;
+use crate::contract::estimate::{self as est, Estimate};
+use crate::contract::{Progress, RequestError};
 use crate::limits::Limits;
-use crate::numerics::chart::{self, MAX_CHART_POINTS, Parallelism};
-use crate::numerics::params::{InvalidInput, require_finite, require_positive};
+use crate::numerics::params::InvalidInput;
 
-/// A request type that can run as a job.
-pub trait JobKind: Serialize + Sized {
-    /// The `kind` of the submission, also the path of its synchronous route.
-    const NAME: &'static str;
-    /// Parses the request body (errors name the field).
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError>;
-    /// Every check that needs no solve, so that bad input is refused at
-    /// submission (422) instead of failing later.
-    fn validate(&self) -> Result<(), RequestError>;
-    /// Computes the answer (JSON text). Long kinds report progress and stop
-    /// when `progress.cancelled()`.
-    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError>;
-    /// An upper estimate of the answer's size, from the validated request
-    /// (see [`crate::jobs::estimate`]).
-    fn estimate(&self) -> Estimate;
-}
-
-pub use super::estimate::Estimate;
-use super::estimate::{self as est, Estimate as E};
-
-/// The answer as JSON; never one holding a non-finite number (the job
-/// fails `invalid_input`).
-fn to_json(value: &impl Serialize) -> Result<String, RequestError> {
-    crate::contract::finite::to_string(value)
-}
-
-impl JobKind for StabilityRequest {
-    const NAME: &'static str = "stability";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        contract::parse(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        self.system.model()?;
-        require_positive("state.length_m", self.params.state.length_m)?;
-        require_finite("state.rate_m_s", self.params.state.rate_m_s)?;
-        require_finite(
-            "state.acceleration_m_s2",
-            self.params.state.acceleration_m_s2,
-        )?;
-        if self.params.modes == 0 || self.params.modes > MAX_MODES {
-            return Err(InvalidInput::new(
-                "modes",
-                format!(
-                    "must be between 1 and {MAX_MODES}, got {}",
-                    self.params.modes
-                ),
-            )
-            .into());
-        }
-        Ok(())
-    }
-    fn run(&self, _: &dyn Progress) -> Result<String, RequestError> {
-        to_json(&run::stability(self)?)
-    }
-    fn estimate(&self) -> Estimate {
-        E::bytes(
-            "modes",
-            est::STABILITY_BASE as f64 + self.params.modes as f64 * est::PER_EIGENVALUE as f64,
-        )
-    }
-}
-
-impl JobKind for CriticalRequest {
-    const NAME: &'static str = "critical";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        contract::parse(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        // the synchronous route's own checks
-        run::check_critical(self)
-    }
-    fn run(&self, _: &dyn Progress) -> Result<String, RequestError> {
-        to_json(&run::critical(self)?)
-    }
-    fn estimate(&self) -> Estimate {
-        E::new("profile", est::SMALL_ANSWER)
-    }
-}
-
-impl JobKind for SafeRateRequest {
-    const NAME: &'static str = "safe_rate";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        contract::parse(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        let model = self.system.model()?;
-        let target = require_positive("target_elevation_m", self.params.target_elevation_m)?;
-        let l0 = model.system.initial_length_m;
-        if target <= l0 {
-            return Err(InvalidInput::new(
-                "target_elevation_m",
-                format!("must be a finite length above initial_length_m = {l0} m, got {target}"),
-            )
-            .into());
-        }
-        Ok(())
-    }
-    fn run(&self, _: &dyn Progress) -> Result<String, RequestError> {
-        to_json(&run::safe_rate(self)?)
-    }
-    fn estimate(&self) -> Estimate {
-        E::new("target_elevation_m", est::SMALL_ANSWER)
-    }
-}
-
-/// Rates per chunk of a chart job (times the buoyancies): progress is
-/// persisted and cancellation checked between chunks.
-const CHART_CHUNK_POINTS: usize = 512;
-
-impl JobKind for ChartRequest {
-    const NAME: &'static str = "chart";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        contract::parse(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        let model = self.system.model()?;
-        let points = run::chart_points(self);
-        if points > MAX_CHART_POINTS {
-            return Err(InvalidInput::new(
-                "rates_m_s.count",
-                format!(
-                    "the chart would have {points} points; at most {MAX_CHART_POINTS} are allowed"
-                ),
-            )
-            .into());
-        }
-        self.params.rates_m_s.rates("rates_m_s").map(drop)?;
-        chart::deployment_chart_with(
-            &model.system,
-            self.system.discretisation()?,
-            &[],
-            &self.buoyancies(&model.system),
-            Parallelism::Serial,
-            &|_, _| {},
-        )?;
-        Ok(())
-    }
-
-    /// The chart in chunks of rates: the same points as
-    /// [`run::chart`] (each point is independent), with progress and
-    /// cancellation between chunks.
-    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
-        self.validate()?;
-        let model = self.system.model()?;
-        let sys = model.system;
-        let rates = self.params.rates_m_s.rates("rates_m_s")?;
-        let buoyancies = self.buoyancies(&sys);
-        let total = rates.len() * buoyancies.len();
-        let chunk_rates = (CHART_CHUNK_POINTS / buoyancies.len()).max(1);
-        let mut series: Vec<ChartSeriesOutput> = Vec::with_capacity(buoyancies.len());
-        for (c, chunk) in rates.chunks(chunk_rates).enumerate() {
-            if progress.cancelled() {
-                return Err(RequestError::Cancelled);
-            }
-            let before = c * chunk_rates * buoyancies.len();
-            let report = |done: usize, _: usize| progress.report(before + done, total);
-            let part = chart::deployment_chart_with(
-                &sys,
-                self.system.discretisation()?,
-                chunk,
-                &buoyancies,
-                Parallelism::Rayon,
-                &report,
-            )?;
-            for (i, s) in part.into_iter().enumerate() {
-                if series.len() <= i {
-                    series.push(ChartSeriesOutput {
-                        net_buoyancy_n: s.net_buoyancy_n,
-                        wave_speed_m_s: (s.net_buoyancy_n / sys.mass_per_length_kg_m).sqrt(),
-                        points: Vec::with_capacity(rates.len()),
-                    });
-                }
-                series[i]
-                    .points
-                    .extend(s.points.into_iter().map(|p| ChartPointOutput {
-                        rate_m_s: p.rate_m_s,
-                        critical_time_s: p.critical_time_s,
-                        max_elevation_m: p.max_elevation_m,
-                        closed_form_elevation_m: p.closed_form_elevation_m,
-                        critical_time_error_s: p.critical_time_error_s,
-                        max_elevation_error_m: p.max_elevation_error_m,
-                        winch_tension_at_onset_n: s.net_buoyancy_n
-                            - sys.mass_per_length_kg_m * sys.gravity_m_s2 * p.max_elevation_m,
-                        kinematic_tension_n: sys.mass_per_length_kg_m * p.rate_m_s * p.rate_m_s,
-                    }));
-            }
-        }
-        if progress.cancelled() {
-            return Err(RequestError::Cancelled);
-        }
-        to_json(&ChartResponse {
-            series,
-            elements: run::chart_elements(self.system.discretisation()?),
-            converged: self.system.model.elements.is_none(),
-        })
-    }
-    fn estimate(&self) -> Estimate {
-        let series = self.params.net_buoyancies_n.len().max(1) as f64;
-        let points = series * self.params.rates_m_s.count() as f64;
-        E::bytes(
-            "rates_m_s.count",
-            (est::CHART_BASE as f64)
-                + series * est::PER_CHART_SERIES as f64
-                + points * est::PER_CHART_POINT as f64,
-        )
-    }
-}
-
-trait Buoyancies {
-    fn buoyancies(&self, sys: &crate::numerics::params::AerostatSystem) -> Vec<f64>;
-}
-
-impl Buoyancies for ChartRequest {
-    fn buoyancies(&self, sys: &crate::numerics::params::AerostatSystem) -> Vec<f64> {
-        if self.params.net_buoyancies_n.is_empty() {
-            vec![sys.net_buoyancy_n]
-        } else {
-            self.params.net_buoyancies_n.clone()
-        }
-    }
-}
+/// Seconds assumed for one request of a kind that is not chunked.
+const OTHER_ITEM_S: f64 = 0.05;
 
 /// Parses `request` as `T`, naming fields from `prefix` (`request`,
 /// `request[2].request`).
-fn parse_as<T: JobKind>(request: &Value, prefix: &str) -> Result<T, RequestError> {
+fn parse_as<T: Analysis>(request: &Value, prefix: &str) -> Result<T, RequestError> {
     let bytes = serde_json::to_vec(request).expect("values serialise");
-    T::parse_body(&bytes).map_err(|e| prefixed(e, prefix))
-}
-
-/// Progress that is cancelled from the start: running a request with it
-/// performs every input check and stops before the first step.
-struct CancelledFromTheStart;
-
-impl Progress for CancelledFromTheStart {
-    fn report(&self, _: usize, _: usize) {}
-    fn cancelled(&self) -> bool {
-        true
-    }
-}
-
-/// Validates by running with [`CancelledFromTheStart`]: invalid input is
-/// the error; a cancellation (or an answer) means the input is good.
-fn validate_by_cancelled_run<T>(
-    run: impl FnOnce(&dyn Progress) -> Result<T, RequestError>,
-) -> Result<(), RequestError> {
-    match run(&CancelledFromTheStart) {
-        Ok(_) | Err(RequestError::Cancelled) => Ok(()),
-        Err(e) => Err(e),
-    }
-}
-
-impl JobKind for AnySimulateRequest {
-    const NAME: &'static str = "simulate";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        simulate::parse_simulate(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        validate_by_cancelled_run(|p| simulate::simulate_any(self, p))
-    }
-    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
-        to_json(&simulate::simulate_any(self, progress)?)
-    }
-    fn estimate(&self) -> Estimate {
-        match self {
-            Self::LinearString(r) => {
-                let samples = r.params.samples as f64;
-                let tracks = r.params.eigenvalues.as_ref().map_or(0.0, |e| {
-                    let solves = (r.params.duration_s / e.interval_s).ceil() + 1.0;
-                    solves
-                        * (est::PER_EIGEN_TRACK as f64
-                            + e.count as f64 * est::PER_EIGENVALUE as f64)
-                });
-                E::bytes(
-                    "samples",
-                    est::SIMULATE_BASE as f64 + samples * est::PER_SIMULATE_SAMPLE as f64 + tracks,
-                )
-            }
-            Self::GeometricallyExact(r) => {
-                let steps = (r.duration_s / r.time_step_s).ceil();
-                let samples = (steps / r.output_every_steps.max(1) as f64).ceil() + 1.0;
-                let spectra = if r.eigenvalues_every_steps > 0 {
-                    (steps / r.eigenvalues_every_steps as f64).ceil() + 1.0
-                } else {
-                    0.0
-                };
-                E::bytes(
-                    "output_every_steps",
-                    est::SIMULATE_BASE as f64
-                        + samples * est::PER_GE_SAMPLE as f64
-                        + spectra
-                            * (est::PER_EIGEN_TRACK as f64
-                                + r.modes as f64 * est::PER_EIGENVALUE as f64),
-                )
-            }
-        }
-    }
-}
-
-impl JobKind for FrequencyResponseRequest {
-    const NAME: &'static str = "frequency_response";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        contract::parse(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        validate_by_cancelled_run(|p| transient::frequency_response(self, Parallelism::Serial, p))
-    }
-    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
-        to_json(&transient::frequency_response(
-            self,
-            Parallelism::Rayon,
-            progress,
-        )?)
-    }
-    fn estimate(&self) -> Estimate {
-        AnyFrequencyResponseRequest::Wind(Box::new(self.clone())).estimate()
-    }
-}
-
-impl JobKind for AnyChartRequest {
-    const NAME: &'static str = "chart";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        ge_charts::parse_chart(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        match self {
-            Self::LinearString(r) => r.validate(),
-            Self::GeometricallyExact(r) => {
-                ge_charts::prepare_chart(r).map(drop).map_err(Into::into)
-            }
-        }
-    }
-    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
-        match self {
-            Self::LinearString(r) => r.run(progress),
-            Self::GeometricallyExact(r) => {
-                to_json(&ge_charts::ge_chart(r, Parallelism::Rayon, progress)?)
-            }
-        }
-    }
-    fn estimate(&self) -> Estimate {
-        match self {
-            Self::LinearString(r) => r.estimate(),
-            Self::GeometricallyExact(r) => {
-                let points = ge_charts::prepare_chart(r).map_or(0, |c| c.point_count()) as f64;
-                E::bytes(
-                    "rates_m_s",
-                    est::CHART_BASE as f64
-                        + points * (est::PER_GE_CHART_POINT + est::PER_CHART_SERIES) as f64,
-                )
-            }
-        }
-    }
-}
-
-impl JobKind for AnyFrequencyResponseRequest {
-    const NAME: &'static str = "frequency_response";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        ge_charts::parse_frequency_response(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        validate_by_cancelled_run(|p| {
-            ge_charts::frequency_response_any(self, Parallelism::Serial, p)
-        })
-    }
-    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
-        to_json(&ge_charts::frequency_response_any(
-            self,
-            Parallelism::Rayon,
-            progress,
-        )?)
-    }
-    fn estimate(&self) -> Estimate {
-        match self {
-            Self::Wind(r) => {
-                let f = r.params.frequencies_rad_s.count() as f64;
-                let n = r.params.samples as f64;
-                E::bytes(
-                    "frequencies_rad_s.count",
-                    est::SIMULATE_BASE as f64 + (f * (n + 4.0) + n) * est::PER_NUMBER as f64,
-                )
-            }
-            Self::Base(r) => E::bytes(
-                "frequencies_rad_s.count",
-                est::SIMULATE_BASE as f64
-                    + r.frequencies_rad_s.count() as f64 * est::PER_BASE_POINT as f64,
-            ),
-        }
-    }
-}
-
-impl JobKind for AnyStabilityRequest {
-    const NAME: &'static str = "stability";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        ge_critical::parse_stability(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        match self {
-            Self::LinearString(r) => r.validate(),
-            Self::GeometricallyExact(r) => ge_critical::validate_stability(r).map_err(Into::into),
-        }
-    }
-    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
-        match self {
-            Self::LinearString(r) => r.run(progress),
-            Self::GeometricallyExact(r) => to_json(&ge_critical::ge_stability(r)?),
-        }
-    }
-    fn estimate(&self) -> Estimate {
-        match self {
-            Self::LinearString(r) => r.estimate(),
-            Self::GeometricallyExact(r) => E::new(
-                "modes",
-                est::STABILITY_BASE + r.modes as u64 * est::PER_EIGENVALUE,
-            ),
-        }
-    }
-}
-
-impl JobKind for AnyCriticalRequest {
-    const NAME: &'static str = "critical";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        ge_critical::parse_critical(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        match self {
-            Self::LinearString(r) => r.validate(),
-            Self::GeometricallyExact(r) => ge_critical::prepare_critical(r)
-                .map(drop)
-                .map_err(Into::into),
-        }
-    }
-    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
-        match self {
-            Self::LinearString(r) => r.run(progress),
-            Self::GeometricallyExact(r) => to_json(&ge_critical::ge_critical(r, progress)?),
-        }
-    }
-    fn estimate(&self) -> Estimate {
-        match self {
-            Self::LinearString(r) => r.estimate(),
-            Self::GeometricallyExact(_) => E::new("profile", est::SMALL_ANSWER),
-        }
-    }
-}
-
-impl JobKind for crate::contract::bands::BandsRequest {
-    const NAME: &'static str = "bands";
-    fn parse_body(body: &[u8]) -> Result<Self, RequestError> {
-        crate::contract::bands::parse_bands(body)
-    }
-    fn validate(&self) -> Result<(), RequestError> {
-        crate::contract::bands::prepare(self).map(drop)
-    }
-    fn run(&self, progress: &dyn Progress) -> Result<String, RequestError> {
-        to_json(&crate::contract::bands::bands(
-            self,
-            Parallelism::Rayon,
-            progress,
-        )?)
-    }
-    fn estimate(&self) -> Estimate {
-        let samples = self.params.uncertainty.samples.max(1);
-        let rates = (crate::contract::bands::evaluations(self) / samples) as u64;
-        E::new(
-            "rates_m_s",
-            est::CHART_BASE + rates.saturating_mul(est::PER_BAND_POINT),
-        )
-    }
+    T::parse(&bytes).map_err(|e| prefixed(e, prefix))
 }
 
 fn prefixed(e: RequestError, prefix: &str) -> RequestError {
@@ -510,8 +51,8 @@ fn prefixed(e: RequestError, prefix: &str) -> RequestError {
     }
 }
 
-macro_rules! job_kinds {
-    ($($(#[$doc:meta])* $variant:ident($req:ty)),* $(,)?) => {
+macro_rules! job_items {
+    ($($(#[$doc:meta])* $variant:ident($req:ty => $resp:ty) $path:literal $op:ident),* $(,)?) => {
         /// One request: `kind` names the route, `request` is its body.
         #[derive(Clone, Debug, Serialize, ToSchema)]
         #[serde(tag = "kind", content = "request", rename_all = "snake_case")]
@@ -521,67 +62,71 @@ macro_rules! job_kinds {
 
         impl JobItem {
             /// The kinds, as written in `kind`.
-            pub const KINDS: &'static [&'static str] = &[$(<$req as JobKind>::NAME),*];
+            pub const KINDS: &'static [&'static str] = &[$(<$req as Analysis>::NAME),*];
 
             fn parse_kind(kind: &str, request: &Value, prefix: &str) -> Option<Result<Self, RequestError>> {
-                $(if kind == <$req as JobKind>::NAME {
+                $(if kind == <$req as Analysis>::NAME {
                     return Some(parse_as::<$req>(request, prefix).map(Self::$variant));
                 })*
                 None
             }
 
             pub fn kind(&self) -> &'static str {
-                match self { $(Self::$variant(_) => <$req as JobKind>::NAME),* }
+                match self { $(Self::$variant(_) => <$req as Analysis>::NAME),* }
             }
 
             fn validate_kind(&self) -> Result<(), RequestError> {
-                match self { $(Self::$variant(r) => r.validate()),* }
+                match self { $(Self::$variant(r) => <$req as Analysis>::prepare(r)),* }
             }
 
+            /// The answer as JSON text.
             fn run_kind(&self, progress: &dyn Progress) -> Result<String, RequestError> {
-                match self { $(Self::$variant(r) => r.run(progress)),* }
+                match self { $(Self::$variant(r) => to_json(&<$req as Analysis>::run(r, progress)?)),* }
             }
 
             /// Upper estimate of the answer's size.
             pub fn estimate(&self) -> Estimate {
-                match self { $(Self::$variant(r) => r.estimate()),* }
+                match self { $(Self::$variant(r) => <$req as Analysis>::estimate(r)),* }
+            }
+
+            fn items(&self) -> Option<crate::contract::analysis::Items> {
+                match self { $(Self::$variant(r) => <$req as Analysis>::items(r)),* }
+            }
+
+            /// The items `range` of this request as JSON text.
+            fn run_range(&self, range: Range<usize>, progress: &dyn Progress) -> Result<String, RequestError> {
+                match self { $(Self::$variant(r) => <$req as Analysis>::run_items(r, range, progress)),* }
+            }
+
+            /// The answer from the chunks' results, in chunk order.
+            fn assemble(&self, parts: &[String]) -> Result<String, RequestError> {
+                match self { $(Self::$variant(r) => <$req as Analysis>::assemble(r, parts)),* }
             }
         }
     };
 }
+for_each_kind!(job_items);
 
-job_kinds!(
-    /// `POST /api/v1/stability` (either cable model).
-    Stability(AnyStabilityRequest),
-    /// `POST /api/v1/critical` (either cable model).
-    Critical(AnyCriticalRequest),
-    /// `POST /api/v1/safe-rate`.
-    SafeRate(SafeRateRequest),
-    /// `POST /api/v1/charts`, up to 1 000 000 points (GE: 2 000).
-    Chart(AnyChartRequest),
-    /// `POST /api/v1/simulate` (either cable model).
-    Simulate(AnySimulateRequest),
-    /// `POST /api/v1/frequency-response`.
-    FrequencyResponse(AnyFrequencyResponseRequest),
-    /// `POST /api/v1/equilibrium`.
-    Equilibrium(crate::contract::equilibrium::dto::EquilibriumRequest),
-    /// `POST /api/v1/envelope`, up to 250 000 points (with progress).
-    Envelope(crate::contract::envelope::dto::EnvelopeRequest),
-    /// `POST /api/v1/bands`, up to 2 000 000 chart points (samples × rates).
-    Bands(crate::contract::bands::BandsRequest),
-    /// `POST /api/v1/plan`: the deployment plan (progress of its transient check).
-    Plan(crate::contract::plan::PlanRequest),
-    /// `POST /api/v1/plan/bands`.
-    PlanBands(crate::contract::bands::PlanBandsRequest),
-    /// `POST /api/v1/envelope/bands`, up to 2 000 000 equilibria (samples × cells).
-    EnvelopeBands(crate::contract::bands::EnvelopeBandsRequest),
-    /// `POST /api/v1/dynamics`: one run in time (progress in steps).
-    Dynamics(crate::contract::dynamics::DynamicsRequest),
-    /// `POST /api/v1/dynamics/peaks`: Monte Carlo over turbulence seeds, chunked by sample.
-    DynamicsPeaks(crate::contract::dynamics::DynamicsPeaksRequest),
-    /// `POST /api/v1/windows`: launch windows from a forecast (progress in plans).
-    Windows(crate::contract::windows::WindowsRequest),
-);
+impl JobItem {
+    /// How this request splits into chunks (None: it runs as one piece).
+    fn chunk_plan(&self) -> Option<ChunkPlan> {
+        let items = self.items()?;
+        let plan = ChunkPlan::for_cost(items.count, items.seconds_each);
+        match items.most_per_chunk {
+            Some(most) if plan.count() > 1 => Some(ChunkPlan {
+                per_chunk: plan.per_chunk.min(most),
+                ..plan
+            }),
+            _ => Some(plan),
+        }
+    }
+
+    /// Seconds one run of this request may take (sizing batch chunks).
+    fn cost_s(&self) -> f64 {
+        self.items()
+            .map_or(OTHER_ITEM_S, |i| i.count as f64 * i.seconds_each)
+    }
+}
 
 impl JobItem {
     #[cfg(test)]
@@ -696,30 +241,13 @@ pub struct BatchItemOutcome {
     pub error: Option<ErrorBody>,
 }
 
-/// The schemas of one request's answer: those of the synchronous routes.
-pub const ITEM_RESULT_SCHEMAS: &[&str] = &[
-    "AnyStabilityResponse",
-    "AnyCriticalResponse",
-    "SafeRateResponse",
-    "AnyChartResponse",
-    "AnySimulateResponse",
-    "AnyFrequencyResponseResponse",
-    "EquilibriumResponse",
-    "EnvelopeResponse",
-    "BandsResponse",
-    "PlanResponse",
-    "PlanBandsResponse",
-    "EnvelopeBandsResponse",
-    "DynamicsResponse",
-    "DynamicsPeaksResponse",
-    "WindowsResponse",
-];
-
+/// The schemas of one request's answer: those of the synchronous routes
+/// (every kind's answer, [`catalogue::response_schemas`]).
 fn item_result_schema() -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {
     use utoipa::openapi::schema::{OneOfBuilder, Ref};
     let mut one_of = OneOfBuilder::new();
-    for name in ITEM_RESULT_SCHEMAS {
-        one_of = one_of.item(Ref::from_schema_name(*name));
+    for name in catalogue::response_schemas() {
+        one_of = one_of.item(Ref::from_schema_name(name));
     }
     one_of.description(Some(
         "The answer, as the synchronous route gives it; absent on error.",
@@ -869,221 +397,6 @@ impl JobSubmission {
     }
 }
 
-// ------------------------------------------------------------ chunks (split/assemble)
-
-use super::chunks::ChunkPlan;
-
-/// Seconds per element-step of a GE search, QEP checks included (measured:
-/// 24 points of 10 elements, 6 100 steps in 0.48 s on one core), for sizing
-/// chunks; a point is costed at its whole horizon, an upper bound (most
-/// end at the onset).
-const GE_ELEMENT_STEP_S: f64 = 8e-6;
-/// Seconds per element of one chart point of a bands sample on a uniform
-/// mesh (measured: 6 400 points of 500 elements in 1.2 s on one core).
-const BAND_ELEMENT_POINT_S: f64 = 4e-7;
-/// Seconds per converged chart point of a bands sample (measured: 9 600
-/// points in 0.06 s).
-const BAND_CONVERGED_POINT_S: f64 = 1e-5;
-/// Seconds per element of one point of a string chart on a uniform mesh
-/// (measured: 300 rates × 3 buoyancies at 400 elements in 0.21-0.23 s on
-/// one core, 5.9-6.5e-7 s, timing `run_chunk` on one rayon thread).
-const STRING_CHART_ELEMENT_POINT_S: f64 = 7e-7;
-/// Seconds per converged point of a string chart (measured: 74 points in
-/// 0.5 ms, 6.5-7.3e-6 s, on one core; slower near the wave speed).
-const STRING_CHART_CONVERGED_POINT_S: f64 = 1e-5;
-/// Seconds per sample × schedule instant of a plan bands chunk, its wire
-/// result included (measured: 3 000 samples × 2 003 instants in 1.36 s on
-/// one core, 2.2e-7 s, most of it writing the result; the nominal plan,
-/// computed again by every chunk, 0.02 s).
-const PLAN_BAND_VALUE_S: f64 = 2.5e-7;
-/// Sample × instant values of one plan bands chunk at most: its result
-/// holds every value of three traces, about 60 bytes a value (15 MB).
-const MAX_PLAN_BAND_CHUNK_VALUES: usize = 250_000;
-/// Seconds per sample × cell × integration step of an envelope bands job
-/// (measured: 200 samples × 42 cells × 100 steps in 0.94 s on one core,
-/// 1.1e-6 s).
-const ENVELOPE_BAND_CELL_STEP_S: f64 = 1.2e-6;
-/// Seconds assumed for one request of a kind that is not chunked.
-const OTHER_ITEM_S: f64 = 0.05;
-/// Seconds per envelope cell per element of the quasi-static GE verdict,
-/// the row's critical length and rate searches included (measured: 40 ×
-/// 50 cells at 20 elements in 12.1 s on 2 loaded cores, 5.8 s quiet;
-/// costed at the loaded figure, 12 ms a cell on one core).
-const GE_ENVELOPE_CELL_ELEMENT_S: f64 = 6e-4;
-
-impl JobItem {
-    /// The independent items of this request and the seconds each may
-    /// take (None: it runs as one piece).
-    fn items(&self) -> Option<(usize, f64)> {
-        match self {
-            Self::Chart(AnyChartRequest::GeometricallyExact(r)) => {
-                let core = ge_charts::prepare_chart(r).ok()?;
-                let steps = core.config.horizon_s / core.config.time_step_s;
-                let cost = steps * core.system.elements as f64 * GE_ELEMENT_STEP_S;
-                Some((core.point_count(), cost))
-            }
-            Self::Bands(r) => {
-                let samples = r.params.uncertainty.samples;
-                let rates = crate::contract::bands::evaluations(r) / samples.max(1);
-                let point = match r.system.discretisation().ok()? {
-                    crate::numerics::chart::Discretisation::Elements(n) => {
-                        n as f64 * BAND_ELEMENT_POINT_S
-                    }
-                    _ => BAND_CONVERGED_POINT_S,
-                };
-                Some((samples, rates as f64 * point))
-            }
-            Self::Chart(AnyChartRequest::LinearString(r)) => {
-                let series = r.params.net_buoyancies_n.len().max(1) as f64;
-                let point = match r.system.discretisation().ok()? {
-                    crate::numerics::chart::Discretisation::Elements(n) => {
-                        n as f64 * STRING_CHART_ELEMENT_POINT_S
-                    }
-                    _ => STRING_CHART_CONVERGED_POINT_S,
-                };
-                Some((
-                    crate::contract::chart_chunks::chart_rate_count(r),
-                    series * point,
-                ))
-            }
-            Self::PlanBands(r) => {
-                let samples = r.params.uncertainty.samples;
-                let values = crate::contract::bands::plan::plan_band_values(r);
-                let instants = values / samples.max(1);
-                Some((samples, instants as f64 * PLAN_BAND_VALUE_S))
-            }
-            Self::Envelope(r) => {
-                let (_, config, spec) = r.ge_problem().ok()?;
-                let cell = match spec {
-                    Some(spec) => spec.elements as f64 * GE_ENVELOPE_CELL_ELEMENT_S,
-                    // A string cell costs what an envelope bands cell does.
-                    None => config.steps as f64 * ENVELOPE_BAND_CELL_STEP_S,
-                };
-                let lengths = r.tether_lengths_m.count() as f64;
-                Some((
-                    crate::contract::envelope::chunks::envelope_row_count(r),
-                    lengths * cell,
-                ))
-            }
-            Self::EnvelopeBands(r) => {
-                let samples = r.params.uncertainty.samples;
-                let (_, config) = r.envelope.problem().ok()?;
-                let cells = r.envelope.points() as f64;
-                let cost = cells * config.steps as f64 * ENVELOPE_BAND_CELL_STEP_S;
-                Some((samples, cost))
-            }
-            Self::DynamicsPeaks(r) => {
-                let per = r.prepare().ok()?.work() * super::dynamics::SEGMENT_STEP_S;
-                Some((r.samples, per))
-            }
-            _ => None,
-        }
-    }
-
-    /// How this request splits into chunks (None: it runs as one piece).
-    fn chunk_plan(&self) -> Option<ChunkPlan> {
-        let plan = self.items().map(|(n, cost)| ChunkPlan::for_cost(n, cost))?;
-        match self {
-            // A split plan bands job: chunk results of bounded size.
-            Self::PlanBands(r) if plan.count() > 1 => {
-                let samples = r.params.uncertainty.samples.max(1);
-                let instants = crate::contract::bands::plan::plan_band_values(r) / samples;
-                let most = (MAX_PLAN_BAND_CHUNK_VALUES / instants.max(1)).max(1);
-                Some(ChunkPlan {
-                    per_chunk: plan.per_chunk.min(most),
-                    ..plan
-                })
-            }
-            _ => Some(plan),
-        }
-    }
-
-    /// Seconds one run of this request may take (sizing batch chunks).
-    fn cost_s(&self) -> f64 {
-        self.items().map_or(OTHER_ITEM_S, |(n, c)| n as f64 * c)
-    }
-
-    /// The items `range` of this request as JSON text.
-    fn run_range(
-        &self,
-        range: std::ops::Range<usize>,
-        progress: &dyn Progress,
-    ) -> Result<String, RequestError> {
-        match self {
-            Self::Chart(AnyChartRequest::GeometricallyExact(r)) => to_json(
-                &ge_charts::ge_chart_points(r, range, Parallelism::Rayon, progress)?,
-            ),
-            Self::Bands(r) => {
-                crate::contract::bands::bands_chunk(r, range, Parallelism::Rayon, progress)
-            }
-            Self::Chart(AnyChartRequest::LinearString(r)) => {
-                crate::contract::chart_chunks::chart_chunk(r, range, Parallelism::Rayon, progress)
-            }
-            Self::PlanBands(r) => crate::contract::bands::plan::plan_bands_chunk(
-                r,
-                range,
-                Parallelism::Rayon,
-                progress,
-            ),
-            Self::Envelope(r) => to_json(&crate::contract::envelope::chunks::envelope_chunk(
-                r,
-                range,
-                Parallelism::Rayon,
-                progress,
-            )?),
-            Self::EnvelopeBands(r) => crate::contract::bands::envelope::envelope_bands_chunk(
-                r,
-                range,
-                Parallelism::Rayon,
-                progress,
-            ),
-            Self::DynamicsPeaks(r) => crate::contract::dynamics::peaks::peaks_chunk(
-                r,
-                range,
-                Parallelism::Rayon,
-                progress,
-            ),
-            _ => self.run_kind(progress),
-        }
-    }
-
-    /// The answer from the chunks' results, in chunk order.
-    fn assemble(&self, parts: &[String]) -> Result<String, RequestError> {
-        let bad = |e: serde_json::Error| RequestError::Malformed(format!("a chunk result: {e}"));
-        match self {
-            Self::Chart(AnyChartRequest::GeometricallyExact(r)) => {
-                let mut points = Vec::new();
-                for part in parts {
-                    let chunk: Vec<ge_charts::GeChartPointOutput> =
-                        serde_json::from_str(part).map_err(bad)?;
-                    points.extend(chunk);
-                }
-                to_json(&ge_charts::ge_chart_assemble(r, points)?)
-            }
-            Self::Bands(r) => to_json(&crate::contract::bands::bands_from_chunks(r, parts)?),
-            Self::Chart(AnyChartRequest::LinearString(r)) => {
-                to_json(&crate::contract::chart_chunks::chart_from_chunks(r, parts)?)
-            }
-            Self::PlanBands(r) => to_json(&crate::contract::bands::plan::plan_bands_from_chunks(
-                r, parts,
-            )?),
-            Self::Envelope(r) => to_json(&crate::contract::envelope::chunks::envelope_from_chunks(
-                r, parts,
-            )?),
-            Self::EnvelopeBands(r) => {
-                to_json(&crate::contract::bands::envelope::envelope_bands_from_chunks(r, parts)?)
-            }
-            Self::DynamicsPeaks(r) => to_json(
-                &crate::contract::dynamics::peaks::peaks_from_chunks(r, parts)?,
-            ),
-            _ => parts
-                .first()
-                .cloned()
-                .ok_or_else(|| RequestError::Malformed("no chunk result".into())),
-        }
-    }
-}
-
 /// A batch answer put together from the items of its chunks, unparsed.
 #[derive(Serialize)]
 struct RawBatchOutcome {
@@ -1185,18 +498,32 @@ mod tests {
     use super::*;
     use serde_json::json;
 
+    /// A kind's schema example (its request type's `example`).
+    fn schema_example(kind: &str) -> Option<Value> {
+        macro_rules! examples {
+            ($($(#[$doc:meta])* $variant:ident($req:ty => $resp:ty) $path:literal $op:ident),* $(,)?) => {{
+                $(if kind == <$req as Analysis>::NAME {
+                    let schema = <$req as utoipa::PartialSchema>::schema();
+                    return serde_json::to_value(&schema).ok()?.get("example").cloned();
+                })*
+                None
+            }};
+        }
+        for_each_kind!(examples)
+    }
+
     fn valid(kind: &str) -> Value {
-        if let Some(v) = crate::jobs::tether::example_request(kind) {
-            return v;
-        }
-        if let Some(v) = crate::jobs::bands::example_request(kind) {
-            return v;
-        }
-        if let Some(v) = crate::jobs::dynamics::example_request(kind) {
-            return v;
-        }
-        if let Some(v) = crate::jobs::windows::example_request(kind) {
-            return v;
+        let by_example = [
+            "equilibrium",
+            "envelope",
+            "plan_bands",
+            "envelope_bands",
+            "dynamics",
+            "dynamics_peaks",
+            "windows",
+        ];
+        if by_example.contains(&kind) {
+            return schema_example(kind).expect("the schema has an example");
         }
         let mut v = json!({"cable": {"mass_per_length_kg_m": 0.078}, "aerostat": {"net_buoyancy_n": 1000.0}});
         let extra = match kind {

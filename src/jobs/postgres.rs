@@ -36,9 +36,9 @@ use std::time::Duration;
 
 use postgres::{Client, NoTls, Row};
 
-use super::chunks::{ChunkLease, ChunkState, ClaimedChunk};
+use super::backend::{ChunkLease, ChunkState, ClaimedChunk};
 use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
-use super::store::{
+use super::backend::{
     ClaimPolicy, ClaimedJob, InsertError, Inserted, JobBackend, JobHead, JobRecord, JobStatus,
     KeyedJob, NewJob, PutSystem, StoreError, StoredSystem,
 };
@@ -687,7 +687,7 @@ impl JobBackend for PgStore {
                 "INSERT INTO job_answers (job_id, page, data) VALUES ($1, $2, $3)
                  ON CONFLICT (job_id, page) DO UPDATE SET data = excluded.data",
             )?;
-            for (i, page) in super::store::answer_pages(result).enumerate() {
+            for (i, page) in super::backend::answer_pages(result).enumerate() {
                 let i = i as i32;
                 tx.execute(&insert, &[&lease.job_id, &i, &page])?;
             }
@@ -809,7 +809,7 @@ impl JobBackend for PgStore {
                 .map(|r| r.get(0))
                 .collect())
             })?;
-            rec.result = Some(super::store::join_pages(id, pages)?);
+            rec.result = Some(super::backend::join_pages(id, pages)?);
         }
         Ok(Some(rec))
     }

@@ -28,11 +28,17 @@ use std::time::Duration;
 use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
 
 use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
-use super::store::{
+use super::backend::{
     ChunkLease, ChunkState, ClaimPolicy, ClaimedChunk, ClaimedJob, InsertError, Inserted,
     JobBackend, JobHead, JobRecord, JobStatus, KeyedJob, NewJob, PutSystem, StoreError,
     StoredSystem,
 };
+
+impl From<rusqlite::Error> for StoreError {
+    fn from(e: rusqlite::Error) -> Self {
+        Self(e.to_string())
+    }
+}
 
 const SCHEMA_V1: &str = "
 CREATE TABLE IF NOT EXISTS jobs (
@@ -562,7 +568,7 @@ impl JobBackend for JobStore {
             let mut stmt = tx.prepare(
                 "INSERT OR REPLACE INTO job_answers (job_id, page, data) VALUES (?1, ?2, ?3)",
             )?;
-            for (i, page) in super::store::answer_pages(result).enumerate() {
+            for (i, page) in super::backend::answer_pages(result).enumerate() {
                 stmt.execute(params![lease.job_id, i as i64, page])?;
             }
         }
@@ -671,7 +677,7 @@ impl JobBackend for JobStore {
             let pages = stmt
                 .query_map([id], |r| r.get::<_, Vec<u8>>(0))?
                 .collect::<Result<Vec<_>, _>>()?;
-            rec.result = Some(super::store::join_pages(id, pages)?);
+            rec.result = Some(super::backend::join_pages(id, pages)?);
         }
         Ok(Some(rec))
     }

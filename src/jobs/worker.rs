@@ -25,7 +25,7 @@ pub const STOP_GRACE: Duration = Duration::from_secs(20);
 
 /// Runs a worker process until SIGTERM/SIGINT.
 pub fn run(config: WorkerConfig) -> Result<(), Box<dyn std::error::Error>> {
-    crate::api::error::install_panic_hook();
+    crate::shutdown::install_panic_hook();
     let store = config
         .store
         .open()
@@ -51,7 +51,7 @@ pub fn run(config: WorkerConfig) -> Result<(), Box<dyn std::error::Error>> {
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()?;
-    runtime.block_on(crate::api::shutdown_signal());
+    runtime.block_on(crate::shutdown::shutdown_signal());
     tracing::info!("stopping: the running work ends or goes back to the queue");
     queue.shutdown();
     let (done, finished) = std::sync::mpsc::channel();

@@ -23,6 +23,7 @@
 pub mod common;
 pub mod dto;
 pub mod envelope;
+pub mod kind;
 pub mod plan;
 pub mod run;
 

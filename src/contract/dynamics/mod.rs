@@ -15,7 +15,9 @@
 //! * [`peaks`]: the Monte Carlo, chunked by sample for the job queue.
 
 pub mod dto;
+pub mod kind;
 pub mod peaks;
+pub mod price;
 pub mod run;
 pub mod validate;
 

@@ -5,6 +5,8 @@
 
 pub mod chunks;
 pub mod dto;
+pub mod kind;
+pub mod price;
 pub mod stability;
 
 use crate::contract::equilibrium::dto::WindFlowInput;

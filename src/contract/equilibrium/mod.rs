@@ -4,6 +4,7 @@
 //! [`crate::numerics::tether`] and converts the answer.
 
 pub mod dto;
+pub mod kind;
 
 use crate::contract::RequestError;
 use crate::numerics::params::InvalidInput;

@@ -48,13 +48,6 @@ use crate::numerics::params::{
     InvalidInput, require_finite, require_non_negative, require_positive,
 };
 
-// The GE stability query moved to its own file; its old paths.
-pub use super::stability::{
-    AnyStabilityRequest, AnyStabilityResponse, GeEquilibriumOutput, GeStabilityOutcome,
-    GeStabilityRequest, GeStabilityResponse, ge_stability, parse_stability, stability_any,
-    validate_stability,
-};
-
 /// Largest element count of a GE critical-time search or stability query
 /// (a dense QEP of size 6n per check).
 pub const MAX_GE_QEP_ELEMENTS: usize = 200;

@@ -8,6 +8,7 @@
 pub mod base_response;
 pub mod charts;
 pub mod critical;
+pub mod kind;
 pub mod model;
 pub mod numerics;
 pub mod simulate;

@@ -6,6 +6,7 @@
 pub mod ceiling;
 pub mod dto;
 pub mod ge;
+pub mod kind;
 mod output;
 pub mod run;
 mod validate;

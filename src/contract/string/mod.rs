@@ -3,5 +3,6 @@
 
 pub mod chunks;
 pub mod dto;
+pub mod kind;
 pub mod run;
 pub mod tension;

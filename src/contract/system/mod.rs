@@ -11,6 +11,7 @@
 //! numbers); every bound in the schema is the bound the validation applies.
 
 pub mod grid;
+pub mod moved;
 pub mod presets;
 pub mod resolve;
 pub mod validate;
@@ -19,7 +20,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 pub use grid::GridInput;
-pub use resolve::{MOVED, refuse_moved, resolve_request};
+pub use moved::{MOVED, refuse_moved};
 
 /// A tether material preset: fills every property not given from `diameter_m`.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, ToSchema, PartialEq, Eq)]

@@ -41,13 +41,31 @@ pub struct ForecastInput {
     pub format: ForecastFormat,
     /// `open_meteo`: the JSON object as the API returns it; `metar`, `taf`,
     /// `csv`: the text, as a JSON string.
-    #[schema(value_type = Object)]
+    #[schema(schema_with = data_schema)]
     pub data: serde_json::Value,
     /// Roughness length z0 of the log law through an hour with one height
     /// (m); default 0.03 (open terrain).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(example = 0.03, minimum = 0.000001, maximum = 10.0)]
     pub roughness_length_m: Option<f64>,
+}
+
+/// `forecast.data`'s schema: an object (`open_meteo`) or a string (the
+/// text formats).
+fn data_schema() -> utoipa::openapi::schema::OneOf {
+    use utoipa::openapi::schema::{ObjectBuilder, OneOfBuilder, Type};
+    OneOfBuilder::new()
+        .item(
+            ObjectBuilder::new()
+                .schema_type(Type::Object)
+                .description(Some("`open_meteo`: the JSON object as the API returns it")),
+        )
+        .item(
+            ObjectBuilder::new()
+                .schema_type(Type::String)
+                .description(Some("`metar`, `taf`, `csv`: the report's text")),
+        )
+        .build()
 }
 
 /// One period of one member: `[start_s, end_s)`.

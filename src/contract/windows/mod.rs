@@ -10,6 +10,7 @@ mod aviation;
 mod csv;
 pub mod dto;
 pub mod forecast;
+pub mod kind;
 mod open_meteo;
 pub mod points;
 pub mod run;

@@ -49,16 +49,20 @@ pub mod chart;
 pub mod critical;
 pub mod diagnostics;
 pub mod element;
+pub mod equations;
 pub mod extensible;
+pub mod inertia;
 pub mod qs_converged;
 pub mod qs_critical;
 pub mod qs_flutter;
+pub mod qs_levels;
 pub mod qs_mesh;
 pub mod qs_wind;
 pub mod qs_wind_onset;
 pub mod quasi_static;
 pub mod solver;
 pub mod stability;
+pub mod start;
 pub mod tether_system;
 pub mod wind_criterion;
 
@@ -168,7 +172,7 @@ pub struct GeModel {
     /// set by the tether bridge, whose solid-section rotary inertia puts
     /// the rotation–shear modes at `√(GA/I_ρ) ~ 10⁷ 1/s`.
     pub slow_spectrum: bool,
-    pub(crate) ops: element::InertiaOperators,
+    pub(crate) ops: inertia::InertiaOperators,
 }
 
 impl GeModel {
@@ -194,7 +198,7 @@ impl GeModel {
             gravity_m_s2,
             rule: StiffnessRule::Reduced,
             slow_spectrum: false,
-            ops: element::InertiaOperators::new(elements),
+            ops: inertia::InertiaOperators::new(elements),
         })
     }
 
@@ -225,7 +229,7 @@ impl GeModel {
                 "must increase from 0 to 1 with at least two nodes",
             ));
         }
-        m.ops = element::InertiaOperators::graded(nodes);
+        m.ops = inertia::InertiaOperators::graded(nodes);
         Ok(m)
     }
 

@@ -82,7 +82,7 @@
 use super::GeModel;
 use super::air_load::AirLoads;
 use super::element::TipLoad;
-use super::qs_converged::{
+use super::qs_levels::{
     ConvergedOnset, ConvergedOutcome, ConvergedSearch, ConvergenceConfig, NEAR, OnsetKind,
     level_rtol, prolong, richardson, summarise, with_elements,
 };

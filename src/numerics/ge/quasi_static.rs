@@ -339,7 +339,7 @@ pub fn state_at(
 ) -> Result<State, QepError> {
     let v = match motion {
         StateMotion::AtRest => vec![0.0; q.len()],
-        StateMotion::SteadyPayout => super::critical::steady_payout_velocity(model, kin, &q),
+        StateMotion::SteadyPayout => super::start::steady_payout_velocity(model, kin, &q),
     };
     let zero = vec![0.0; q.len()];
     let r = solver::residual(model, kin, load, 0.0, &q, &v, &zero);

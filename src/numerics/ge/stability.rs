@@ -9,7 +9,7 @@ use faer::Mat;
 
 use super::GeModel;
 use super::element::TipLoad;
-use super::solver::{self, Drive, State, SystemMatrices};
+use super::equations::{self, Drive, State, SystemMatrices};
 use crate::numerics::params::Kinematics;
 use crate::numerics::qep::{self, Eigenvalue, QepError, Spectrum};
 
@@ -21,14 +21,14 @@ pub fn local_spectrum(
     mu: f64,
     state: &State,
 ) -> Result<Spectrum, QepError> {
-    let sys = solver::system_matrices(model, kin, load, mu, &state.q, &state.v, &state.a);
+    let sys = equations::system_matrices(model, kin, load, mu, &state.q, &state.v, &state.a);
     spectrum_of(model, sys)
 }
 
 /// The QEP spectrum about a state of a run under `drive` (its loads at the
 /// state's time, air load included).
 pub fn drive_spectrum(model: &GeModel, drive: &Drive, state: &State) -> Result<Spectrum, QepError> {
-    spectrum_of(model, solver::drive_matrices(model, drive, state))
+    spectrum_of(model, equations::drive_matrices(model, drive, state))
 }
 
 /// The QEP spectrum of the linearised system `sys` (companion form,
@@ -180,8 +180,8 @@ pub fn full_spectrum_of(model: &GeModel, sys: SystemMatrices) -> Result<Spectrum
     ))
 }
 
-/// How the cable moves at a queried state (see [`super::critical::StartState`]).
-pub use super::critical::StartState as StateMotion;
+/// How the cable moves at a queried state (see [`super::start::StartState`]).
+pub use super::start::StartState as StateMotion;
 
 /// Local stability of the GE cable at one deployment state `(L, L̇, L̈)`.
 #[derive(Clone, Debug)]
@@ -200,7 +200,7 @@ pub struct GeStateStability {
 #[derive(Debug)]
 pub enum GeStateFailure {
     /// The quasi-static equilibrium did not converge.
-    Equilibrium(solver::NewtonFailure),
+    Equilibrium(equations::NewtonFailure),
     /// The mass matrix was singular or the eigenvalue iteration failed.
     Spectrum(QepError),
 }
@@ -220,17 +220,17 @@ pub fn state_stability(
     load: TipLoad,
     motion: StateMotion,
     load_steps: usize,
-    newton: solver::NewtonConfig,
+    newton: equations::NewtonConfig,
 ) -> Result<GeStateStability, GeStateFailure> {
-    let q = solver::static_solve(model, kin, load, load_steps, newton)
+    let q = equations::static_solve(model, kin, load, load_steps, newton)
         .map_err(GeStateFailure::Equilibrium)?;
     let v = match motion {
         StateMotion::AtRest => vec![0.0; q.len()],
-        StateMotion::SteadyPayout => super::critical::steady_payout_velocity(model, kin, &q),
+        StateMotion::SteadyPayout => super::start::steady_payout_velocity(model, kin, &q),
     };
     let zero = vec![0.0; q.len()];
-    let r = solver::residual(model, kin, load, 0.0, &q, &v, &zero);
-    let m = solver::system_matrices(model, kin, load, 0.0, &q, &v, &zero).mass;
+    let r = equations::residual(model, kin, load, 0.0, &q, &v, &zero);
+    let m = equations::system_matrices(model, kin, load, 0.0, &q, &v, &zero).mass;
     let lu = m
         .factor()
         .ok_or(GeStateFailure::Spectrum(QepError::NonFinite))?;
@@ -245,7 +245,7 @@ pub fn state_stability(
     let spectrum =
         local_spectrum(model, kin, load, 0.0, &state).map_err(GeStateFailure::Spectrum)?;
     Ok(GeStateStability {
-        root_axial_force_n: super::critical::root_axial_force_n(model, kin.length_m, &state.q),
+        root_axial_force_n: super::start::root_axial_force_n(model, kin.length_m, &state.q),
         spectrum,
         state,
         load_steps,

@@ -426,6 +426,18 @@ struct Along {
 /// depends on the chunking, never on the number of threads.
 const ALONG_CHUNK: usize = 64;
 
+impl super::ge_stability::GeWind for SteadyWind {
+    fn problem(&self, s: &AerostatSystem, buoyancy_n: f64, length_m: f64) -> EquilibriumProblem {
+        SteadyWind::problem(self, s, buoyancy_n, length_m)
+    }
+    fn air_density_kg_m3(&self) -> f64 {
+        self.air_density_kg_m3
+    }
+    fn speed_m_s(&self, z_m: f64) -> f64 {
+        self.wind.speed_m_s(z_m)
+    }
+}
+
 /// `f` at every length, in fixed chunks on rayon, each chunk in order
 /// with its own continuations: the equilibria of a fine grid of lengths
 /// take about one RK4 pass each instead of five.
@@ -614,7 +626,7 @@ impl Air {
         let mut ok = |l: f64| w.stability_tension_along(p, l, Some(&mut along)) >= need;
         // The GE criterion may allow more than the calm string (bending).
         let calm = match &w.ge {
-            Some(ge) => ge.search_upper_m(w, p).map_or(calm, |u| u.max(calm)),
+            Some(ge) => ge.search_upper_m(&**w, p).map_or(calm, |u| u.max(calm)),
             None => calm,
         };
         if ok(calm) {

@@ -87,9 +87,9 @@ use crate::numerics::ge::quasi_static::{
 use crate::numerics::ge::stability::StateMotion;
 use crate::numerics::ge::tether_system::{GeTetherOptions, ge_tether_system};
 use crate::numerics::ge::wind_criterion;
-use crate::numerics::params::{InvalidInput, Kinematics};
-use crate::numerics::plan::air::SteadyWind;
+use crate::numerics::params::{AerostatSystem, InvalidInput, Kinematics};
 use crate::numerics::plan::{PlanProblem, STABILITY_MARGIN};
+use crate::numerics::tether::EquilibriumProblem;
 
 /// Fewest and most table lengths.
 pub const MIN_TABLE_LENGTHS: usize = 3;
@@ -377,6 +377,17 @@ fn last_stable(lo: f64, hi: f64, stable: impl Fn(f64) -> bool + Sync) -> Result<
     Ok(a)
 }
 
+/// What the criterion needs of the steady wind it is made in (implemented
+/// by [`super::air::SteadyWind`], which holds the criterion).
+pub trait GeWind {
+    /// The equilibrium problem at a length with a net buoyancy.
+    fn problem(&self, s: &AerostatSystem, buoyancy_n: f64, length_m: f64) -> EquilibriumProblem;
+    /// The air density (kg/m³).
+    fn air_density_kg_m3(&self) -> f64;
+    /// The mean wind speed at height `z_m` (m/s).
+    fn speed_m_s(&self, z_m: f64) -> f64;
+}
+
 impl GeCriterion {
     pub fn new(options: GeStabilityOptions) -> Self {
         Self {
@@ -397,7 +408,7 @@ impl GeCriterion {
     /// The table and model, made on first use for `p` in `wind`.
     pub fn table(
         &self,
-        wind: &SteadyWind,
+        wind: &dyn GeWind,
         p: &PlanProblem,
     ) -> Result<&(GeTable, GePlanModel), &str> {
         self.table
@@ -409,12 +420,12 @@ impl GeCriterion {
     /// Whether `S(L)` is the string criterion in `wind` itself, not the
     /// table: converged in wind (`wind_criterion`), where the table's rows
     /// are that criterion's rates and interpolating them would only lose.
-    pub fn string_in_wind(&self, wind: &SteadyWind) -> bool {
+    pub fn string_in_wind(&self, wind: &dyn GeWind) -> bool {
         self.options.converge.is_some_and(|c| !c.tracked_wind_onset)
-            && wind.air_density_kg_m3 > 0.0
+            && wind.air_density_kg_m3() > 0.0
             && [1.0, 10.0, 100.0, 1e3, 1e4]
                 .iter()
-                .any(|&z| wind.wind.speed_m_s(z) != 0.0)
+                .any(|&z| wind.speed_m_s(z) != 0.0)
     }
 
     /// The table if it was made.
@@ -424,7 +435,7 @@ impl GeCriterion {
 
     /// `S(L)` (N); `−(1 − r)F` (unstable) when the table could not be made
     /// or was made for another reserve.
-    pub fn stability_tension_n(&self, wind: &SteadyWind, p: &PlanProblem, length_m: f64) -> f64 {
+    pub fn stability_tension_n(&self, wind: &dyn GeWind, p: &PlanProblem, length_m: f64) -> f64 {
         let b = p.reserve_buoyancy_n();
         match self.table(wind, p) {
             Ok((t, _)) if t.reserve_buoyancy_n == b => {
@@ -435,14 +446,14 @@ impl GeCriterion {
     }
 
     /// Upper end of the lift-limit search (m): past the table's last row.
-    pub fn search_upper_m(&self, wind: &SteadyWind, p: &PlanProblem) -> Option<f64> {
+    pub fn search_upper_m(&self, wind: &dyn GeWind, p: &PlanProblem) -> Option<f64> {
         self.table(wind, p).ok().map(|(t, _)| t.max_safe_length_m)
     }
 }
 
 /// Makes the table (module docs).
 fn build(
-    wind: &SteadyWind,
+    wind: &dyn GeWind,
     p: &PlanProblem,
     options: &GeStabilityOptions,
 ) -> Result<(GeTable, GePlanModel), String> {

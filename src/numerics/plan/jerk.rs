@@ -24,7 +24,7 @@
 //! the shortfall, at most [`MAX_TIGHTENINGS`] times.
 
 use crate::numerics::plan::air::{Air, RestLoads};
-use crate::numerics::plan::schedule::{Grid, Knot, PlanOutcome, Schedule, pass_on, static_check};
+use crate::numerics::plan::pass::{Grid, Knot, PlanOutcome, Schedule, pass_on, static_check};
 use crate::numerics::plan::{BindingLimit, PlanProblem, STABILITY_MARGIN};
 
 /// Reruns of the pass with a tighter margin.

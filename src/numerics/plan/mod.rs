@@ -33,6 +33,7 @@ pub mod ascent;
 pub mod deadline;
 pub mod ge_stability;
 pub mod jerk;
+pub mod pass;
 pub mod retrieval;
 pub mod schedule;
 
