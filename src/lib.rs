@@ -12,6 +12,8 @@
 //!   above [`jobs`], which never names it.
 //! * [`limits`]: the service's and the job queue's limits (a plain struct
 //!   `config` fills and the queue carries).
+//! * [`price`]: what a synchronous request costs in CPU seconds (measured
+//!   unit costs) and the budget past which it goes to the job queue.
 //!
 //! Invariants: `numerics` never touches serde, tokio, axum or SQLite;
 //! invalid input is an `Err` naming the field; physical outcomes
@@ -23,3 +25,4 @@ pub mod contract;
 pub mod jobs;
 pub mod limits;
 pub mod numerics;
+pub mod price;

@@ -121,6 +121,10 @@ enum Command {
     /// The largest tension over an exposure, Monte Carlo over turbulence
     /// seeds (progress bar in samples).
     DynamicsPeaks(InputArg),
+    /// Launch windows by the hour from a forecast (Open-Meteo JSON, METAR,
+    /// TAF or CSV): each period judged as the plan judges its wind
+    /// (progress bar in plans).
+    Windows(InputArg),
 }
 
 /// A progress bar on standard error for `total` units of `what`.
@@ -219,6 +223,8 @@ impl Progress for Bar {
 /// Runs the server on a multi-threaded tokio runtime (I/O only: solves
 /// run on rayon).
 fn serve(args: ServeArgs) -> ExitCode {
+    // Before any thread starts: memory comes back after a load (api::memory).
+    tetherplan::api::memory::tune_allocator();
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
@@ -290,6 +296,14 @@ fn main() -> ExitCode {
             req.prepare()?;
             let bar = progress_bar(req.samples as u64, "samples");
             let out = contract::dynamics::peaks::peaks(req, Parallelism::Rayon, &bar);
+            bar.0.finish_and_clear();
+            out
+        }),
+        Command::Windows(arg) => answer_with(arg, contract::windows::parse_windows, |req| {
+            let started = std::time::Instant::now();
+            let prepared = contract::windows::prepare(req)?;
+            let bar = progress_bar(prepared.plan_count() as u64, "plans");
+            let out = contract::windows::run::answer(req, &prepared, &bar, started);
             bar.0.finish_and_clear();
             out
         }),

@@ -187,6 +187,51 @@ fn every_route_is_documented_with_its_statuses() {
             "list_systems",
             &["200", "401", "500"],
         ),
+        (
+            "post",
+            "/api/v1/flights",
+            "create_flight",
+            &["201", "400", "401", "413", "415", "422", "500"],
+        ),
+        ("get", "/api/v1/flights", "list_flights", &["200", "401", "500"]),
+        (
+            "get",
+            "/api/v1/flights/{id}",
+            "get_flight",
+            &["200", "401", "404", "500"],
+        ),
+        (
+            "post",
+            "/api/v1/flights/{id}/end",
+            "end_flight",
+            &["200", "401", "404", "500"],
+        ),
+        (
+            "post",
+            "/api/v1/flights/{id}/telemetry",
+            "post_telemetry",
+            &[
+                "200", "400", "401", "404", "409", "413", "415", "422", "500",
+            ],
+        ),
+        (
+            "post",
+            "/api/v1/flights/{id}/alarms/acknowledge",
+            "acknowledge_alarms",
+            &["200", "401", "404", "500"],
+        ),
+        (
+            "get",
+            "/api/v1/flights/{id}/replan",
+            "replan_flight",
+            &["200", "401", "404", "422", "500"],
+        ),
+        (
+            "get",
+            "/api/v1/flights/{id}/events",
+            "flight_events",
+            &["200", "401", "404"],
+        ),
         ("get", "/api/v1/presets", "list_presets", &["200", "401"]),
         ("get", "/healthz", "get_health", &["200"]),
         ("get", "/openapi.json", "get_openapi", &["200"]),
@@ -272,6 +317,18 @@ fn numeric_fields_name_their_unit() {
         "segments",
         "halvings",
         "sample",
+        // A live flight's check (SPEC §13 names them; their unit is the
+        // check's `unit` field), a batch's counts, a refused sample's line.
+        "value",
+        "caution_at",
+        "stop_at",
+        "accepted",
+        "duplicates",
+        "rejected",
+        "line",
+        "samples_received",
+        "acknowledged",
+        "seq",
     ];
     // Dimensionless by name: ratios (E*, γ̃ as the issues name them), step
     // and sample counts, Newton iteration counts, relative tolerances,

@@ -27,6 +27,8 @@
 //!   tension and altitude plots are drawn, the shape animation advances and
 //!   pauses; the peak distribution of 6 seeds is drawn with the gust check;
 //!   an invalid gust duration shows the API's error beside its field.
+//! * `windows_page.mjs` drops the Open-Meteo file of `tests/forecasts/` on the
+//!   launch-windows panel: the day's timeline; a NO-GO hour turns the plan NO-GO.
 //! * `docs_page.mjs` runs every POST operation's "Try it out" in `/docs`
 //!   with the document's example (each must answer 2xx) under the CSP.
 //!
@@ -227,4 +229,9 @@ fn envelope_page_in_headless_chromium() {
 #[test]
 fn dynamics_page_in_headless_chromium() {
     run_page_script("dynamics_page.mjs");
+}
+
+#[test]
+fn windows_page_in_headless_chromium() {
+    run_page_script("windows_page.mjs");
 }

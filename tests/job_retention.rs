@@ -332,3 +332,62 @@ fn coordinator_deaths(store: &dyn JobBackend) {
             .unwrap()
     );
 }
+
+/// The bytes of a SQLite database on disk: the file, its WAL and shared memory.
+fn sqlite_bytes(path: &std::path::Path) -> u64 {
+    ["", "-wal", "-shm"]
+        .iter()
+        .map(|s| {
+            let mut p = path.as_os_str().to_owned();
+            p.push(s);
+            std::fs::metadata(p).map_or(0, |m| m.len())
+        })
+        .sum()
+}
+
+/// Issue 34, item 9: the file shrinks after a purge. Eight done jobs with
+/// 4 MB answers make a file of over 32 MB; once they are purged it holds
+/// less than 2 MB (it kept its full size before: 278 MB of 312 MB after
+/// eight large jobs). A file made before (auto_vacuum off) is converted at
+/// open, so it shrinks too.
+#[test]
+fn sqlite_file_shrinks_after_a_purge() {
+    let dir = std::env::temp_dir().join(format!("tp-vacuum-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for old_file in [false, true] {
+        let path = dir.join(format!("jobs-{old_file}.db"));
+        for s in ["", "-wal", "-shm"] {
+            let _ = std::fs::remove_file(format!("{}{s}", path.display()));
+        }
+        if old_file {
+            // A database as older versions made it: auto_vacuum off.
+            let c = rusqlite::Connection::open(&path).unwrap();
+            c.execute_batch("PRAGMA auto_vacuum = NONE; CREATE TABLE filler (x INTEGER);")
+                .unwrap();
+            let mode: i64 = c.query_row("PRAGMA auto_vacuum", [], |r| r.get(0)).unwrap();
+            assert_eq!(mode, 0);
+        }
+        let store = JobStore::open(&path).unwrap();
+        let answer = format!("{{\"x\": \"{}\"}}", "7".repeat(4 << 20));
+        for _ in 0..8 {
+            let id = insert(&store);
+            let job = store.claim(&POLICY).unwrap().expect("claimed");
+            assert_eq!(job.id, id);
+            assert!(store.finish_done(&job.lease, &answer).unwrap());
+        }
+        let full = sqlite_bytes(&path);
+        assert!(full > 32 << 20, "{full} bytes with eight 4 MB answers");
+        std::thread::sleep(Duration::from_millis(20));
+        let purged = store
+            .housekeeping(Duration::ZERO, Duration::from_secs(3600))
+            .unwrap();
+        assert_eq!(purged, 8);
+        let after = sqlite_bytes(&path);
+        eprintln!("old file {old_file}: {full} bytes with the jobs, {after} after the purge");
+        assert!(after < 2 << 20, "{after} bytes after the purge (was {full})");
+        let c = rusqlite::Connection::open(&path).unwrap();
+        let mode: i64 = c.query_row("PRAGMA auto_vacuum", [], |r| r.get(0)).unwrap();
+        assert_eq!(mode, 2, "incremental");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -78,6 +78,8 @@ solve_path!(
                 ),
             ));
         }
+        let price = crate::price::envelope(total, req.envelope.integration_steps, "uncertainty.samples");
+        let _admitted = ctx.charge(&price, "envelope_bands")?;
         to_json(&envelope::envelope_bands(&req, Parallelism::Rayon, &Deadline::after(ctx))?)
     }
 );

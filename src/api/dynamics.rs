@@ -35,8 +35,9 @@ solve_path!(
     /// at evenly spaced times, `slack_events`, and the peak and minimum
     /// tensions beside the quasi-static ones at the same wind.
     /// Synchronously at most 3 000 000 segment-steps (`duration_s /
-    /// numerics.time_step_s × numerics.segments`) and 20 000 samples;
-    /// larger runs: a job with `"kind": "dynamics"`.
+    /// numerics.time_step_s × numerics.segments`), 20 000 samples and
+    /// 2 CPU-seconds as priced from the steps, segments and turbulence
+    /// field (`crate::price`); larger runs: a job with `"kind": "dynamics"`.
     run_dynamics, "/api/v1/dynamics", DynamicsRequest, DynamicsResponse,
     parse = |body| dynamics::parse_dynamics(body),
     |req, ctx| {
@@ -50,6 +51,8 @@ solve_path!(
                 ),
             ));
         }
+        let price = crate::price::dynamics(&prepared);
+        let _admitted = ctx.charge(&price, "dynamics")?;
         if req.sample_count > MAX_SYNC_SAMPLES {
             return Err(ApiError::too_large(
                 "sample_count",
@@ -72,8 +75,10 @@ solve_path!(
     ///
     /// Sample `i` is the `POST /api/v1/dynamics` run of the same system
     /// with turbulence seed `seed + i` and `duration_s = exposure_s`.
-    /// Synchronously at most 6 000 000 segment-steps in all; larger: a job
-    /// with `"kind": "dynamics_peaks"`, split by sample over any number of
+    /// Synchronously at most 6 000 000 segment-steps in all and 2
+    /// CPU-seconds as priced per sample (its static start, its turbulence
+    /// field, its steps and segments: `crate::price`); larger: a job with
+    /// `"kind": "dynamics_peaks"`, split by sample over any number of
     /// workers with the same answer.
     run_dynamics_peaks, "/api/v1/dynamics/peaks", DynamicsPeaksRequest, DynamicsPeaksResponse,
     parse = |body| dynamics::parse_peaks(body),
@@ -88,6 +93,8 @@ solve_path!(
                 ),
             ));
         }
+        let price = crate::price::dynamics_peaks(&prepared, req.samples);
+        let _admitted = ctx.charge(&price, "dynamics_peaks")?;
         to_json(&dynamics::peaks::peaks(&req, Parallelism::Rayon, &Deadline::after(ctx))?)
     }
 );

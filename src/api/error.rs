@@ -165,6 +165,9 @@ impl<S: Send + Sync> FromRequest<S> for JsonBody {
                 ),
             ));
         }
+        // Gathered into one buffer as it arrives: the memory follows the
+        // body's bytes, not its pieces (`api::body`).
+        let req = req.map(|b| axum::body::Body::new(crate::api::body::Gathered::new(b)));
         let bytes = Bytes::from_request(req, state).await.map_err(|rejection| {
             if refused_for_budget(&rejection) {
                 ApiError::new(

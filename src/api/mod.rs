@@ -13,16 +13,20 @@ pub mod assets;
 pub mod auth;
 pub mod auth_doc;
 pub mod bands;
+pub mod body;
 pub mod dynamics;
 pub mod error;
+pub mod flights;
 pub mod guard;
 pub mod jobs;
+pub mod memory;
 pub mod openapi;
 pub mod server;
 pub mod solve;
 pub mod spec;
 pub mod systems;
 pub mod tether;
+pub mod windows;
 
 use std::path::Path;
 use std::sync::Arc;
@@ -48,8 +52,12 @@ pub struct AppState {
     pub queue: Arc<JobQueue>,
     pub limits: Limits,
     solves: Arc<Semaphore>,
+    /// Priced synchronous work running now (`crate::price`).
+    priced: Arc<crate::price::InFlight>,
     /// API tokens (none: open).
     pub tokens: Arc<auth::Tokens>,
+    /// Live flights (in memory until [`Self::with_flights`]).
+    pub flights: Arc<flights::hub::FlightHub>,
 }
 
 impl AppState {
@@ -60,8 +68,16 @@ impl AppState {
             queue,
             limits,
             solves,
+            priced: Arc::new(crate::price::InFlight::default()),
             tokens: Arc::new(auth::Tokens::default()),
+            flights: Arc::new(flights::hub::FlightHub::in_memory()),
         }
+    }
+
+    /// The same, keeping its flights in `hub`.
+    pub fn with_flights(mut self, hub: flights::hub::FlightHub) -> Self {
+        self.flights = Arc::new(hub);
+        self
     }
 
     /// The same, requiring one of `tokens` on every `/api` route.
@@ -163,6 +179,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
         )
         .route("/api/v1/dynamics", post(dynamics::run_dynamics))
         .route("/api/v1/dynamics/peaks", post(dynamics::run_dynamics_peaks))
+        .route("/api/v1/windows", post(windows::compute_windows))
         .route("/api/v1/systems", get(systems::list_systems))
         .route(
             "/api/v1/systems/{name}",
@@ -176,6 +193,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
             "/api/v1/jobs/{id}",
             get(jobs::get_job).delete(jobs::delete_job),
         )
+        .merge(flights::routes())
         .route("/api", any(api_not_found))
         .route("/api/{*rest}", any(api_not_found))
         .method_not_allowed_fallback(method_not_allowed)
@@ -210,7 +228,11 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
     ));
     // TETHERPLAN_JOB_THREADS=0: jobs are left to `tetherplan worker` processes.
     let worker = (config.job_threads > 0).then(|| queue.spawn_worker());
-    let state = AppState::new(queue.clone()).with_tokens(&config.api_tokens);
+    let flights = flights::hub::FlightHub::open(&config.store)
+        .map_err(|e| format!("cannot open the flights of {}: {e}", config.store.describe()))?;
+    let state = AppState::new(queue.clone())
+        .with_tokens(&config.api_tokens)
+        .with_flights(flights);
     let listener = tokio::net::TcpListener::bind(config.addr)
         .await
         .map_err(|e| format!("cannot listen on {}: {e}", config.addr))?;

@@ -41,6 +41,7 @@ use crate::jobs::store::JobStatus;
         crate::api::bands::compute_envelope_bands,
         crate::api::dynamics::run_dynamics,
         crate::api::dynamics::run_dynamics_peaks,
+        crate::api::windows::compute_windows,
         crate::api::systems::put_system,
         crate::api::systems::get_system,
         crate::api::systems::delete_system,
@@ -61,6 +62,7 @@ use crate::jobs::store::JobStatus;
         Health, crate::contract::bands::BandsResponse,
         crate::contract::bands::PlanBandsResponse, crate::contract::bands::EnvelopeBandsResponse,
         crate::contract::dynamics::DynamicsResponse, crate::contract::dynamics::DynamicsPeaksResponse,
+        crate::contract::windows::WindowsResponse,
     )),
     modifiers(&BearerTokens),
     tags(
@@ -83,7 +85,9 @@ fn get_openapi() {}
 /// The document, with the request examples, the cable's two forms and the
 /// synchronous limits ([`crate::api::spec`]).
 pub fn openapi() -> utoipa::openapi::OpenApi {
-    crate::api::spec::refine(ApiDoc::openapi())
+    let mut doc = ApiDoc::openapi();
+    doc.merge(crate::api::flights::FlightsDoc::openapi());
+    crate::api::spec::refine(doc)
 }
 
 /// The document as committed in `openapi/openapi.json` (pretty, newline-terminated).

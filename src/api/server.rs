@@ -18,7 +18,12 @@
 //!   exceed the cap, the *oldest* connection is asked to close (hyper's
 //!   graceful shutdown: an idle or half-sent connection closes at once, a
 //!   request in progress is answered first), so a flood of idle connections
-//!   cannot lock out new clients: the server keeps answering. Past the cap
+//!   cannot lock out new clients: the server keeps answering. A connection
+//!   whose task has not run yet is not chosen (in a burst of accepts it
+//!   would be closed before reading the request its client sent), and at
+//!   the cap the accept loop first lets the connection tasks run, so that
+//!   connections whose clients have gone are counted out (a reconnect storm
+//!   made `/healthz` fail 7 times in 80). Past the cap
 //!   by a quarter (closing takes a moment), new connections are closed at
 //!   once rather than run the process out of files.
 //! * **Accept errors** (out of files, aborted handshakes) never end the
@@ -30,7 +35,7 @@
 use std::collections::VecDeque;
 use std::future::Future;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Duration;
 
 use std::pin::Pin;
@@ -50,6 +55,10 @@ use hyper_util::service::TowerToHyperService;
 use crate::api::error::ApiError;
 use tokio::net::TcpListener;
 use tokio::sync::{Notify, OwnedSemaphorePermit, Semaphore, watch};
+
+/// Times the accept loop yields to the connection tasks when the cap is
+/// reached, before it counts the connections open.
+const PRESSURE_YIELDS: usize = 8;
 
 /// File descriptors kept free of connections (database, WAL, job threads,
 /// logs, the listener).
@@ -152,25 +161,38 @@ pub fn connection_cap(max_connections: usize, fd_limit: Option<u64>) -> usize {
 /// asked to close, oldest first.
 struct Registry {
     live: AtomicUsize,
-    open: std::sync::Mutex<VecDeque<(u64, Arc<Notify>)>>,
+    /// Open connections, oldest first: id, close request, and whether its
+    /// task has started (read anything).
+    open: std::sync::Mutex<VecDeque<(u64, Arc<Notify>, Arc<AtomicBool>)>>,
+    /// Gives the heap back a moment after connections close.
+    trimmer: crate::api::memory::Trimmer,
 }
 
 impl Registry {
     fn forget(&self, id: u64) {
+        self.trimmer.closed();
         let mut open = self.open.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(i) = open.iter().position(|(c, _)| *c == id) {
+        if let Some(i) = open.iter().position(|(c, ..)| *c == id) {
             open.remove(i);
         }
     }
 
-    /// Asks the oldest connections to close until at most `cap` remain open.
+    /// Asks the oldest connections to close until at most `cap` remain
+    /// open. A connection whose task has not started yet is passed over: it
+    /// has not had a chance to read the request its client already sent
+    /// (in a burst of accepts it would otherwise be closed unread).
     fn shed_to(&self, cap: usize) -> usize {
         let mut open = self.open.lock().unwrap_or_else(|e| e.into_inner());
         let mut shed = 0;
-        while open.len() > cap {
-            if let Some((_, stop)) = open.pop_front() {
-                stop.notify_one();
-                shed += 1;
+        let mut i = 0;
+        while open.len() > cap && i < open.len() {
+            if open[i].2.load(Ordering::Acquire) {
+                if let Some((_, stop, _)) = open.remove(i) {
+                    stop.notify_one();
+                    shed += 1;
+                }
+            } else {
+                i += 1;
             }
         }
         shed
@@ -201,7 +223,9 @@ pub async fn run(
     let registry = Arc::new(Registry {
         live: AtomicUsize::new(0),
         open: std::sync::Mutex::new(VecDeque::new()),
+        trimmer: crate::api::memory::Trimmer::default(),
     });
+    let trimming = tokio::spawn(registry.trimmer.clone().run());
     let hard_ceiling = cap.saturating_add(cap / 4).max(cap + 1);
     let (stop_all, stopping) = watch::channel(false);
     let mut builder = http1::Builder::new();
@@ -230,6 +254,15 @@ pub async fn run(
                 }
             },
         };
+        // At the cap, let the connection tasks run first (those whose
+        // clients have gone end, those just accepted read their requests)
+        // rather than count connections nobody has polled yet.
+        for _ in 0..PRESSURE_YIELDS {
+            if registry.live.load(Ordering::Acquire) < cap {
+                break;
+            }
+            tokio::task::yield_now().await;
+        }
         if registry.live.load(Ordering::Acquire) >= hard_ceiling {
             if !refused_logged {
                 tracing::warn!(
@@ -246,12 +279,13 @@ pub async fn run(
         next_id += 1;
         let id = next_id;
         let stop = Arc::new(Notify::new());
+        let started = Arc::new(AtomicBool::new(false));
         registry.live.fetch_add(1, Ordering::AcqRel);
         registry
             .open
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .push_back((id, stop.clone()));
+            .push_back((id, stop.clone(), started.clone()));
         let shed = registry.shed_to(cap);
         if shed > 0 {
             tracing::debug!(shed, cap, "connection cap reached: closing the oldest");
@@ -269,6 +303,7 @@ pub async fn run(
         let limits = limits.clone();
         tokio::spawn(async move {
             let _guard = guard;
+            started.store(true, Ordering::Release);
             let conn = builder.serve_connection(TokioIo::new(stream), service);
             tokio::pin!(conn);
             tokio::select! {
@@ -302,6 +337,7 @@ pub async fn run(
         });
     }
     drop(listener);
+    trimming.abort();
     let _ = stop_all.send(true);
     let deadline = tokio::time::Instant::now() + limits.close_grace;
     while registry.live.load(Ordering::Acquire) > 0 && tokio::time::Instant::now() < deadline {

@@ -35,6 +35,8 @@ pub(crate) struct SolveCtx {
     limits: Limits,
     end: std::time::Instant,
     abandoned: Arc<AtomicBool>,
+    /// The priced work of all synchronous requests running now.
+    priced: Arc<crate::price::InFlight>,
 }
 
 impl std::ops::Deref for SolveCtx {
@@ -45,6 +47,34 @@ impl std::ops::Deref for SolveCtx {
 }
 
 impl SolveCtx {
+    /// Charges a request's price ([`crate::price`]): 422 `too_large`
+    /// (naming the field, pointing to a `job_kind` job) past the
+    /// synchronous budget; 503 with Retry-After while other priced work
+    /// fills the pool; else the admission, held while the work runs.
+    pub(crate) fn charge(
+        &self,
+        price: &crate::price::Price,
+        job_kind: &str,
+    ) -> Result<crate::price::Admitted<'_>, ApiError> {
+        if !price.fits() {
+            return Err(ApiError::too_large(&price.field, price.refusal(job_kind)));
+        }
+        self.priced.admit(price).map_err(|running| {
+            ApiError::new(
+                StatusCode::SERVICE_UNAVAILABLE,
+                "overloaded",
+                None,
+                format!(
+                    "this request costs about {:.1} CPU-seconds and {running:.1} CPU-seconds of other \
+                     synchronous work are running (at most {} at once); retry shortly or submit a job",
+                    price.cpu_s,
+                    crate::price::IN_FLIGHT_CPU_S
+                ),
+            )
+            .retry_after(1)
+        })
+    }
+
     /// Has the caller had its 504 or gone away?
     pub(crate) fn abandoned(&self) -> bool {
         self.abandoned.load(Ordering::Relaxed) || std::time::Instant::now() >= self.end
@@ -91,6 +121,7 @@ impl AppState {
             limits: self.limits.clone(),
             end: std::time::Instant::now() + self.limits.solve_timeout,
             abandoned,
+            priced: self.priced.clone(),
         };
         let span = tracing::Span::current();
         rayon::spawn(move || {

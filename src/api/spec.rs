@@ -8,8 +8,9 @@
 //! * **The cable is one of three forms**: `mass_per_length_kg_m`, or
 //!   `density_kg_m3` with `area_m2` (never both: the server refuses a mix),
 //!   or a `preset` with its `diameter_m`: `CableInput` becomes a `oneOf` of
-//!   the three, each built from the derived property schemas (so their
-//!   bounds stay the derive's).
+//!   its forms, each built from the derived property schemas (so their
+//!   bounds stay the derive's); a stored system's cable may be partial
+//!   (`PartialCableInput`: the same forms, or no mass field at all).
 //! * **The synchronous limits** per route, in the operation description
 //!   (see [`SYNC_LIMITS`]); the larger requests are valid job requests.
 
@@ -271,16 +272,32 @@ fn refine_value(v: &mut Value) {
         }
     }
     if let Some(cable) = v.pointer_mut("/components/schemas/CableInput") {
-        cable_one_of(cable);
+        let partial = cable_one_of(cable);
+        if let Some(schemas) = v
+            .pointer_mut("/components/schemas")
+            .and_then(Value::as_object_mut)
+        {
+            schemas.insert("PartialCableInput".into(), partial);
+        }
+        // A stored system may be partial: its cable is the partial one.
+        if let Some(c) = v.pointer_mut("/components/schemas/SystemDescription/properties/cable") {
+            *c = json!({"oneOf": [
+                {"$ref": "#/components/schemas/PartialCableInput"},
+                {"type": "null"}
+            ]});
+        }
     }
 }
 
-/// `CableInput` as `oneOf` its three forms (mass per length, density and
-/// area, preset with diameter), from the derived properties; every other
-/// property is optional in each form.
-fn cable_one_of(cable: &mut Value) {
+/// `CableInput` as `oneOf` its forms (mass per length, density and area,
+/// preset with diameter — alone, with a mass per length, or with density
+/// and area), from the derived properties; every other property is
+/// optional in each form. Also `PartialCableInput`, the cable of a stored
+/// system (SPEC §9: a request that names the system completes it): the
+/// same forms, or none of the mass fields at all.
+fn cable_one_of(cable: &mut Value) -> Value {
     let Some(props) = cable.get("properties").and_then(Value::as_object).cloned() else {
-        return;
+        return cable.clone();
     };
     // The derive marks the optional fields nullable; in each form the
     // fields it uses are required numbers.
@@ -300,6 +317,11 @@ fn cable_one_of(cable: &mut Value) {
         .collect();
     let form = |title: &str, required: &[&str], own: Vec<(&str, Value)>| {
         let mut p = common.clone();
+        // A mass field this form does not use may still be given as
+        // `null`, which the server reads as absent (a preset may not).
+        for k in ["mass_per_length_kg_m", "density_kg_m3", "area_m2"] {
+            p.insert(k.to_string(), json!({"type": "null"}));
+        }
         for (k, v) in own {
             p.insert(k.to_string(), v);
         }
@@ -315,24 +337,69 @@ fn cable_one_of(cable: &mut Value) {
         .get("description")
         .cloned()
         .unwrap_or_else(|| json!("The cable."));
+    // A preset is never null (the server refuses `"preset": null`).
     let mut preset = props.get("preset").cloned().unwrap_or_else(|| json!({}));
     if let Some(o) = preset.as_object_mut() {
-        // required here: not null
         if let Some(Value::Array(one_of)) = o.get_mut("oneOf") {
             one_of.retain(|v| v.get("type") != Some(&json!("null")));
+            if one_of.len() == 1 {
+                let only = one_of.remove(0);
+                o.remove("oneOf");
+                if let Some(only) = only.as_object() {
+                    o.extend(only.clone());
+                }
+            }
         }
     }
-    *cable = json!({
-        "description": description,
-        "oneOf": [
-            form("mass per length", &["mass_per_length_kg_m"],
-                 vec![("mass_per_length_kg_m", number("mass_per_length_kg_m"))]),
-            form("density and area", &["density_kg_m3", "area_m2"],
-                 vec![("density_kg_m3", number("density_kg_m3")), ("area_m2", number("area_m2"))]),
-            form("preset with its diameter", &["preset", "diameter_m"],
-                 vec![("preset", preset), ("mass_per_length_kg_m", props.get("mass_per_length_kg_m").cloned().unwrap_or_else(|| json!({})))]),
-        ]
-    });
+    let with_mass = vec![
+        form(
+            "mass per length",
+            &["mass_per_length_kg_m"],
+            vec![("mass_per_length_kg_m", number("mass_per_length_kg_m"))],
+        ),
+        form(
+            "density and area",
+            &["density_kg_m3", "area_m2"],
+            vec![
+                ("density_kg_m3", number("density_kg_m3")),
+                ("area_m2", number("area_m2")),
+            ],
+        ),
+        form(
+            "preset with its diameter",
+            &["preset", "diameter_m"],
+            vec![
+                ("preset", preset.clone()),
+                ("diameter_m", number("diameter_m")),
+                (
+                    "mass_per_length_kg_m",
+                    props
+                        .get("mass_per_length_kg_m")
+                        .cloned()
+                        .unwrap_or_else(|| json!({})),
+                ),
+            ],
+        ),
+        form(
+            "preset with its diameter, density and area",
+            &["preset", "diameter_m", "density_kg_m3", "area_m2"],
+            vec![
+                ("preset", preset),
+                ("diameter_m", number("diameter_m")),
+                ("density_kg_m3", number("density_kg_m3")),
+                ("area_m2", number("area_m2")),
+            ],
+        ),
+    ];
+    let mut partial_forms = vec![form("without its mass", &[], vec![])];
+    partial_forms.extend(with_mass.iter().cloned());
+    *cable = json!({"description": description, "oneOf": with_mass});
+    json!({
+        "description": "The cable of a stored system (`PUT /api/v1/systems/{name}`): any of \
+            `CableInput`'s fields, its mass given in one of the same forms or not at all; a \
+            request that names the system gives the rest.",
+        "oneOf": partial_forms
+    })
 }
 
 #[cfg(test)]
@@ -353,6 +420,8 @@ mod tests {
             assert!(ex.is_object(), "{p} has no request example");
         }
         let cable = &doc["components"]["schemas"]["CableInput"];
-        assert_eq!(cable["oneOf"].as_array().unwrap().len(), 3, "{cable}");
+        assert_eq!(cable["oneOf"].as_array().unwrap().len(), 4, "{cable}");
+        let partial = &doc["components"]["schemas"]["PartialCableInput"];
+        assert_eq!(partial["oneOf"].as_array().unwrap().len(), 5, "{partial}");
     }
 }

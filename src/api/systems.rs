@@ -107,7 +107,7 @@ pub fn check_description(body: &[u8]) -> Result<serde_json::Value, RequestError>
 /// Store (or replace) a named system for this token.
 #[utoipa::path(
     put, path = "/api/v1/systems/{name}", operation_id = "put_system", tag = "systems",
-    params(("name" = String, Path, description = "1 to 64 letters, digits, '-', '_' or '.'")),
+    params(("name" = String, Path, description = "1 to 64 letters, digits, '-', '_' or '.', starting with a letter or digit, with single dots between other characters (never `.`, `..` or anything read as a path)", min_length = 1, max_length = 64, pattern = r"^[A-Za-z0-9](\.?[A-Za-z0-9_-])*$")),
     request_body(content = SystemDescription, description = "The system objects (SPEC §9), without `system`"),
     responses(
         (status = 200, description = "Replaced", body = SystemView),
@@ -176,7 +176,7 @@ pub async fn put_system(
 /// One stored system of this token.
 #[utoipa::path(
     get, path = "/api/v1/systems/{name}", operation_id = "get_system", tag = "systems",
-    params(("name" = String, Path, description = "The system's name")),
+    params(("name" = String, Path, description = "The system's name", min_length = 1, max_length = 64, pattern = r"^[A-Za-z0-9](\.?[A-Za-z0-9_-])*$")),
     responses(
         (status = 200, description = "The system", body = SystemView),
         (status = 404, description = "No such system for this token", body = ErrorBody),
@@ -203,7 +203,7 @@ pub async fn get_system(
 /// Delete a stored system of this token.
 #[utoipa::path(
     delete, path = "/api/v1/systems/{name}", operation_id = "delete_system", tag = "systems",
-    params(("name" = String, Path, description = "The system's name")),
+    params(("name" = String, Path, description = "The system's name", min_length = 1, max_length = 64, pattern = r"^[A-Za-z0-9](\.?[A-Za-z0-9_-])*$")),
     responses(
         (status = 204, description = "Deleted"),
         (status = 404, description = "No such system for this token", body = ErrorBody),

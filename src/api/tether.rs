@@ -15,6 +15,9 @@ use crate::contract::equilibrium::dto::{EquilibriumRequest, EquilibriumResponse}
 use crate::contract::{self, equilibrium};
 use crate::numerics::chart::Parallelism;
 
+/// The part of an envelope's price that names the field it is refused for.
+const SOLO_SHARE: f64 = 0.5;
+
 fn to_json(value: &impl serde::Serialize) -> Result<Vec<u8>, ApiError> {
     Ok(contract::finite::to_vec(value)?)
 }
@@ -40,7 +43,9 @@ solve_path!(
     ///
     /// Each point is judged against slack, the required safety factor, an
     /// optional ceiling and (with `payout_rate_m_s`) stability; the first
-    /// violated is its binding limit. Synchronously at most 5 000 points;
+    /// violated is its binding limit. Synchronously at most 5 000 points
+    /// and 2 CPU-seconds (points × `integration_steps`, about 0.7 µs per
+    /// point and step: 5 000 points at 500 steps);
     /// larger envelopes (up to 250 000 points) go to `POST /api/v1/jobs` with
     /// `"kind": "envelope"`.
     compute_envelope, "/api/v1/envelope", EnvelopeRequest, EnvelopeResponse,
@@ -65,6 +70,21 @@ solve_path!(
                 ),
             ));
         }
+        let mut price = crate::price::envelope(
+            points,
+            req.integration_steps,
+            &req.tether_lengths_m.count_field("tether_lengths_m"),
+        );
+        if let Some(contract::envelope::stability::EnvelopeStabilityInput::QuasiStaticGe { elements, .. }) = &req.stability {
+            let rows = req.wind_speeds_m_s.as_ref().map_or(1, |g| g.count());
+            let ge = crate::price::ge_envelope(rows, points, *elements);
+            price.cpu_s += ge.cpu_s;
+            if ge.cpu_s > SOLO_SHARE * price.cpu_s {
+                price.field = ge.field;
+                price.counts = ge.counts;
+            }
+        }
+        let _admitted = ctx.charge(&price, "envelope")?;
         to_json(&envelope::envelope(&req, Parallelism::Rayon, &Deadline::after(ctx))?)
     }
 );

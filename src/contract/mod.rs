@@ -8,6 +8,7 @@ pub mod dynamics;
 pub mod envelope;
 pub mod equilibrium;
 pub mod error;
+pub mod flight;
 pub mod finite;
 pub mod ge;
 pub mod json;
@@ -18,6 +19,7 @@ pub mod ranges;
 pub mod string;
 pub mod system;
 pub mod transient;
+pub mod windows;
 
 // The old paths of the modules that moved into their domain folders, kept
 // for the API, the jobs, the CLI and the tests.

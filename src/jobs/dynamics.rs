@@ -41,7 +41,11 @@ impl JobKind for DynamicsRequest {
         let shapes = self
             .shape_times_s
             .as_ref()
-            .map_or(self.shape_count, Vec::len) as u64;
+            .map_or(
+                self.shape_count
+                    .unwrap_or(crate::contract::dynamics::dto::DEFAULT_SHAPE_COUNT),
+                Vec::len,
+            ) as u64;
         let nodes = shapes.saturating_mul(self.numerics.segments as u64 + 1);
         E::new(
             "sample_count",

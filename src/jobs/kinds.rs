@@ -579,6 +579,8 @@ job_kinds!(
     Dynamics(crate::contract::dynamics::DynamicsRequest),
     /// `POST /api/v1/dynamics/peaks`: Monte Carlo over turbulence seeds, chunked by sample.
     DynamicsPeaks(crate::contract::dynamics::DynamicsPeaksRequest),
+    /// `POST /api/v1/windows`: launch windows from a forecast (progress in plans).
+    Windows(crate::contract::windows::WindowsRequest),
 );
 
 impl JobItem {
@@ -710,6 +712,7 @@ pub const ITEM_RESULT_SCHEMAS: &[&str] = &[
     "EnvelopeBandsResponse",
     "DynamicsResponse",
     "DynamicsPeaksResponse",
+    "WindowsResponse",
 ];
 
 fn item_result_schema() -> impl Into<utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>> {
@@ -1190,6 +1193,9 @@ mod tests {
             return v;
         }
         if let Some(v) = crate::jobs::dynamics::example_request(kind) {
+            return v;
+        }
+        if let Some(v) = crate::jobs::windows::example_request(kind) {
             return v;
         }
         let mut v = json!({"cable": {"mass_per_length_kg_m": 0.078}, "aerostat": {"net_buoyancy_n": 1000.0}});

@@ -17,7 +17,10 @@
 pub mod bands;
 pub mod chunks;
 pub mod dynamics;
+pub mod windows;
 pub mod estimate;
+pub mod flights;
+pub mod flights_sqlite;
 pub mod kinds;
 pub mod lease;
 pub mod plan;

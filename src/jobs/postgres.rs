@@ -178,8 +178,64 @@ pub struct PgStore {
 
 impl From<postgres::Error> for StoreError {
     fn from(e: postgres::Error) -> Self {
-        Self(format!("postgres: {e}"))
+        Self(format!("postgres: {}", plain_error(&e)))
     }
+}
+
+/// A PostgreSQL error in plain words. The client's own `Display` says only
+/// "db error" for everything the server refuses: this gives the server's
+/// message, detail and code, named by what it means (authentication, a
+/// missing database, a table that exists already), or for a connection
+/// that never opened, why (refused, timed out, name not found).
+pub fn plain_error(e: &postgres::Error) -> String {
+    use postgres::error::SqlState;
+    if let Some(db) = e.as_db_error() {
+        let code = db.code();
+        let what = if *code == SqlState::INVALID_PASSWORD
+            || *code == SqlState::INVALID_AUTHORIZATION_SPECIFICATION
+        {
+            "authentication failed (check the user and password of the database URL)"
+        } else if *code == SqlState::INVALID_CATALOG_NAME {
+            "no such database"
+        } else if *code == SqlState::DUPLICATE_TABLE || *code == SqlState::DUPLICATE_OBJECT {
+            "a table or index of that name exists already"
+        } else if *code == SqlState::INSUFFICIENT_PRIVILEGE {
+            "permission denied"
+        } else if *code == SqlState::TOO_MANY_CONNECTIONS {
+            "the server has no free connection"
+        } else {
+            "the server refused the statement"
+        };
+        let mut s = format!("{what}: {} (SQLSTATE {})", db.message(), code.code());
+        if let Some(d) = db.detail() {
+            s.push_str("; ");
+            s.push_str(d);
+        }
+        if let Some(h) = db.hint() {
+            s.push_str("; hint: ");
+            s.push_str(h);
+        }
+        return s;
+    }
+    let mut source = std::error::Error::source(e);
+    while let Some(cause) = source {
+        if let Some(io) = cause.downcast_ref::<std::io::Error>() {
+            use std::io::ErrorKind::*;
+            let what = match io.kind() {
+                ConnectionRefused => {
+                    "connection refused: nothing accepts connections at that host and port \
+                     (is PostgreSQL running, and on that port?)"
+                }
+                TimedOut => "the connection timed out (host unreachable or a firewall?)",
+                NotFound => "the host name was not found",
+                ConnectionReset | UnexpectedEof => "the server closed the connection",
+                _ => "the server could not be reached",
+            };
+            return format!("{what} ({io})");
+        }
+        source = cause.source();
+    }
+    e.to_string()
 }
 
 /// `url` without its password, for logs and messages.
@@ -289,11 +345,56 @@ impl PgStore {
     }
 }
 
-fn connect(url: &str) -> Result<Client, StoreError> {
-    Client::connect(url, NoTls)
-        .map_err(|e| StoreError(format!("cannot connect to {}: {e}", redact(url))))
+/// The client is dropped off any tokio runtime thread: rust-postgres'
+/// `Client` blocks on its private runtime when dropped, which panics
+/// ("Cannot start a runtime from within a runtime") on a runtime thread,
+/// as when the store fails to open inside `serve`.
+impl Drop for PgStore {
+    fn drop(&mut self) {
+        let client = self
+            .client
+            .get_mut()
+            .unwrap_or_else(|e| e.into_inner())
+            .take();
+        if let Some(client) = client {
+            if tokio::runtime::Handle::try_current().is_ok() {
+                std::thread::scope(|s| {
+                    s.spawn(move || drop(client));
+                });
+            } else {
+                drop(client);
+            }
+        }
+    }
 }
 
+fn connect(url: &str) -> Result<Client, StoreError> {
+    Client::connect(url, NoTls).map_err(|e| {
+        StoreError(format!(
+            "cannot connect to {}: {}",
+            redact(url),
+            plain_error(&e)
+        ))
+    })
+}
+
+/// The tables a migration creates (`CREATE TABLE [IF NOT EXISTS] name`).
+fn created_tables(sql: &str) -> Vec<&str> {
+    sql.split("CREATE TABLE ")
+        .skip(1)
+        .filter_map(|rest| {
+            let rest = rest.trim_start();
+            let rest = rest.strip_prefix("IF NOT EXISTS ").unwrap_or(rest);
+            rest.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .next()
+                .filter(|n| !n.is_empty())
+        })
+        .collect()
+}
+
+/// Brings the schema to [`SCHEMA_VERSION`] in one transaction: either
+/// every missing version is applied, or (a table it did not make, a
+/// failed statement) nothing is and the database is left as it was.
 fn migrate(c: &mut Client) -> Result<(), StoreError> {
     let mut tx = c.transaction()?;
     tx.execute("SELECT pg_advisory_xact_lock($1)", &[&MIGRATION_LOCK])?;
@@ -304,19 +405,61 @@ fn migrate(c: &mut Client) -> Result<(), StoreError> {
         )",
     )?;
     let current: i32 = tx
-        .query_one("SELECT coalesce(max(version), 0) FROM schema_version", &[])?
+        .query_one("SELECT coalesce(max(version), 0) FROM schema_version", &[])
+        .map_err(|e| {
+            StoreError(format!(
+                "the table `schema_version` is not the one tetherplan keeps ({}): use an empty \
+                 database or schema; nothing was changed",
+                plain_error(&e)
+            ))
+        })?
         .get(0);
+    if current > SCHEMA_VERSION {
+        return Err(StoreError(format!(
+            "the job database is at schema version {current}, newer than this server's \
+             {SCHEMA_VERSION}: run a newer tetherplan; nothing was changed"
+        )));
+    }
+    let mut applied = Vec::new();
     for (version, sql) in MIGRATIONS {
         if *version > current {
-            tx.batch_execute(sql)?;
+            for table in created_tables(sql) {
+                let exists: bool = tx
+                    .query_one("SELECT to_regclass($1::TEXT) IS NOT NULL", &[&table])?
+                    .get(0);
+                if exists {
+                    return Err(StoreError(format!(
+                        "the database already has a table `{table}` that tetherplan did not make \
+                         (its schema is at version {current}; version {version} creates \
+                         `{table}`): point TETHERPLAN_DATABASE_URL at an empty database or \
+                         schema, or drop that table; nothing was changed"
+                    )));
+                }
+            }
+            tx.batch_execute(sql).map_err(|e| {
+                StoreError(format!(
+                    "the migration of the job database to schema version {version} failed: {}; \
+                     nothing was changed",
+                    plain_error(&e)
+                ))
+            })?;
             tx.execute(
                 "INSERT INTO schema_version (version) VALUES ($1)",
                 &[version],
             )?;
-            tracing::info!(version, "job database migrated");
+            applied.push(*version);
         }
     }
-    tx.commit()?;
+    tx.commit().map_err(|e| {
+        StoreError(format!(
+            "the migration of the job database could not be committed: {}; nothing was changed",
+            plain_error(&e)
+        ))
+    })?;
+    // Logged once committed: a rolled-back migration is not reported as done.
+    for version in applied {
+        tracing::info!(version, "job database migrated");
+    }
     Ok(())
 }
 

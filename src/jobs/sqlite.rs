@@ -14,6 +14,12 @@
 //!    (claims of a chunked job while chunks remain) and `job_answers`: a done
 //!    job's answer in pages (streamed by `GET /api/v1/jobs/{id}`); the
 //!    answers of version 4 move there, one page each.
+//!
+//! The file shrinks after a purge: the database is kept in
+//! `auto_vacuum = INCREMENTAL` (set on a new file; an older file made
+//! without it is converted by one `VACUUM` at open), and housekeeping that
+//! deleted anything runs `PRAGMA incremental_vacuum` and a truncating WAL
+//! checkpoint, so the pages of purged jobs go back to the file system.
 
 use std::path::Path;
 use std::sync::Mutex;
@@ -147,6 +153,9 @@ const NOW: &str = "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')";
 /// The fence of a write: the row is still running under this lease.
 const FENCE: &str = "id = ?1 AND status = 'running' AND lease_owner = ?2 AND lease_epoch = ?3";
 
+/// `PRAGMA auto_vacuum` of a file kept in incremental vacuum.
+const AUTO_VACUUM_INCREMENTAL: i64 = 2;
+
 /// The job table behind one connection, claiming as one worker.
 pub struct JobStore {
     conn: Mutex<Connection>,
@@ -159,9 +168,36 @@ impl JobStore {
     pub fn open(path: &Path) -> Result<Self, StoreError> {
         let conn = Connection::open(path)?;
         conn.busy_timeout(Duration::from_secs(10))?;
+        // Before any table exists this takes effect at once; an older file
+        // needs one VACUUM to change it (below).
+        conn.pragma_update(None, "auto_vacuum", "INCREMENTAL")?;
         conn.pragma_update(None, "journal_mode", "WAL")?;
         conn.pragma_update(None, "synchronous", "NORMAL")?;
+        let mode: i64 = conn.query_row("PRAGMA auto_vacuum", [], |r| r.get(0))?;
+        if mode != AUTO_VACUUM_INCREMENTAL {
+            tracing::info!(
+                path = %path.display(),
+                "converting the job database to incremental vacuum (once; the file shrinks after purges from now on)"
+            );
+            conn.execute_batch("VACUUM")?;
+        }
         Self::init(conn)
+    }
+
+    /// Gives the free pages of the file back to the file system (after a
+    /// purge): `incremental_vacuum` moves them to the end of the file and
+    /// cuts it, the checkpoint writes that through the WAL and empties it.
+    pub fn compact(&self) -> Result<(), StoreError> {
+        let conn = self.conn();
+        // Stepped to its end: each step frees one page.
+        let mut stmt = conn.prepare("PRAGMA incremental_vacuum")?;
+        let mut rows = stmt.query([])?;
+        while rows.next()?.is_some() {}
+        drop(rows);
+        drop(stmt);
+        // Busy readers may keep part of the WAL: that part is cut next time.
+        conn.query_row("PRAGMA wal_checkpoint(TRUNCATE)", [], |_| Ok(()))?;
+        Ok(())
     }
 
     /// A private in-memory store (tests).
@@ -910,6 +946,11 @@ impl JobBackend for JobStore {
         let since = now_ms() - stale_workers.as_millis().min(i64::MAX as u128) as i64;
         tx.execute("DELETE FROM workers WHERE heartbeat_ms < ?1", [since])?;
         tx.commit()?;
+        let free_pages: i64 = conn.query_row("PRAGMA freelist_count", [], |r| r.get(0))?;
+        drop(conn);
+        if free_pages > 0 {
+            self.compact()?;
+        }
         Ok(purged)
     }
 

@@ -5,9 +5,11 @@
 pub mod aero;
 pub mod chart;
 pub mod dynamics;
+pub mod forecast;
 pub mod ge;
 pub mod ge_reduced;
 pub mod mesh;
+pub mod monitor;
 pub mod newmark;
 pub mod params;
 pub mod plan;

@@ -99,6 +99,10 @@ window.tetherplanShared = window.tetherplanShared || {};
   function readFlow(roots, errors) {
     const n = (name, opts) => readNumber(roots, name, errors, opts);
     const kind = named(roots, "wind.flow.kind")?.value || "uniform";
+    if (kind === "power_law") {
+      return { kind, coefficient_m_s: n("wind.flow.speed_m_s"), exponent_nondim: n("wind.flow.exponent_nondim"),
+        reference_height_m: n("wind.flow.power_reference_height_m") };
+    }
     const flow = { kind, speed_m_s: n("wind.flow.speed_m_s") };
     if (kind === "log_law") {
       flow.reference_height_m = n("wind.flow.reference_height_m");

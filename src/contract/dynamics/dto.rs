@@ -29,9 +29,8 @@ fn default_spectral_radius() -> f64 {
 fn default_sample_count() -> usize {
     601
 }
-fn default_shape_count() -> usize {
-    31
-}
+/// Shapes kept when neither `shape_count` nor `shape_times_s` is given.
+pub const DEFAULT_SHAPE_COUNT: usize = 31;
 
 /// The turbulence spectrum.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
@@ -196,12 +195,12 @@ pub struct DynamicsRequest {
     #[serde(default = "default_sample_count")]
     #[schema(example = 601, minimum = 2, maximum = 200000)]
     pub sample_count: usize,
-    /// Tether shapes kept, evenly spaced from 0 to `duration_s` (0: none);
-    /// `shape_times_s` instead names the times. Shapes × (segments + 1)
-    /// nodes at most 200 000.
-    #[serde(default = "default_shape_count")]
-    #[schema(example = 31, minimum = 0, maximum = 1000)]
-    pub shape_count: usize,
+    /// Tether shapes kept, evenly spaced from 0 to `duration_s` (0: none;
+    /// default 31); `shape_times_s` instead names the times (give one of
+    /// the two, not both). Shapes × (segments + 1) nodes at most 200 000.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 31, default = 31, minimum = 0, maximum = 1000)]
+    pub shape_count: Option<usize>,
     /// The times of the kept shapes (s), instead of `shape_count` (at most 1000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape_times_s: Option<Vec<f64>>,

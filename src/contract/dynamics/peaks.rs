@@ -230,7 +230,7 @@ impl DynamicsPeaksRequest {
             initial_length_m: None,
             duration_s: self.exposure_s,
             sample_count: count,
-            shape_count: 0,
+            shape_count: Some(0),
             shape_times_s: None,
             wind_probe_height_m: None,
             internal_damping_n_s: self.internal_damping_n_s,

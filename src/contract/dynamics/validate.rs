@@ -358,6 +358,14 @@ impl DynamicsRequest {
         let count = require_count("sample_count", self.sample_count, 2, MAX_SAMPLE_COUNT)?;
         let sample_interval = duration / (count - 1) as f64;
         let shape_times = match &self.shape_times_s {
+            Some(_) if self.shape_count.is_some() => {
+                return Err(InvalidInput::new(
+                    "shape_count",
+                    "give either `shape_count` (evenly spaced shapes) or `shape_times_s` (the \
+                     times of the shapes), not both: the two contradict each other unless they \
+                     say the same",
+                ));
+            }
             Some(times) => {
                 if times.len() > MAX_SHAPES {
                     return Err(InvalidInput::new(
@@ -371,7 +379,12 @@ impl DynamicsRequest {
                 times.clone()
             }
             None => {
-                let k = require_count("shape_count", self.shape_count, 0, MAX_SHAPES)?;
+                let k = require_count(
+                    "shape_count",
+                    self.shape_count.unwrap_or(super::dto::DEFAULT_SHAPE_COUNT),
+                    0,
+                    MAX_SHAPES,
+                )?;
                 match k {
                     0 => vec![],
                     1 => vec![duration],

@@ -33,6 +33,8 @@ pub struct EnvelopeRequest {
     /// The air: its density and the shape of its flow (uniform, log law or
     /// power law), scaled to each grid speed (the speed at the flow's
     /// reference height: `speed_m_s`, or a power law's `coefficient_m_s`).
+    /// The flow's own speed is 0 to 150 m/s here, with a grid as well
+    /// (it sets the gust ratio of `gust.gust_m_s`).
     pub wind: WindInput,
     /// Wind speeds (m/s, 0 to 150, at most 1000): a list or `{min, max, count}`;
     /// absent: the flow's own speed only (today's wind).

@@ -101,20 +101,20 @@ impl EnvelopeRequest {
         })
     }
 
-    /// The wind speeds: the grid, or the flow's own speed.
+    /// The wind speeds: the grid, or the flow's own speed. The flow's
+    /// speed is checked (0 to 150 m/s) with a grid too: it still sets the
+    /// gust ratio of `wind.gust.gust_m_s`, and a field the route took but
+    /// did not check would pass any number unseen.
     pub fn wind_speeds(&self) -> Result<Vec<f64>, InvalidInput> {
+        let (_, speed) = self.shape()?;
+        let field = match &self.wind.flow {
+            WindFlowInput::PowerLaw { .. } => "wind.flow.coefficient_m_s",
+            _ => "wind.flow.speed_m_s",
+        };
+        let own = require_range(field, speed, 0.0, false, 150.0)?;
         match &self.wind_speeds_m_s {
             Some(g) => g.values("wind_speeds_m_s", WIND_GRID),
-            None => {
-                let (_, speed) = self.shape()?;
-                Ok(vec![require_range(
-                    "wind.flow.speed_m_s",
-                    speed,
-                    0.0,
-                    false,
-                    150.0,
-                )?])
-            }
+            None => Ok(vec![own]),
         }
     }
 }

@@ -31,8 +31,16 @@ pub struct WindForecastPointInput {
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HaulDownInput {
-    /// Wind speed against time, times strictly increasing (1..=10000 points).
+    /// Wind speed against time, times strictly increasing (1..=10000 points);
+    /// or leave it out and give `source`.
+    #[serde(default)]
     pub forecast: Vec<WindForecastPointInput>,
+    /// The forecast as it comes (issue 32: `open_meteo`, `metar`, `taf`,
+    /// `csv`, as `POST /api/v1/windows` takes it), instead of `forecast`: each
+    /// period's flow read at `target_elevation_m`, its gust by its gust ratio,
+    /// times from its first period (an ensemble: its first member).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<crate::contract::windows::forecast::ForecastInput>,
     /// Largest wind in which the aerostat may stay aloft (m/s).
     #[schema(example = 12.0, exclusive_minimum = 0.0, maximum = 200.0)]
     pub max_operating_wind_m_s: f64,

@@ -3,6 +3,7 @@
 //! in named steps ([`run`]) and the answer's pieces (`output`) over
 //! [`crate::numerics::plan`].
 
+pub mod ceiling;
 pub mod dto;
 pub mod ge;
 mod output;

@@ -91,7 +91,7 @@ pub(super) fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
 /// `resolve`: find the wind target (equilibria; with the GE criterion its
 /// table). Without it (job submission) a GE request's target is only
 /// range-checked.
-fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidInput> {
+pub(super) fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidInput> {
     let system_input = SystemInput {
         cable: req.cable.clone(),
         aerostat: req.aerostat.clone(),
@@ -244,7 +244,7 @@ fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidI
     let forecast = req
         .haul_down
         .as_ref()
-        .map(|h| haul_down_forecast(h, gust.as_ref()))
+        .map(|h| haul_down_forecast(h, gust.as_ref(), req.target_elevation_m))
         .transpose()?;
     Ok(Validated {
         model,
@@ -264,9 +264,24 @@ fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidI
 fn haul_down_forecast(
     h: &HaulDownInput,
     gust: Option<&GustWind>,
+    height_m: f64,
 ) -> Result<HaulDownForecast, InvalidInput> {
     let at = |i: usize, name: &str| format!("haul_down.forecast[{i}].{name}");
-    for (i, p) in h.forecast.iter().enumerate() {
+    let from_source;
+    let forecast = match (&h.source, h.forecast.is_empty()) {
+        (Some(_), false) => {
+            return Err(InvalidInput::new(
+                "haul_down.source",
+                "give either `forecast` (the points) or `source` (a forecast as it comes), not both",
+            ));
+        }
+        (Some(s), true) => {
+            from_source = crate::contract::windows::haul_down_points(s, height_m)?;
+            &from_source
+        }
+        (None, _) => &h.forecast,
+    };
+    for (i, p) in forecast.iter().enumerate() {
         bounded(&at(i, "time_s"), p.time_s, 0.0, 1e9)?;
         bounded(&at(i, "wind_speed_m_s"), p.wind_speed_m_s, 0.0, 200.0)?;
         if let Some(g) = p.gust_m_s {
@@ -282,8 +297,7 @@ fn haul_down_forecast(
             }
         }
     }
-    let pts: Vec<(f64, f64)> = h
-        .forecast
+    let pts: Vec<(f64, f64)> = forecast
         .iter()
         .map(|p| (p.time_s, p.wind_speed_m_s))
         .collect();
@@ -292,7 +306,7 @@ fn haul_down_forecast(
     bounded("haul_down.max_operating_wind_m_s", limit, 0.0, 200.0)?;
     let gust = match h.max_gust_m_s {
         None => {
-            if let Some(i) = h.forecast.iter().position(|p| p.gust_m_s.is_some()) {
+            if let Some(i) = forecast.iter().position(|p| p.gust_m_s.is_some()) {
                 return Err(InvalidInput::new(
                     "haul_down.max_gust_m_s",
                     format!(
@@ -307,7 +321,7 @@ fn haul_down_forecast(
             let g = require_positive("haul_down.max_gust_m_s", g)?;
             bounded("haul_down.max_gust_m_s", g, 0.0, 200.0)?;
             let mut gpts = Vec::with_capacity(pts.len());
-            for (i, p) in h.forecast.iter().enumerate() {
+            for (i, p) in forecast.iter().enumerate() {
                 let u = match (p.gust_m_s, gust) {
                     (Some(u), _) => u,
                     (None, Some(gw)) => p.wind_speed_m_s * gw.factor,

@@ -42,7 +42,12 @@ pub enum CablePresetName {
 #[derive(Clone, Debug, Default, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CableInput {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// A material preset (`null` is refused: leave the field out instead).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "present_value"
+    )]
     pub preset: Option<CablePresetName>,
     /// Diameter d (m): the reference width of the normal drag; required with a preset or in wind.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -205,6 +210,21 @@ impl WindFlowInput {
             Self::Tabulated { points } => points.iter().all(|p| p.speed_m_s == 0.0),
             Self::LogLaw { speed_m_s, .. } => *speed_m_s == 0.0,
         }
+    }
+}
+
+/// An optional field whose value, when the key is given, may not be
+/// `null`: in the schema it has no null form (the key is left out instead).
+fn present_value<'de, D, T>(d: D) -> Result<Option<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    match Option::<T>::deserialize(d)? {
+        Some(v) => Ok(Some(v)),
+        None => Err(serde::de::Error::custom(
+            "is null: give a value or leave the field out",
+        )),
     }
 }
 

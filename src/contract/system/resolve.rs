@@ -60,24 +60,37 @@ pub fn refuse_moved(v: &Value) -> Result<(), InvalidInput> {
 /// Longest name of a stored system.
 pub const MAX_NAME_LEN: usize = 64;
 
-/// Checks a system's name: 1 to 64 letters, digits, `-`, `_` or `.`.
+/// The pattern of a system's name (with at most [`MAX_NAME_LEN`]
+/// characters): letters, digits, `-` and `_`, with single dots between
+/// them; it starts with a letter or digit and ends without a dot, so no
+/// name reads as a path (`.`, `..`, `.hidden`, `a..b`, `a/b`).
+pub const NAME_PATTERN: &str = r"^[A-Za-z0-9](\.?[A-Za-z0-9_-])*$";
+
+/// Checks a system's name against [`NAME_PATTERN`] and [`MAX_NAME_LEN`].
 pub fn check_name(field: &str, name: &str) -> Result<(), InvalidInput> {
-    let ok = !name.is_empty()
-        && name.len() <= MAX_NAME_LEN
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
-    if ok {
-        Ok(())
+    let shown = || format!("{:?}", name.chars().take(80).collect::<String>());
+    let chars_ok = name
+        .chars()
+        .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+    let why = if name.is_empty() || name.len() > MAX_NAME_LEN || !chars_ok {
+        format!(
+            "a system's name is 1 to {MAX_NAME_LEN} letters, digits, '-', '_' or '.', got {}",
+            shown()
+        )
+    } else if !name.starts_with(|c: char| c.is_ascii_alphanumeric()) {
+        format!(
+            "a system's name starts with a letter or digit (a name such as `.`, `..` or `.x` reads as a path), got {}",
+            shown()
+        )
+    } else if name.contains("..") || name.ends_with('.') {
+        format!(
+            "a system's name has single dots between other characters, never two in a row or one at the end (it would read as a path), got {}",
+            shown()
+        )
     } else {
-        Err(InvalidInput::new(
-            field,
-            format!(
-                "a system's name is 1 to {MAX_NAME_LEN} letters, digits, '-', '_' or '.', got {:?}",
-                name.chars().take(80).collect::<String>()
-            ),
-        ))
-    }
+        return Ok(());
+    };
+    Err(InvalidInput::new(field, why))
 }
 
 /// Deep merge: `over` onto `base` (objects key by key, `null` removes, anything else replaces).

@@ -1,0 +1,51 @@
+//! Live flights over HTTP (SPEC §13, issue 33): the routes
+//! ([`handlers`], [`events`]), the flights of a server ([`hub`]) and their
+//! part of the OpenAPI document ([`FlightsDoc`]). Wired into the router by
+//! [`routes`] and into the document by merging [`FlightsDoc`].
+
+pub mod events;
+pub mod handlers;
+pub mod hub;
+
+use axum::Router;
+use axum::routing::{get, post};
+use utoipa::OpenApi;
+
+use crate::api::AppState;
+
+/// The flight routes.
+pub fn routes() -> Router<AppState> {
+    Router::new()
+        .route(
+            "/api/v1/flights",
+            post(handlers::create_flight).get(handlers::list_flights),
+        )
+        .route("/api/v1/flights/{id}", get(handlers::get_flight))
+        .route("/api/v1/flights/{id}/end", post(handlers::end_flight))
+        .route(
+            "/api/v1/flights/{id}/telemetry",
+            post(handlers::post_telemetry),
+        )
+        .route(
+            "/api/v1/flights/{id}/alarms/acknowledge",
+            post(handlers::acknowledge_alarms),
+        )
+        .route("/api/v1/flights/{id}/replan", get(handlers::replan_flight))
+        .route("/api/v1/flights/{id}/events", get(events::flight_events))
+}
+
+#[derive(OpenApi)]
+#[openapi(
+    paths(
+        handlers::create_flight,
+        handlers::list_flights,
+        handlers::get_flight,
+        handlers::end_flight,
+        handlers::post_telemetry,
+        handlers::acknowledge_alarms,
+        handlers::replan_flight,
+        events::flight_events,
+    ),
+    tags((name = "flights", description = "Live flights: a committed plan against its telemetry, with alarms (SPEC §13)"))
+)]
+pub struct FlightsDoc;

@@ -1,0 +1,12 @@
+//! Live flights (SPEC §13, issue 33): the JSON contract around the pure
+//! monitor of [`crate::numerics::monitor`]. [`telemetry`] parses the
+//! batches of samples (JSON, CSV, NMEA `$--MWV`), [`dto`] holds the
+//! flight's limits and answers, [`model`] commits a flight (its plan, its
+//! limits, its ceiling table) and turns the monitor into JSON, [`wind`]
+//! carries a measured wind into the plan's flow, [`replan`] plans again from now.
+
+pub mod dto;
+pub mod model;
+pub mod replan;
+pub mod telemetry;
+pub mod wind;

@@ -1,0 +1,217 @@
+// Today's launch windows from a forecast (SPEC §12, issue 32): a panel of its
+// own after today's plan. Paste a forecast or drop a file on the panel
+// (Open-Meteo JSON or its ensemble, a METAR, a TAF, or CSV
+// `time,height_m,speed_m_s,gust_m_s`; the format is recognised), post
+// /api/v1/windows with the system card and the plan's target, and draw the
+// day's timeline: one cell per forecast period coloured by its verdict
+// (data-verdict go | no-go), its bar as high as the reachable altitude, the
+// launch windows marked beneath. Choosing a cell sets the plan's wind to that
+// period's §9 wind (the fitted flow and gust) and plans again. Speeds are
+// shown in m/s, knots or km/h and heights in metres or feet, chosen in the
+// panel and kept in the URL (`units_speed`, `units_length`); the API stays SI.
+"use strict";
+
+(function () {
+  const S = window.tetherplanShared;
+  const plan = document.getElementById("plan");
+  if (!S || !plan) return;
+  const KNOT = 1852 / 3600;
+  const SPEED = { "m/s": 1, kn: KNOT, "km/h": 1 / 3.6 };
+  const LENGTH = { m: 1, ft: 0.3048 };
+  const params = new URLSearchParams(window.location.search);
+  const units = {
+    speed: SPEED[params.get("units_speed")] ? params.get("units_speed") : "m/s",
+    length: LENGTH[params.get("units_length")] ? params.get("units_length") : "m",
+  };
+  const sp = (v) => (v == null ? "–" : `${(v / SPEED[units.speed]).toFixed(1)} ${units.speed}`);
+  const len = (v) => (v == null ? "–" : `${Math.round(v / LENGTH[units.length])} ${units.length}`);
+
+  const section = document.createElement("section");
+  section.id = "windows";
+  section.setAttribute("aria-labelledby", "windows-heading");
+  section.innerHTML = `
+  <h2 id="windows-heading">Today's launch windows from a forecast</h2>
+  <p class="hint">Paste a forecast or drop its file here: Open-Meteo JSON (or its ensemble), a METAR, a TAF, or CSV
+    <code>time,height_m,speed_m_s,gust_m_s</code>. Each hour is judged as the plan above judges its wind; choose an hour to plan in it.</p>
+  <form id="windows-form" novalidate>
+    <div class="field wide"><label for="windows-data">Forecast</label>
+      <textarea id="windows-data" rows="4" placeholder="drop a file here or paste"></textarea></div>
+    <div class="field"><label for="windows-file">Forecast file</label><input id="windows-file" type="file" accept=".json,.csv,.txt"></div>
+    <div class="field"><label for="windows-operation">Time aloft (h)</label><input id="windows-operation" inputmode="decimal" value="1"></div>
+    <div class="field"><label for="windows-limit">Highest wind at the aerostat (m/s, blank: the plan's limits only)</label>
+      <input id="windows-limit" inputmode="decimal" value=""></div>
+    <div class="field"><label for="units-speed">Speeds in</label><select id="units-speed">
+      ${Object.keys(SPEED).map((u) => `<option${u === units.speed ? " selected" : ""}>${u}</option>`).join("")}</select></div>
+    <div class="field"><label for="units-length">Heights in</label><select id="units-length">
+      ${Object.keys(LENGTH).map((u) => `<option${u === units.length ? " selected" : ""}>${u}</option>`).join("")}</select></div>
+    <div class="actions"><button type="submit" id="windows-button">Show the day</button></div>
+    <p id="windows-error" class="error" role="alert" hidden></p>
+  </form>
+  <p id="windows-summary" class="note" hidden></p>
+  <div id="windows-timeline" class="windows-timeline" role="list" aria-label="Forecast periods" hidden></div>
+  <div id="windows-bands" class="windows-bands" aria-label="Launch windows"></div>`;
+  plan.after(section);
+  const $ = (id) => document.getElementById(id);
+
+  function detect(text) {
+    const t = text.trim();
+    if (t.startsWith("{")) return "open_meteo";
+    if (/^(TAF)\b/.test(t)) return "taf";
+    if (/^(METAR|SPECI)\b/.test(t) || /^[A-Z]{4} \d{6}Z/.test(t)) return "metar";
+    return "csv";
+  }
+
+  function keepUnits() {
+    units.speed = $("units-speed").value;
+    units.length = $("units-length").value;
+    const p = new URLSearchParams(window.location.search);
+    p.set("units_speed", units.speed);
+    p.set("units_length", units.length);
+    history.replaceState(null, "", `${window.location.pathname}?${p.toString()}${window.location.hash}`);
+    if (last) draw(last);
+  }
+  $("units-speed").addEventListener("change", keepUnits);
+  $("units-length").addEventListener("change", keepUnits);
+
+  let last = null;
+  async function run() {
+    const err = $("windows-error");
+    err.hidden = true;
+    const text = $("windows-data").value;
+    if (!text.trim()) return;
+    const errors = [];
+    const sys = S.readSystem(errors, "plan");
+    const format = detect(text);
+    let data = text;
+    if (format === "open_meteo") {
+      try { data = JSON.parse(text); } catch (e) { errors.push({ field: "forecast.data", message: `not JSON: ${e.message}` }); }
+    }
+    const target = S.readNumber([document.getElementById("plan-form")], "target_elevation_m", errors);
+    if (errors.length) {
+      err.textContent = errors.map((e) => `${e.field}: ${e.message}`).join("; ");
+      err.hidden = false;
+      return;
+    }
+    const body = {
+      cable: sys.cable, aerostat: sys.aerostat, winch: sys.winch, gravity_m_s2: sys.gravity_m_s2,
+      initial_length_m: sys.initial_length_m, lift_reserve_nondim: sys.lift_reserve_nondim,
+      required_safety_factor_nondim: sys.required_safety_factor_nondim,
+      wind: { air_density_kg_m3: sys.wind.air_density_kg_m3 },
+      target_elevation_m: target,
+      operation_s: 3600 * Number($("windows-operation").value || 0),
+      forecast: { format, data },
+    };
+    const limit = Number($("windows-limit").value);
+    if ($("windows-limit").value.trim() && Number.isFinite(limit)) body.haul_down = { max_operating_wind_m_s: limit };
+    $("windows-button").disabled = true;
+    section.dataset.state = "pending";
+    const res = await S.api("POST", "api/v1/windows", body);
+    $("windows-button").disabled = false;
+    if (!res.ok) {
+      section.dataset.state = "error";
+      err.textContent = res.body?.error ? `${res.body.error.field}: ${res.body.error.message}` : `error ${res.status}`;
+      err.hidden = false;
+      return;
+    }
+    last = res.body;
+    draw(last);
+    section.dataset.state = "done";
+  }
+
+  function draw(r) {
+    const tl = $("windows-timeline");
+    tl.innerHTML = "";
+    tl.hidden = false;
+    const top = Math.max(1, ...r.hours.map((h) => h.max_altitude_m || 0));
+    r.hours.forEach((h, i) => {
+      const b = document.createElement("button");
+      b.type = "button";
+      b.setAttribute("role", "listitem");
+      b.dataset.verdict = h.verdict;
+      b.dataset.index = String(i);
+      b.setAttribute("aria-pressed", "false");
+      const p = h.probability_go != null ? `, P(go) ${(100 * h.probability_go).toFixed(0)} %` : "";
+      b.title = `${h.time}: ${h.verdict.toUpperCase()}, reach ${len(h.max_altitude_m)}, wind at target ${sp(h.wind_at_target_m_s)}${p}\n${h.reason}`;
+      b.setAttribute("aria-label", `${h.time} ${h.verdict}`);
+      const bar = document.createElement("span");
+      bar.className = "bar";
+      bar.style.height = `${Math.max(4, (100 * (h.max_altitude_m || 0)) / top)}%`;
+      const lab = document.createElement("span");
+      lab.textContent = (h.time.match(/T(\d\d)|^\d\d(\d\d)/) || [])[1] ?? (h.time.match(/^\d\d(\d\d)/) || [])[1] ?? String(i);
+      b.append(bar, lab);
+      b.addEventListener("click", () => choose(r, i));
+      tl.append(b);
+    });
+    const bands = $("windows-bands");
+    bands.innerHTML = "";
+    const cells = [...tl.children];
+    for (const w of r.windows) {
+      const a = r.hours.findIndex((h) => h.time >= w.start);
+      const e = r.hours.findIndex((h) => h.time >= w.end);
+      const first = cells[Math.max(a, 0)];
+      const lastCell = cells[(e < 0 ? cells.length : e) - 1] || first;
+      const s = document.createElement("span");
+      s.className = "window";
+      s.style.left = `${first.offsetLeft}px`;
+      s.style.width = `${lastCell.offsetLeft + lastCell.offsetWidth - first.offsetLeft}px`;
+      s.textContent = `${w.start}–${w.end}${w.probability != null ? ` (${(100 * w.probability).toFixed(0)} %)` : ""}`;
+      s.title = `launch by ${w.latest_launch}`;
+      bands.append(s);
+    }
+    const go = r.hours.filter((h) => h.verdict === "go").length;
+    const sum = $("windows-summary");
+    sum.textContent = `${go} of ${r.hours.length} periods GO; ${r.windows.length} launch window(s)` +
+      (r.members > 1 ? `; ${r.members} ensemble members` : "") +
+      `; limits × α from 1 down by ${r.lead_time_factor.per_hour_nondim} per hour of lead time.`;
+    sum.hidden = false;
+  }
+
+  // The plan's wind becomes the period's §9 wind; then the plan runs.
+  function choose(r, i) {
+    const h = r.hours[i];
+    for (const b of $("windows-timeline").children) b.setAttribute("aria-pressed", String(b.dataset.index === String(i)));
+    const form = document.getElementById("plan-form");
+    const set = (name, v) => {
+      const el = form.elements[name];
+      if (!el) return;
+      el.value = v == null ? "" : String(v);
+      el.dispatchEvent(new Event("input", { bubbles: true }));
+    };
+    const f = h.wind.flow;
+    set("wind.flow.kind", f.kind);
+    form.elements["wind.flow.kind"].dispatchEvent(new Event("change", { bubbles: true }));
+    if (f.kind === "power_law") {
+      set("wind.flow.speed_m_s", f.coefficient_m_s);
+      set("wind.flow.exponent_nondim", f.exponent_nondim);
+      set("wind.flow.power_reference_height_m", f.reference_height_m);
+    } else {
+      set("wind.flow.speed_m_s", f.speed_m_s);
+      if (f.kind === "log_law") {
+        set("wind.flow.reference_height_m", f.reference_height_m);
+        set("wind.flow.roughness_length_m", f.roughness_length_m);
+      }
+    }
+    set("wind.gust.turbulence_intensity_nondim", "");
+    set("wind.gust.peak_factor_nondim", "");
+    set("wind.gust.gust_m_s", h.wind.gust?.gust_m_s ?? "");
+    set("wind.air_density_kg_m3", h.wind.air_density_kg_m3);
+    window.tetherplanPlan?.runPlan?.();
+  }
+
+  async function readFile(file) {
+    $("windows-data").value = await file.text();
+    run();
+  }
+  $("windows-file").addEventListener("change", (e) => e.target.files[0] && readFile(e.target.files[0]));
+  section.addEventListener("dragover", (e) => e.preventDefault());
+  section.addEventListener("drop", (e) => {
+    e.preventDefault();
+    const f = e.dataTransfer?.files?.[0];
+    if (f) readFile(f);
+  });
+  $("windows-form").addEventListener("submit", (e) => {
+    e.preventDefault();
+    run();
+  });
+  window.tetherplanWindows = { run, choose: (i) => last && choose(last, i) };
+})();

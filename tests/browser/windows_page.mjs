@@ -1,0 +1,80 @@
+// Browser test of the launch-windows panel (issue 32):
+//
+//   node tests/browser/windows_page.mjs http://127.0.0.1:8080/
+//
+// The page opens at the default plan (900 m); the Open-Meteo file of
+// tests/forecasts/ is dropped on the panel (a DataTransfer drop event): the
+// day's timeline shows its 24 hours, coloured by verdict, with GO and NO-GO
+// hours; choosing a NO-GO hour sets the plan's wind to that hour's (the
+// fitted power law) and the plan's verdict turns NO-GO; choosing a GO hour
+// turns it GO. Units chosen in the panel go to the URL. Screenshot:
+// tests/artifacts/windows_page.png.
+
+import { readFileSync } from "node:fs";
+import path from "node:path";
+import { fileURLToPath } from "node:url";
+import { checker, launch, target, watchConsole } from "./harness.mjs";
+
+const { url, artifacts } = target("windows_page.mjs");
+const { failures, check } = checker();
+const browser = await launch();
+const consoleErrors = [];
+let phase = "load";
+const here = path.dirname(fileURLToPath(import.meta.url));
+const forecast = readFileSync(path.resolve(here, "..", "forecasts", "open_meteo_hourly.json"), "utf8");
+
+const verdictState = (page) =>
+  page.waitForFunction(() => ["go", "no-go", "error"].includes(document.querySelector("#verdict")?.dataset.state), null, { timeout: 120_000 })
+    .then(() => page.getAttribute("#verdict", "data-state"));
+
+try {
+  const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+  const page = await context.newPage();
+  watchConsole(page, consoleErrors, () => phase);
+  const response = await page.goto(url, { waitUntil: "load" });
+  check(response && response.ok(), `GET / → ${response?.status()}`);
+  await verdictState(page);
+
+  phase = "drop";
+  await page.evaluate((text) => {
+    const dt = new DataTransfer();
+    dt.items.add(new File([text], "open_meteo_hourly.json", { type: "application/json" }));
+    document.querySelector("#windows").dispatchEvent(new DragEvent("drop", { dataTransfer: dt, bubbles: true, cancelable: true }));
+  }, forecast);
+  await page.waitForFunction(() => document.querySelectorAll("#windows-timeline button").length > 0, null, { timeout: 180_000 });
+  const cells = await page.$$eval("#windows-timeline button", (bs) => bs.map((b) => b.dataset.verdict));
+  check(cells.length === 24, `the timeline shows the day's 24 hours (${cells.length})`);
+  check(cells.includes("go") && cells.includes("no-go"), `GO and NO-GO hours (${cells.join(" ")})`);
+  const colours = await page.$$eval("#windows-timeline button .bar", (bs) => [...new Set(bs.map((b) => getComputedStyle(b).backgroundColor))]);
+  check(colours.length === 2, `hours coloured by verdict (${colours.join(", ")})`);
+  await page.locator("#windows").screenshot({ path: path.join(artifacts, "windows_page.png") });
+
+  phase = "choose";
+  const noGo = cells.indexOf("no-go");
+  await page.click(`#windows-timeline button[data-index="${noGo}"]`);
+  check((await page.inputValue('[name="wind.flow.kind"]')) !== "uniform", "the plan's wind is the hour's fitted flow");
+  check((await verdictState(page)) === "no-go", "choosing a NO-GO hour turns the plan NO-GO");
+  const go = cells.indexOf("go");
+  await page.click(`#windows-timeline button[data-index="${go}"]`);
+  check((await verdictState(page)) === "go", "choosing a GO hour turns the plan GO");
+
+  phase = "units";
+  await page.selectOption("#units-speed", "kn");
+  await page.selectOption("#units-length", "ft");
+  const q = new URL(page.url()).searchParams;
+  check(q.get("units_speed") === "kn" && q.get("units_length") === "ft", `units kept in the URL (${page.url()})`);
+  const title = await page.getAttribute(`#windows-timeline button[data-index="${go}"]`, "title");
+  check(/ kn/.test(title) && / ft/.test(title), `the timeline speaks knots and feet (“${title.split("\n")[0]}”)`);
+  await context.close();
+
+  for (const e of consoleErrors) console.log(`  console error (${e.phase}): ${e.text}`);
+  check(consoleErrors.length === 0, `no console errors (${consoleErrors.length})`);
+} catch (e) {
+  console.error(`FAIL ${e.stack || e}`);
+  failures.push(String(e));
+} finally {
+  await browser.close();
+}
+
+console.log(failures.length ? `${failures.length} check(s) failed` : "all browser checks passed");
+process.exit(failures.length ? 1 : 0);
