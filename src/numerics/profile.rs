@@ -125,6 +125,11 @@ impl RateSchedule {
         self.times_s.len()
     }
 
+    /// The knot times `t_k` (s), where the acceleration may jump.
+    pub fn knot_times_s(&self) -> &[f64] {
+        &self.times_s
+    }
+
     /// Knot index `k` with `t_k ≤ t < t_{k+1}` (the last knot for `t` beyond).
     fn segment(&self, t_s: f64) -> usize {
         self.times_s

@@ -37,6 +37,33 @@ def wind(c, t):
     return u
 
 
+def rate_at(c, t):
+    """The winch rate (m/s): linear in the table `rate_points` [[t, rate], ...]
+    (held after it), zero from `stop_time_s` on; none without a table."""
+    pts = c.get("rate_points")
+    if not pts or t >= c.get("stop_time_s", float("inf")):
+        return 0.0
+    if t >= pts[-1][0]:
+        return pts[-1][1]
+    for (t0, r0), (t1, r1) in zip(pts, pts[1:]):
+        if t0 <= t < t1:
+            return r0 + (r1 - r0) * (t - t0) / (t1 - t0)
+    return 0.0
+
+
+def length_at(c, t):
+    """The unstretched length at t (m): the rate integrated exactly."""
+    pts = c.get("rate_points")
+    length = c["length_m"]
+    if not pts:
+        return length
+    t = min(t, c.get("stop_time_s", float("inf")))
+    knots = [p[0] for p in pts if p[0] < t] + [t]
+    for a, b in zip(knots, knots[1:]):
+        length += 0.5 * (rate_at(c, a) + rate_at(c, b - 1e-12 * max(1.0, b))) * (b - a)
+    return length
+
+
 def main():
     c = json.load(sys.stdin)
     g = c["gravity_m_s2"]
@@ -105,14 +132,30 @@ ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
         record(t)
         cpu = time.process_time()
         zeros = [0.0] * (3 * n)
+        # A changing length: the rate is set (only when it changes) every
+        # `rate_update_s` at most, as the mean rate of the chunk, so the
+        # length follows the schedule exactly at the chunk ends.
+        chunks = max(1, int(math.ceil(dt / c.get("rate_update_s", dt) - 1e-9))) if c.get("rate_points") else 1
+        rate_set = None
         for i in range(steps):
             u = wind(c, t + 0.5 * dt)
             vel = [0.0] * (3 * n)
             vel[0::3] = [u] * n
             cmoordyn.ext_wave_set(system, vel, zeros, t)
-            moordyn.Step(system, [], [], t, dt)
+            for k in range(chunks):
+                ta = i * dt + k * dt / chunks
+                tb = i * dt + (k + 1) * dt / chunks
+                if c.get("rate_points"):
+                    # Rounded: a constant rate is set once, not every chunk.
+                    rate = round((length_at(c, tb) - length_at(c, ta)) / (tb - ta), 9)
+                    if rate != rate_set:
+                        moordyn.SetLineUnstretchedLengthVel(line, rate)
+                        rate_set = rate
+                moordyn.Step(system, [], [], ta, tb - ta)
             t = (i + 1) * dt
             record(t)
+            if c.get("rate_points"):
+                out.setdefault("length_m", []).append(moordyn.GetLineUnstretchedLength(line))
         out["cpu_s"] = time.process_time() - cpu
         moordyn.Close(system)
     # MoorDyn writes to stdout too: the answer is the last line.

@@ -209,6 +209,12 @@ pub struct DynamicsRequest {
     #[serde(default)]
     #[schema(example = 0.0, minimum = 0.0, maximum = 1e12)]
     pub internal_damping_n_s: f64,
+    /// Height of a fixed wind probe (m): every sample keeps the wind there
+    /// (`probe_wind_m_s`), above the aerostat's starting station; default
+    /// the aerostat's starting altitude.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 500.0, minimum = 0.0, maximum = 30000.0)]
+    pub wind_probe_height_m: Option<f64>,
     /// Tangential (skin-friction) drag coefficient on π d, default 0.
     #[serde(default)]
     #[schema(example = 0.0, minimum = 0.0, maximum = 1.0)]
@@ -247,6 +253,10 @@ pub struct DynamicsSampleOutput {
     pub tether_length_m: f64,
     /// Wind speed at the aerostat (m/s).
     pub aerostat_wind_m_s: f64,
+    /// Wind speed at the fixed probe point (`wind_probe_height_m`,
+    /// `wind_probe_downwind_m` of the answer) (m/s): the field a fixed
+    /// anemometer would record.
+    pub probe_wind_m_s: f64,
 }
 
 /// One node of a kept shape.
@@ -321,6 +331,9 @@ pub enum DynamicsOutcomeOutput {
     NewtonFailed,
     /// The state became non-finite (`stopped_at_s`).
     Diverged,
+    /// The aerostat went below the winch (`stopped_at_s`): the state left
+    /// the physical (the model has no ground).
+    AerostatBelowWinch,
 }
 
 /// How the answer was computed.
@@ -351,6 +364,10 @@ pub struct DynamicsResponse {
     pub outcome: DynamicsOutcomeOutput,
     /// Time the run stopped at (s): `duration_s` when completed.
     pub stopped_at_s: f64,
+    /// True when the run did not complete: every figure below (peaks,
+    /// minima, lowest altitude) covers only `[0, stopped_at_s]`, is not a
+    /// final figure, and no dynamic or safety factor is given.
+    pub figures_partial: bool,
     pub samples: Vec<DynamicsSampleOutput>,
     pub shapes: Vec<DynamicsShapeOutput>,
     pub slack_events: Vec<SlackEventOutput>,
@@ -365,10 +382,16 @@ pub struct DynamicsResponse {
     pub peak_tension_time_s: f64,
     /// Lowest aerostat altitude among the samples (m).
     pub min_aerostat_altitude_m: f64,
+    /// The fixed point where `probe_wind_m_s` is read: height above the
+    /// winch and distance downwind of it (m).
+    pub wind_probe_height_m: f64,
+    pub wind_probe_downwind_m: f64,
     pub quasi_static: QuasiStaticOutput,
-    /// Peak winch tension / static winch tension at the largest wind; null without it.
+    /// Peak winch tension / static winch tension at the largest wind; null
+    /// without it, or when the run did not complete (`figures_partial`).
     pub dynamic_factor_nondim: Option<f64>,
-    /// Breaking strength / peak tension; null without a breaking strength.
+    /// Breaking strength / peak tension; null without a breaking strength,
+    /// or when the run did not complete.
     pub safety_factor_nondim: Option<f64>,
     pub required_safety_factor_nondim: f64,
     /// Whether the safety factor meets the required one; null without a breaking strength.

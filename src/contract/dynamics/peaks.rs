@@ -232,6 +232,7 @@ impl DynamicsPeaksRequest {
             sample_count: count,
             shape_count: Some(0),
             shape_times_s: None,
+            wind_probe_height_m: None,
             internal_damping_n_s: self.internal_damping_n_s,
             tangential_drag_coefficient_nondim: self.tangential_drag_coefficient_nondim,
             numerics: self.numerics.clone(),

@@ -168,14 +168,20 @@ pub fn response(req: &DynamicsRequest, prepared: &Prepared, ran: &Ran) -> Dynami
         }
         Outcome::NewtonFailed { time_s } => (DynamicsOutcomeOutput::NewtonFailed, time_s),
         Outcome::Diverged { time_s } => (DynamicsOutcomeOutput::Diverged, time_s),
+        Outcome::AerostatBelowWinch { time_s, .. } => {
+            (DynamicsOutcomeOutput::AerostatBelowWinch, time_s)
+        }
     };
+    // A run that did not complete gives no final figure.
+    let partial = outcome != DynamicsOutcomeOutput::Completed;
     let peak = run.peak_winch_tension.value;
     let dynamic_factor = at_max
         .as_ref()
-        .filter(|e| e.winch_tension_n > 0.0)
+        .filter(|e| e.winch_tension_n > 0.0 && !partial)
         .map(|e| peak / e.winch_tension_n);
     let safety = prepared
         .breaking_strength_n
+        .filter(|_| !partial)
         .map(|b| b / run.peak_tension.value);
     let min_altitude = run
         .samples
@@ -205,6 +211,7 @@ pub fn response(req: &DynamicsRequest, prepared: &Prepared, ran: &Ran) -> Dynami
     DynamicsResponse {
         outcome,
         stopped_at_s,
+        figures_partial: partial,
         samples: run
             .samples
             .iter()
@@ -216,6 +223,7 @@ pub fn response(req: &DynamicsRequest, prepared: &Prepared, ran: &Ran) -> Dynami
                 aerostat_downwind_m: s.aerostat_downwind_m,
                 tether_length_m: s.length_m,
                 aerostat_wind_m_s: s.aerostat_wind_m_s,
+                probe_wind_m_s: s.probe_wind_m_s,
             })
             .collect(),
         shapes: run
@@ -251,6 +259,8 @@ pub fn response(req: &DynamicsRequest, prepared: &Prepared, ran: &Ran) -> Dynami
         peak_tension_n: run.peak_tension.value,
         peak_tension_time_s: run.peak_tension.time_s,
         min_aerostat_altitude_m: min_altitude,
+        wind_probe_height_m: run.wind_probe[1],
+        wind_probe_downwind_m: run.wind_probe[0],
         quasi_static,
         dynamic_factor_nondim: dynamic_factor,
         safety_factor_nondim: safety,
@@ -279,19 +289,26 @@ fn explain(
     outcome: DynamicsOutcomeOutput,
     stopped_at_s: f64,
 ) -> String {
-    let mut s = format!(
+    let mut s = String::new();
+    if outcome != DynamicsOutcomeOutput::Completed {
+        s.push_str(&format!(
+            "The run did not complete (it stopped at t = {stopped_at_s:.2} s, reason below): the figures cover 0–{stopped_at_s:.2} s only and are not final; no dynamic or safety factor is given. "
+        ));
+    }
+    s.push_str(&format!(
         "From rest at {:.1} N winch tension, the winch tension peaked at {:.1} N (t = {:.2} s) and fell to {:.1} N (t = {:.2} s).",
         qs.start_winch_tension_n,
         run.peak_winch_tension.value,
         run.peak_winch_tension.time_s,
         run.min_winch_tension.value,
         run.min_winch_tension.time_s
-    );
+    ));
     match (qs.winch_tension_at_max_wind_n, factor) {
         (Some(t), Some(f)) => s.push_str(&format!(
             " The static tension at the largest wind ({:+.2} m/s) is {t:.1} N: the dynamic peak is {f:.3} times it.",
             qs.max_wind_change_m_s
         )),
+        (Some(_), None) => {}
         _ => s.push_str(" No static equilibrium was found at the largest wind."),
     }
     if !run.slack_events.is_empty() {
@@ -308,6 +325,9 @@ fn explain(
         )),
         DynamicsOutcomeOutput::Diverged => s.push_str(&format!(
             " The run stopped at t = {stopped_at_s:.2} s: the state became non-finite."
+        )),
+        DynamicsOutcomeOutput::AerostatBelowWinch => s.push_str(&format!(
+            " The run stopped at t = {stopped_at_s:.2} s: the aerostat went below the winch, which no real tether does (the model has no ground); the state left the physical."
         )),
     }
     s

@@ -184,6 +184,17 @@ impl DynamicsRequest {
                 time("start_time_s", start_time_s)?;
                 span("duration_s", duration_s)?;
                 require_range(&at("amplitude_m_s"), amplitude_m_s, -100.0, false, 100.0)?;
+                // A gust shorter than the steps falls between them: the run
+                // would never see the wind it is compared with.
+                if duration_s < 4.0 * time_step_s {
+                    return Err(InvalidInput::new(
+                        at("duration_s"),
+                        format!(
+                            "must be at least four time steps ({} s) for the gust to be resolved, got {duration_s}",
+                            4.0 * time_step_s
+                        ),
+                    ));
+                }
             }
             Some(TimeHistoryInput::Sinusoid {
                 amplitude_m_s,
@@ -435,6 +446,10 @@ impl DynamicsRequest {
             spectral_radius: rho_inf,
             sample_interval_s: sample_interval,
             shape_times_s: shape_times,
+            wind_probe_height_m: self
+                .wind_probe_height_m
+                .map(|z| require_range("wind_probe_height_m", z, 0.0, false, 30_000.0))
+                .transpose()?,
             ..DynamicsConfig::default()
         };
         Ok(Prepared {

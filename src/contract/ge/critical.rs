@@ -404,6 +404,7 @@ pub fn prepare_critical(
             ),
         ));
     }
+    check_bending_while_moving(&p.model, &profile, horizon, p.initial_length_m)?;
     let problem = CriticalProblem {
         profile,
         net_buoyancy_n: p.net_buoyancy_n,
@@ -412,6 +413,48 @@ pub fn prepare_critical(
         start: req.start_state.into(),
     };
     Ok((p.model, problem, config))
+}
+
+/// Refuses a cable whose bending stiffness the payout cancels: on the
+/// moving mesh the rotary inertia of the material sliding through the
+/// guide enters as `EI − I_ρ v²`, and where that is not positive the
+/// bending equation is ill-posed (every short wave grows at once; the
+/// spectrum of the start state is not finite). `I_ρ = A_ρ L0²/γ̃`.
+fn check_bending_while_moving(
+    model: &GeModel,
+    profile: &crate::numerics::profile::Profile,
+    horizon_s: f64,
+    initial_length_m: f64,
+) -> Result<(), InvalidInput> {
+    let n = 2048;
+    let fastest = (0..=n)
+        .map(|i| {
+            profile
+                .kinematics(horizon_s * i as f64 / n as f64)
+                .rate_m_s
+                .abs()
+        })
+        .fold(0.0f64, f64::max);
+    let s = &model.section;
+    let ei = s.bending_stiffness_n_m2;
+    let inertia_term = s.rotary_inertia_kg_m * fastest * fastest;
+    if inertia_term >= ei {
+        let least =
+            s.mass_per_length_kg_m * initial_length_m * initial_length_m * fastest * fastest / ei;
+        return Err(InvalidInput::new(
+            "model.inertia_ratio",
+            format!(
+                "makes the rotary inertia I_ρ = A_ρ L0²/γ̃ = {:.4e} kg m, so at the profile's fastest rate {fastest:.4} m/s \
+                 I_ρ v² = {inertia_term:.4e} N m² is not below the bending stiffness EI = {ei:.4e} N m²: the bending \
+                 stiffness of the paying-out cable, EI − I_ρ v² = {:.4e} N m², is not positive and the model is ill-posed \
+                 (every short bending wave grows at once). Give an inertia_ratio above A_ρ L0² v²/EI = {least:.4e}, \
+                 or omit it to use the solid section of cable.diameter_m",
+                s.rotary_inertia_kg_m,
+                ei - inertia_term,
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Runs a GE critical-time search; `progress.cancelled()` stops it.

@@ -8,11 +8,11 @@
 //! ([`model::IterationMatrix`]); one block-tridiagonal solve. No work array
 //! is allocated after the start.
 
-use super::MAX_HALVINGS;
 use super::blocks::{V2, add_identity};
+use super::limits::MAX_HALVINGS;
 use super::model::{self, Evaluation, IterationMatrix, NoJacobian, Parameters, evaluate_with};
 use super::problem::LengthSchedule;
-use super::run::Statistics;
+use super::state::Statistics;
 use super::wind::{GustHistory, TurbulenceField};
 use crate::numerics::tether::wind::WindProfile;
 
@@ -79,6 +79,15 @@ impl AirAt<'_> {
     }
 }
 
+/// How one try of a step ended.
+enum Try {
+    Accepted,
+    /// Newton failed.
+    Failed,
+    /// A segment changed between slack and taut: retry in halves.
+    Refine,
+}
+
 /// The integrator and its work arrays.
 pub(super) struct Stepper<'a> {
     pub p: Parameters,
@@ -99,6 +108,10 @@ pub(super) struct Stepper<'a> {
     rhs: Vec<V2>,
     /// `θ`, the contraction of the last Newton iteration that measured one.
     contraction: f64,
+    /// Which segments were taut at the last accepted step (its α-point).
+    taut: Vec<bool>,
+    /// Until when steps are refined after a rate jump (s).
+    fine_until_s: f64,
     pub stats: Statistics,
 }
 
@@ -133,6 +146,8 @@ impl<'a> Stepper<'a> {
             matrix: IterationMatrix::new(n),
             rhs: vec![[0.0; 2]; n],
             contraction: 1.0,
+            taut: vec![true; n],
+            fine_until_s: f64::NEG_INFINITY,
             stats: Statistics::default(),
             p,
         }
@@ -162,6 +177,44 @@ impl<'a> Stepper<'a> {
             let f = self.ev.force[k];
             self.a[k] = [f[0] / m, f[1] / m];
         }
+        for (taut, &t) in self.taut.iter_mut().zip(&self.ev.tension) {
+            *taut = t > 0.0;
+        }
+    }
+
+    /// Carries the state through a jump of the winch rate at `self.t`
+    /// from `rate_before` to the schedule's rate now (a stop, a start, a
+    /// rate table's step). The material velocity `V = Ṙ + ζ̇ R_ζ` is
+    /// continuous through it (material does not change its velocity
+    /// because the winch did), but `ζ̇ = (1 − ζ) L̇/L` jumps, so the mesh
+    /// velocities jump by `ΔṘ = −(1 − ζ) ΔL̇/L R_ζ`: the impulse of the
+    /// convective term `−ζ̈ R_ζ` whose `L̈` is a Dirac `ΔL̇ δ(t)` that no
+    /// finite step sees. Only the material at the winch takes the new
+    /// rate (`V_0 = L̇ (1 + ε_1) t_1`), so a stop sends a tension wave up
+    /// the tether and the slack and snap that follow it. The acceleration
+    /// is then made consistent with the new state (`M a = P`), the
+    /// generalized-α method restarting as from an initial condition.
+    pub fn rate_jump(&mut self, rate_before_m_s: f64) {
+        let now = self.schedule.at(self.t);
+        let jump = now.rate_m_s - rate_before_m_s;
+        let n = self.p.segments;
+        if jump != 0.0 {
+            let dz = 1.0 / n as f64;
+            let x = &self.x;
+            let node = |i: usize| if i == 0 { [0.0; 2] } else { x[i - 1] };
+            for i in 1..n {
+                let zeta = i as f64 * dz;
+                let c = -(1.0 - zeta) * jump / now.length_m * 0.5 / dz;
+                let (rp, rm) = (node(i + 1), node(i - 1));
+                self.v[i - 1][0] += c * (rp[0] - rm[0]);
+                self.v[i - 1][1] += c * (rp[1] - rm[1]);
+            }
+            self.stats.rate_jumps += 1;
+            // The wave the jump sends is followed for two round trips.
+            let c = (self.p.axial_stiffness_n / self.p.mass_per_length_kg_m).sqrt();
+            self.fine_until_s = self.t + 4.0 * now.length_m / c;
+        }
+        self.initial_acceleration();
     }
 
     /// One step of `h`; `false` if Newton failed (the state is unchanged).
@@ -174,7 +227,7 @@ impl<'a> Stepper<'a> {
     /// below the tolerance. The first iteration of a step uses the last
     /// measured `θ`, raised to the power 0.8 (their safeguard), so a step
     /// whose predictor is already close costs one iteration, not two.
-    fn try_step(&mut self, h: f64) -> bool {
+    fn try_step(&mut self, h: f64) -> Try {
         let Alpha {
             am,
             af,
@@ -196,12 +249,17 @@ impl<'a> Stepper<'a> {
             rhs,
             stats,
             contraction,
+            taut,
             ..
         } = self;
         let n = p.segments;
         an.copy_from_slice(a);
         let ta = self.t + (1.0 - af) * h;
         let len = schedule.at(ta);
+        let refine_above = 2.0 * Self::shortest_step_of(p, len.length_m);
+        if self.t < self.fine_until_s && h > refine_above {
+            return Try::Refine;
+        }
         let air_at = air.at(ta);
         let wind = |x: f64, z: f64| air_at.speed(x, z);
         // R_{n+1−α_f} = R_n + (1 − α_f)(h Ṙ_n + h²((½ − β) a_n + β a_{n+1})), likewise Ṙ.
@@ -237,7 +295,7 @@ impl<'a> Stepper<'a> {
                 add_identity(&mut matrix.diag[k], (1.0 - am) * m);
             }
             if !model::solve_tridiagonal(&matrix.lower, &mut matrix.diag, &matrix.upper, rhs) {
-                return false;
+                return Try::Failed;
             }
             let mut big2 = 0.0f64;
             for (an, d) in an.iter_mut().zip(rhs.iter()) {
@@ -246,7 +304,7 @@ impl<'a> Stepper<'a> {
                 big2 = big2.max(d[0] * d[0] + d[1] * d[1]);
             }
             if !big2.is_finite() {
-                return false;
+                return Try::Failed;
             }
             let delta = big2.sqrt() * gamma * h;
             if it > 0 && last > 0.0 {
@@ -257,6 +315,22 @@ impl<'a> Stepper<'a> {
             let converged =
                 delta <= self.tol || (theta < 1.0 && theta / (1.0 - theta) * delta <= self.tol);
             if converged {
+                // A segment that went slack or snapped taut within the step:
+                // the force changed its law inside it, which a step longer
+                // than the snap does not follow (the energy of such steps is
+                // not bounded: the 1000 m tether stopped at 2 m/s gained
+                // meganewtons). Such steps are refined to the snap's time.
+                if h > refine_above
+                    && ev.tension[..n]
+                        .iter()
+                        .zip(taut.iter())
+                        .any(|(&t, &was)| (t > 0.0) != was)
+                {
+                    return Try::Refine;
+                }
+                for (was, &t) in taut.iter_mut().zip(&ev.tension) {
+                    *was = t > 0.0;
+                }
                 let (ha, hn) = (h * h * (0.5 - beta), h * h * beta);
                 let (ga, gn) = (h * (1.0 - gamma), h * gamma);
                 for (((x, v), a), an) in x.iter_mut().zip(v.iter_mut()).zip(a.iter()).zip(an.iter())
@@ -268,22 +342,42 @@ impl<'a> Stepper<'a> {
                 }
                 a.copy_from_slice(an);
                 self.t += h;
-                return true;
+                return Try::Accepted;
             }
         }
-        false
+        Try::Failed
     }
 
-    /// A step of `h`, halving on failure.
+    /// The shortest step a slack–taut change refines to (s): a sixteenth
+    /// of the period `2π l/c` of one segment's axial vibration
+    /// (`c = √(EA/ρA)`, `l = L/N`), the time over which a slack segment
+    /// snaps taut.
+    pub fn shortest_step_of(p: &Parameters, length_m: f64) -> f64 {
+        let l = length_m / p.segments as f64;
+        let c = (p.axial_stiffness_n / p.mass_per_length_kg_m).sqrt();
+        2.0 * std::f64::consts::PI * l / c / 16.0
+    }
+
+    /// A step of `h`, halving on failure (at most [`MAX_HALVINGS`] times)
+    /// and where a segment changes between slack and taut (down to
+    /// [`Self::shortest_step_s`]).
     pub fn step(&mut self, h: f64, depth: usize) -> bool {
-        if self.try_step(h) {
-            self.stats.steps += 1;
-            return true;
+        match self.try_step(h) {
+            Try::Accepted => {
+                self.stats.steps += 1;
+                true
+            }
+            Try::Refine => {
+                self.stats.refinements += 1;
+                self.step(0.5 * h, depth) && self.step(0.5 * h, depth)
+            }
+            Try::Failed => {
+                if depth >= MAX_HALVINGS {
+                    return false;
+                }
+                self.stats.halvings += 1;
+                self.step(0.5 * h, depth + 1) && self.step(0.5 * h, depth + 1)
+            }
         }
-        if depth >= MAX_HALVINGS {
-            return false;
-        }
-        self.stats.halvings += 1;
-        self.step(0.5 * h, depth + 1) && self.step(0.5 * h, depth + 1)
     }
 }

@@ -45,12 +45,14 @@
 
 pub mod blocks;
 mod integrator;
+mod limits;
 pub mod model;
 mod outputs;
 mod problem;
 pub mod reference;
 mod run;
 mod start;
+mod state;
 pub mod wind;
 
 pub use outputs::{Extreme, Sample, Shape, ShapeNode, SlackEvent};
@@ -63,19 +65,9 @@ pub use run::{
 pub use start::{StaticStart, static_start};
 pub use wind::{GustHistory, SpectrumModel, Turbulence, TurbulenceField};
 
-/// Fewest and most segments.
-pub const MIN_SEGMENTS: usize = 2;
-pub const MAX_SEGMENTS: usize = 2000;
-/// Most time steps of one run.
-pub const MAX_STEPS: usize = 20_000_000;
-/// Most `steps × segments` of one run.
-pub const MAX_WORK: f64 = 2e9;
-/// Most halvings of a step whose Newton iteration fails.
-pub const MAX_HALVINGS: usize = 6;
-/// Most samples one run keeps.
-pub const MAX_SAMPLES: usize = 200_000;
-/// Most shapes one run keeps.
-pub const MAX_SHAPES: usize = 1000;
+pub use limits::{
+    MAX_HALVINGS, MAX_SAMPLES, MAX_SEGMENTS, MAX_SHAPES, MAX_STEPS, MAX_WORK, MIN_SEGMENTS,
+};
 
 #[cfg(test)]
 mod tests {

@@ -20,6 +20,8 @@ pub struct Sample {
     pub length_m: f64,
     /// Wind at the aerostat (m/s).
     pub aerostat_wind_m_s: f64,
+    /// Wind at the fixed probe point ([`super::Run::wind_probe`]) (m/s).
+    pub probe_wind_m_s: f64,
 }
 
 /// One node of a kept shape.
@@ -72,10 +74,18 @@ pub(super) struct Recorder {
     next_shape: usize,
     /// Half the step: a shape is kept at the step nearest its time.
     half_step_s: f64,
+    /// The fixed point where the wind is probed `(x, z)` (m).
+    probe: V2,
 }
 
 impl Recorder {
-    pub fn new(t0: f64, sample_interval_s: f64, shape_times_s: &[f64], step_s: f64) -> Self {
+    pub fn new(
+        t0: f64,
+        sample_interval_s: f64,
+        shape_times_s: &[f64],
+        step_s: f64,
+        probe: V2,
+    ) -> Self {
         let mut shape_times = shape_times_s.to_vec();
         shape_times.sort_by(f64::total_cmp);
         let start = |value: f64| Extreme { value, time_s: t0 };
@@ -91,6 +101,7 @@ impl Recorder {
             shape_times,
             next_shape: 0,
             half_step_s: 0.5 * step_s,
+            probe,
         }
     }
 
@@ -156,6 +167,7 @@ impl Recorder {
                 aerostat_downwind_m: top[0],
                 length_m: len.length_m,
                 aerostat_wind_m_s: air.speed(top[0], top[1]),
+                probe_wind_m_s: air.speed(self.probe[0], self.probe[1]),
             });
             while self.next_sample <= t + eps {
                 self.next_sample += self.sample_interval_s;

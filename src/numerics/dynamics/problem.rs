@@ -4,9 +4,9 @@
 //! ([`DynamicsConfig`]); and their checks (fields named as in the JSON
 //! contract).
 
+use super::limits::{MAX_SAMPLES, MAX_SEGMENTS, MAX_SHAPES, MAX_STEPS, MAX_WORK, MIN_SEGMENTS};
 use super::model::{Length, Parameters};
 use super::wind::{GustHistory, Turbulence};
-use super::{MAX_SAMPLES, MAX_SEGMENTS, MAX_SHAPES, MAX_STEPS, MAX_WORK, MIN_SEGMENTS};
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 use crate::numerics::profile::Profile;
 use crate::numerics::tether::equilibrium::{Body, Cable, EquilibriumProblem};
@@ -78,6 +78,32 @@ impl LengthSchedule {
         }
     }
 
+    /// The times in `(0, until]` at which the rate or the acceleration may
+    /// jump (a profile's stop, a rate table's knots), increasing: the run
+    /// steps onto each (see `Stepper::rate_jump`).
+    pub fn breakpoints_s(&self, until_s: f64) -> Vec<f64> {
+        let Self::Profile(p) = self else {
+            return vec![];
+        };
+        let mut times: Vec<f64> = match p {
+            Profile::Trapezoidal { schedule, .. }
+            | Profile::PiecewiseLinearRate { schedule, .. } => schedule.knot_times_s().to_vec(),
+            _ => vec![],
+        };
+        times.extend(p.stop_time_s());
+        times.retain(|t| t.is_finite() && *t > 0.0 && *t <= until_s);
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
+
+    /// The rate just before `t` (m/s): the left limit at a breakpoint.
+    pub fn rate_before_m_s(&self, t_s: f64) -> f64 {
+        let dt = 1e-9 * t_s.abs().max(1.0);
+        let k = self.at(t_s - dt);
+        k.rate_m_s + k.acceleration_m_s2 * dt
+    }
+
     /// The longest length over `[0, until]` (sampled; profiles are monotone between knots).
     pub fn longest_m(&self, until_s: f64) -> f64 {
         (0..=512)
@@ -130,6 +156,10 @@ pub struct DynamicsConfig {
     pub turbulence_time_step_s: f64,
     /// Level spacing of a turbulence field (m), at most.
     pub turbulence_level_spacing_m: f64,
+    /// Height of the fixed point where the wind is probed (m), above the
+    /// aerostat's starting station downwind; `None`: the aerostat's
+    /// starting altitude.
+    pub wind_probe_height_m: Option<f64>,
 }
 
 impl Default for DynamicsConfig {
@@ -145,6 +175,7 @@ impl Default for DynamicsConfig {
             max_newton_iterations: 30,
             turbulence_time_step_s: 0.2,
             turbulence_level_spacing_m: 50.0,
+            wind_probe_height_m: None,
         }
     }
 }

@@ -8,43 +8,10 @@ use super::model::{Evaluation, Length, Parameters};
 use super::outputs::{Extreme, Recorder, Sample, Shape, SlackEvent};
 use super::problem::{DynamicsConfig, DynamicsError, DynamicsProblem, validate_config};
 use super::start::static_start;
+pub use super::state::{Outcome, State, Statistics};
 use super::wind::{self, TurbulenceField};
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::equilibrium::Equilibrium;
-
-/// Nodal positions and velocities (nodes `1 … N`; the winch is the origin).
-#[derive(Clone, Debug, PartialEq)]
-pub struct State {
-    pub time_s: f64,
-    pub positions: Vec<V2>,
-    pub velocities: Vec<V2>,
-}
-
-/// How a run ended.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Outcome {
-    Completed,
-    /// Newton failed even on the smallest sub-step.
-    NewtonFailed {
-        time_s: f64,
-    },
-    /// A non-finite state.
-    Diverged {
-        time_s: f64,
-    },
-    /// The observer asked to stop.
-    Stopped {
-        time_s: f64,
-    },
-}
-
-/// Counters.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
-pub struct Statistics {
-    pub steps: usize,
-    pub newton_iterations: usize,
-    pub halvings: usize,
-}
 
 /// The answer of a run.
 #[derive(Clone, Debug, PartialEq)]
@@ -61,6 +28,8 @@ pub struct Run {
     pub peak_tension: Extreme,
     pub final_state: State,
     pub statistics: Statistics,
+    /// The fixed point `(x, z)` where [`Sample::probe_wind_m_s`] is read (m).
+    pub wind_probe: V2,
 }
 
 /// What an observer sees after every accepted step.
@@ -136,7 +105,18 @@ pub fn simulate_from(
         .ceil()
         .max(1.0) as usize;
     let h = config.duration_s / steps as f64;
-    let mut rec = Recorder::new(st.t, config.sample_interval_s, &config.shape_times_s, h);
+    let start_top = st.x[n - 1];
+    let wind_probe = [
+        start_top[0],
+        config.wind_probe_height_m.unwrap_or(start_top[1]),
+    ];
+    let mut rec = Recorder::new(
+        st.t,
+        config.sample_interval_s,
+        &config.shape_times_s,
+        h,
+        wind_probe,
+    );
     let mut outcome = Outcome::Completed;
 
     // The initial evaluation (by `initial_acceleration`) is of the start state.
@@ -148,13 +128,54 @@ pub fn simulate_from(
         &air.at(st.t),
         false,
     );
-    for i in 0..steps {
-        if !st.step(h, 0) {
-            outcome = Outcome::NewtonFailed { time_s: st.t };
-            break;
-        }
-        if st.x.iter().any(|r| !(r[0].is_finite() && r[1].is_finite())) {
-            outcome = Outcome::Diverged { time_s: st.t };
+    let t0 = st.t;
+    // Where the winch rate or acceleration jumps: stepped onto exactly.
+    let breaks = problem.length.breakpoints_s(t0 + config.duration_s);
+    let mut next_break = breaks.partition_point(|&b| b <= t0 + 1e-9 * h);
+    // A sub-step shorter than this is not taken: the jump is moved onto
+    // the grid (the velocity jump is applied exactly either way).
+    let shortest = 1e-6 * h;
+    'steps: for i in 0..steps {
+        let t_end = t0 + (i + 1) as f64 * h;
+        loop {
+            let brk = breaks
+                .get(next_break)
+                .copied()
+                .filter(|&b| b <= t_end + shortest);
+            let target = match brk {
+                Some(b) if b < t_end - shortest => b,
+                _ => t_end,
+            };
+            if target - st.t > shortest {
+                if !st.step(target - st.t, 0) {
+                    outcome = Outcome::NewtonFailed { time_s: st.t };
+                    break 'steps;
+                }
+                st.t = target;
+                if let Some(o) = unphysical(&st.x, st.t) {
+                    outcome = o;
+                    break 'steps;
+                }
+            }
+            match brk {
+                Some(b) => {
+                    st.rate_jump(problem.length.rate_before_m_s(b));
+                    next_break += 1;
+                    if target < t_end {
+                        // Every state the run passes through is checked.
+                        rec.record(
+                            st.t,
+                            st.schedule.at(st.t),
+                            &st.x,
+                            &st.ev,
+                            &air.at(st.t),
+                            false,
+                        );
+                        continue;
+                    }
+                }
+                None => {}
+            }
             break;
         }
         // Outputs from the state at the step's end.
@@ -184,6 +205,7 @@ pub fn simulate_from(
         min_winch_tension: rec.min_winch,
         peak_tension: rec.peak,
         statistics: st.stats,
+        wind_probe,
         final_state: State {
             time_s: st.t,
             positions: st.x,
@@ -200,4 +222,17 @@ pub fn aerostat(view: &StepView) -> V2 {
 /// `|a|` re-exported for tests.
 pub fn magnitude(v: V2) -> f64 {
     norm(v)
+}
+
+/// Whether the state has left the physical: a non-finite position, or the
+/// aerostat below the winch (the model has no ground).
+fn unphysical(x: &[V2], t: f64) -> Option<Outcome> {
+    if x.iter().any(|r| !(r[0].is_finite() && r[1].is_finite())) {
+        return Some(Outcome::Diverged { time_s: t });
+    }
+    let top = x[x.len() - 1];
+    (top[1] < 0.0).then_some(Outcome::AerostatBelowWinch {
+        time_s: t,
+        altitude_m: top[1],
+    })
 }

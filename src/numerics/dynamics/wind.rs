@@ -35,6 +35,23 @@
 //! The band `[1/T_p, 1/(2Δt_w)]` holds all but the spectrum's tails (the
 //! measured variance is checked against it in the tests).
 //!
+//! **Between levels.** Read linearly between two levels alone, a point
+//! mid-way would keep only `(1 + ρ)/2` of the power at frequencies whose
+//! coherence `ρ` across the cell is small (the turbulence the tether
+//! answers to, 0.03–0.3 Hz, lost a third of its energy that way). Each
+//! cell `k` (levels `k`, `k + 1`) therefore carries a third series `η_k`,
+//! independent of the levels, of spectrum `S̄ (1 − ρ_k)` (`S̄` at the
+//! cell's mean speed), and a point at the fraction `φ` of the cell reads
+//!
+//! ```text
+//! u′ = (1 − φ) u′_k + φ u′_{k+1} + √(2 φ (1 − φ)) η_k
+//! ```
+//!
+//! whose spectrum is `S ((1 − φ)² + φ² + 2 φ (1 − φ) ρ + 2 φ (1 − φ)(1 − ρ)) = S`
+//! at every frequency and height, continuous across the levels. The series
+//! are linear between samples in time, which keeps `1 − (1 − cos 2πfΔt_w)/3`
+//! of the power at `f`; the synthesised spectrum is raised by its inverse.
+//!
 //! **Frozen and carried downwind** (Taylor): `u′(x, z, t) = u′_z(t − x/U_c)`
 //! with `U_c` the mean speed at the aerostat's initial altitude; the series
 //! is periodic in `T_p ≥ duration + x_max/U_c`, linear in `t` and `z`
@@ -235,6 +252,9 @@ pub struct TurbulenceField {
     inv_convection: f64,
     /// Level-major.
     data: Vec<f64>,
+    /// The cells' independent series `η_k` (cell `k` between levels `k`
+    /// and `k + 1`), cell-major.
+    cells: Vec<f64>,
 }
 
 impl TurbulenceField {
@@ -285,7 +305,13 @@ impl TurbulenceField {
         let half = 1.0 / 2f64.sqrt();
         let mut chain = vec![(0.0f64, 0.0f64); m / 2];
         let mut data = vec![0.0; levels * m];
+        let mut cells = vec![0.0; (levels - 1) * m];
         let mut buf = vec![(0.0, 0.0); m];
+        // Linear interpolation in time between samples `Δt_w` apart keeps
+        // `1 − (1 − cos 2πfΔt_w)/3` of the power at `f` (averaged over
+        // where in the interval the series is read): the synthesised
+        // spectrum is raised by its inverse so the wind read is the model's.
+        let emphasis = |f: f64| 1.0 / (1.0 - (1.0 - (2.0 * PI * f * grid.time_step_s).cos()) / 3.0);
         for k in 0..levels {
             let u = speeds[k];
             let ubar = if k > 0 {
@@ -312,7 +338,10 @@ impl TurbulenceField {
                 chain[j] = (gr, gi);
                 let amp = if u > 1e-6 && t.intensity > 0.0 {
                     // a_m cos + b_m sin with a, b ~ N(0, S Δf): coefficient a − i b.
-                    (2.0 * t.model.density(f, t.intensity * u, t.length_scale_m, u) * df).sqrt()
+                    (2.0 * t.model.density(f, t.intensity * u, t.length_scale_m, u)
+                        * df
+                        * emphasis(f))
+                    .sqrt()
                 } else {
                     0.0
                 };
@@ -320,6 +349,29 @@ impl TurbulenceField {
             }
             fft_in_place(&mut buf, 1.0);
             for (d, c) in data[k * m..(k + 1) * m].iter_mut().zip(&buf) {
+                *d = c.0;
+            }
+            if k == 0 {
+                continue;
+            }
+            // The cell below level k: η with S̄ (1 − ρ), independent of the levels.
+            let cell = k - 1;
+            buf.iter_mut().for_each(|c| *c = (0.0, 0.0));
+            if ubar > 1e-6 && t.intensity > 0.0 {
+                for j in 1..m / 2 {
+                    let f = j as f64 * df;
+                    let rho = (-DAVENPORT_DECAY * f * dz / ubar).exp();
+                    let xr = normal(j as u64, (2 * (MAX_LEVELS + cell)) as u64) * half;
+                    let xi = normal(j as u64, (2 * (MAX_LEVELS + cell) + 1) as u64) * half;
+                    let s = t
+                        .model
+                        .density(f, t.intensity * ubar, t.length_scale_m, ubar);
+                    let amp = (2.0 * s * (1.0 - rho) * df * emphasis(f)).sqrt();
+                    buf[j] = (amp * xr, -amp * xi);
+                }
+                fft_in_place(&mut buf, 1.0);
+            }
+            for (d, c) in cells[cell * m..(cell + 1) * m].iter_mut().zip(&buf) {
                 *d = c.0;
             }
         }
@@ -333,6 +385,7 @@ impl TurbulenceField {
             inv_dz: 1.0 / dz,
             inv_convection: 1.0 / grid.convection_m_s,
             data,
+            cells,
         })
     }
 
@@ -344,6 +397,11 @@ impl TurbulenceField {
     /// The series at level `k` (for tests).
     pub fn level(&self, k: usize) -> &[f64] {
         &self.data[k * self.samples..(k + 1) * self.samples]
+    }
+
+    /// The series `η_k` of the cell between levels `k` and `k + 1` (for tests).
+    pub fn cell(&self, k: usize) -> &[f64] {
+        &self.cells[k * self.samples..(k + 1) * self.samples]
     }
 
     /// Level spacing (m).
@@ -381,7 +439,9 @@ impl TurbulenceField {
         let (b0, b1) = (a[self.samples + i0], a[self.samples + i1]);
         let va = a0 + frac * (a1 - a0);
         let vb = b0 + frac * (b1 - b0);
-        va + fz * (vb - va)
+        let c = &self.cells[k0 * self.samples..(k0 + 1) * self.samples];
+        let eta = c[i0] + frac * (c[i1] - c[i0]);
+        va + fz * (vb - va) + (2.0 * fz * (1.0 - fz)).sqrt() * eta
     }
 }
 
@@ -477,7 +537,8 @@ mod tests {
             let k0 = (zk.floor() as usize).min(3);
             let fz = zk - k0 as f64;
             let at = |k: usize| f.level(k)[i0] + fr * (f.level(k)[i1] - f.level(k)[i0]);
-            at(k0) + fz * (at(k0 + 1) - at(k0))
+            let eta = f.cell(k0)[i0] + fr * (f.cell(k0)[i1] - f.cell(k0)[i0]);
+            at(k0) + fz * (at(k0 + 1) - at(k0)) + (2.0 * fz * (1.0 - fz)).sqrt() * eta
         };
         for &(x, z, tt) in &[
             (0.0, 0.0, 0.0),

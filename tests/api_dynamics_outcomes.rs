@@ -1,0 +1,119 @@
+//! A dynamic answer is right or says why it is not (issue 31, item 8 of
+//! issue 34): a run that did not complete gives no final figure (no
+//! dynamic or safety factor, `figures_partial`), a gust shorter than the
+//! steps is refused naming its field, a winch stop is followed to the end,
+//! and the fixed wind probe is in every sample.
+
+use serde_json::{Value, json};
+use tetherplan::contract::RequestError;
+use tetherplan::contract::dynamics::{dynamics, parse_dynamics};
+use tetherplan::contract::run::NoProgress;
+
+/// The §10 tether (EA 1e7 N, no damping) under F 1000 N, 10 kg, C_D 0.3 on 20 m².
+fn request(extra: Value) -> Value {
+    let mut v = json!({
+        "cable": {"mass_per_length_kg_m": 0.078, "diameter_m": 0.005,
+                  "normal_drag_coefficient_nondim": 1.2, "axial_stiffness_n": 1.0e7},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.3,
+                     "reference_area_m2": 20.0},
+        "wind": {"flow": {"kind": "uniform", "speed_m_s": 8.0}},
+        "tether_length_m": 1000.0,
+        "duration_s": 20.0,
+        "sample_count": 21,
+        "shape_count": 0
+    });
+    for (k, x) in extra.as_object().unwrap() {
+        v[k] = x.clone();
+    }
+    v
+}
+
+fn answer(v: &Value) -> Result<Value, RequestError> {
+    let req = parse_dynamics(v.to_string().as_bytes())?;
+    Ok(serde_json::to_value(dynamics(&req, &NoProgress)?).unwrap())
+}
+
+/// `internal_damping_n_s: 1e12` (before: `newton_failed` with a dynamic
+/// factor 45.5): whatever the outcome, a run that did not complete has
+/// `figures_partial` and no dynamic or safety factor; one that completed
+/// has them.
+#[test]
+fn a_run_that_did_not_complete_gives_no_final_figure() {
+    let mut v = request(json!({"internal_damping_n_s": 1e12}));
+    v["wind"]["time_history"] = json!({"kind": "step", "time_s": 1.0, "speed_m_s": 12.0});
+    let a = answer(&v).unwrap();
+    println!(
+        "outcome {}, stopped at {}, partial {}, factor {}",
+        a["outcome"], a["stopped_at_s"], a["figures_partial"], a["dynamic_factor_nondim"]
+    );
+    let completed = a["outcome"] == "completed";
+    assert_eq!(a["figures_partial"], json!(!completed));
+    if !completed {
+        assert!(a["dynamic_factor_nondim"].is_null());
+        assert!(a["safety_factor_nondim"].is_null());
+        assert!(
+            a["explanation"]
+                .as_str()
+                .unwrap()
+                .contains("did not complete")
+        );
+    }
+    let plain = answer(&request(json!({}))).unwrap();
+    assert_eq!(plain["outcome"], "completed");
+    assert_eq!(plain["figures_partial"], json!(false));
+    assert!(plain["dynamic_factor_nondim"].is_number());
+}
+
+/// A `1 − cos` gust of 5e-324 s (before: a dynamic factor 0.04 against a
+/// gust no step saw) is refused naming its duration.
+#[test]
+fn a_gust_shorter_than_the_steps_is_refused() {
+    let mut v = request(json!({}));
+    v["wind"]["time_history"] = json!({"kind": "one_minus_cosine", "start_time_s": 1.0, "duration_s": 5e-324, "amplitude_m_s": 6.0});
+    match answer(&v) {
+        Err(RequestError::Invalid(e)) => {
+            println!("{e}");
+            assert_eq!(e.field, "wind.time_history.duration_s");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// The case of issue 31 through the contract: paid out at 2 m/s from 200 m
+/// in calm air, stopping at 1000 m (400 s), held to 430 s: completed, the
+/// largest winch tension below 5 kN (before: 2.2e7 N and the aerostat at
+/// −107 m, "completed"), the lowest altitude above 990 m after the stop.
+/// The fixed probe reads the calm air (0 m/s) at its height.
+#[test]
+fn a_winch_stop_through_the_contract() {
+    let v = request(json!({
+        "wind": {"flow": {"kind": "uniform", "speed_m_s": 0.0}},
+        "tether_length_m": null,
+        "initial_length_m": 200.0,
+        "profile": {"kind": "constant_rate", "rate_m_s": 2.0, "target_length_m": 1000.0},
+        "duration_s": 430.0, "sample_count": 431, "wind_probe_height_m": 300.0
+    }));
+    let a = answer(&v).unwrap();
+    println!(
+        "outcome {}, peak winch {} N at {} s, slack {}",
+        a["outcome"], a["peak_winch_tension_n"], a["peak_winch_tension_time_s"], a["slack_events"]
+    );
+    assert_eq!(a["outcome"], "completed");
+    assert!(a["peak_winch_tension_n"].as_f64().unwrap() < 5000.0);
+    let lowest = a["samples"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| s["time_s"].as_f64().unwrap() >= 400.0)
+        .map(|s| s["aerostat_altitude_m"].as_f64().unwrap())
+        .fold(f64::INFINITY, f64::min);
+    assert!(lowest > 990.0, "{lowest}");
+    assert_eq!(a["wind_probe_height_m"], json!(300.0));
+    assert!(
+        a["samples"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|s| s["probe_wind_m_s"] == json!(0.0))
+    );
+}
