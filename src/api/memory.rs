@@ -39,7 +39,7 @@ pub const TRIM_EVERY: Duration = Duration::from_secs(2);
 /// runtime's threads start.
 pub fn tune_allocator() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    glibc::tune();
+    glibc::tune(ARENAS, MMAP_THRESHOLD, TRIM_THRESHOLD);
 }
 
 /// Gives the free heap back to the system now (glibc; a no-op elsewhere).
@@ -54,13 +54,13 @@ pub fn trim() -> bool {
 
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
 mod glibc {
-    pub fn tune() {
+    pub fn tune(arenas: i32, mmap_threshold: i32, trim_threshold: i32) {
         // SAFETY: mallopt only changes the allocator's parameters; called
         // before other threads allocate.
         unsafe {
-            libc::mallopt(libc::M_ARENA_MAX, super::ARENAS);
-            libc::mallopt(libc::M_MMAP_THRESHOLD, super::MMAP_THRESHOLD);
-            libc::mallopt(libc::M_TRIM_THRESHOLD, super::TRIM_THRESHOLD);
+            libc::mallopt(libc::M_ARENA_MAX, arenas);
+            libc::mallopt(libc::M_MMAP_THRESHOLD, mmap_threshold);
+            libc::mallopt(libc::M_TRIM_THRESHOLD, trim_threshold);
         }
     }
 

@@ -52,9 +52,9 @@ pub struct ForecastInput {
 
 /// `forecast.data`'s schema: an object (`open_meteo`) or a string (the
 /// text formats).
-fn data_schema() -> utoipa::openapi::schema::OneOf {
-    use utoipa::openapi::schema::{ObjectBuilder, OneOfBuilder, Type};
-    OneOfBuilder::new()
+fn data_schema() -> utoipa::openapi::schema::Schema {
+    use utoipa::openapi::schema::{ObjectBuilder, OneOfBuilder, Schema, Type};
+    Schema::OneOf(OneOfBuilder::new()
         .item(
             ObjectBuilder::new()
                 .schema_type(Type::Object)
@@ -65,7 +65,7 @@ fn data_schema() -> utoipa::openapi::schema::OneOf {
                 .schema_type(Type::String)
                 .description(Some("`metar`, `taf`, `csv`: the report's text")),
         )
-        .build()
+        .build())
 }
 
 /// One period of one member: `[start_s, end_s)`.
