@@ -47,11 +47,19 @@
     <div class="actions"><button type="submit" id="windows-button">Show the day</button></div>
     <p id="windows-error" class="error" role="alert" hidden></p>
   </form>
+  <div id="windows-job" class="job" hidden>
+    <progress id="windows-job-progress" max="1" value="0"></progress>
+    <span id="windows-job-text"></span>
+    <button type="button" id="windows-job-cancel" class="secondary">Cancel</button>
+  </div>
   <p id="windows-summary" class="note" hidden></p>
   <div id="windows-timeline" class="windows-timeline" role="list" aria-label="Forecast periods" hidden></div>
   <div id="windows-bands" class="windows-bands" aria-label="Launch windows"></div>`;
   plan.after(section);
   const $ = (id) => document.getElementById(id);
+  // A forecast of many distinct winds costs more than a direct answer may
+  // (a plan each): the server says so and the panel runs it as a job.
+  const runJob = S.jobRunner("windows-");
 
   function detect(text) {
     const t = text.trim();
@@ -105,7 +113,13 @@
     if ($("windows-limit").value.trim() && Number.isFinite(limit)) body.haul_down = { max_operating_wind_m_s: limit };
     $("windows-button").disabled = true;
     section.dataset.state = "pending";
-    const res = await S.api("POST", "api/v1/windows", body);
+    let res = await S.api("POST", "api/v1/windows", body);
+    section.dataset.via = "direct";
+    if (S.needsJob(res)) {
+      section.dataset.via = "job";
+      const out = await runJob("windows", body, "launch windows");
+      res = out.result ? { ok: true, body: out.result } : { ok: false, status: out.status, body: out.error };
+    }
     $("windows-button").disabled = false;
     if (!res.ok) {
       section.dataset.state = "error";

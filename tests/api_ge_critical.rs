@@ -257,3 +257,35 @@ async fn ge_bad_input_names_the_field() {
     assert_eq!(status, StatusCode::OK, "{s}");
     assert!(s["closed_form_elevation_m"].as_f64().is_some());
 }
+
+/// Issue 31, item 6: a cable whose payout cancels its bending stiffness
+/// (`EI − I_ρ v² ≤ 0`, `I_ρ = A_ρ L0²/γ̃`) is refused naming
+/// `model.inertia_ratio` with the numbers, never answered with a NaN
+/// growth rate. ρA 0.078 kg/m, L0 1 m, γ̃ 1: I_ρ = 0.078 kg m; at 10 m/s
+/// I_ρ v² = 7.8 N m² against EI 0.01 N m². At 0.1 m/s (7.8e-4 N m²) the
+/// same cable is well posed and answers.
+#[tokio::test]
+async fn a_payout_that_cancels_the_bending_stiffness_is_refused_in_numbers() {
+    let (app, _) = app();
+    let body = |rate: f64| {
+        let mut b = with(
+            system(1e5),
+            json!({"profile": {"kind": "constant_rate", "rate_m_s": rate}}),
+        );
+        b["model"]["bending_stiffness_n_m2"] = json!(0.01);
+        b
+    };
+    let (status, v) = post(&app, "/api/v1/critical", &body(10.0)).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{v}");
+    assert_eq!(v["error"]["field"], "model.inertia_ratio", "{v}");
+    let message = v["error"]["message"].as_str().unwrap();
+    let i_rho_v2 = 0.078 * 1.0 * 1.0 / 1.0 * 10.0 * 10.0;
+    assert!(
+        message.contains(&format!("{i_rho_v2:.4e}")) && message.contains("1.0000e-2"),
+        "{message}"
+    );
+    assert!(!message.contains("NaN"), "{message}");
+    let (status, v) = post(&app, "/api/v1/critical", &body(0.1)).await;
+    assert_eq!(status, StatusCode::OK, "{v}");
+    assert!(!v.to_string().contains("NaN"), "{v}");
+}

@@ -15,8 +15,27 @@ fn app() -> axum::Router {
     common::app_with(1, Limits::default()).0
 }
 
+/// The route's answer; a forecast of more distinct winds than the
+/// synchronous budget pays for (a plan each, issue 34's prices) is refused
+/// `too_large` at once and answered as a `windows` job, as the page does.
 async fn post(uri: &str, body: &Value) -> (StatusCode, Value) {
-    common::post(&app(), uri, body).await
+    let (app, queue) = common::app_with(1, Limits::default());
+    let (status, answer) = common::post(&app, uri, body).await;
+    if !(uri == "/api/v1/windows" && answer["error"]["code"] == "too_large") {
+        return (status, answer);
+    }
+    assert_eq!(answer["error"]["field"], "forecast.data", "{answer}");
+    let (status, sub) = common::post(
+        &app,
+        "/api/v1/jobs",
+        &json!({"kind": "windows", "request": body}),
+    )
+    .await;
+    assert_eq!(status, StatusCode::ACCEPTED, "{sub}");
+    let ran = tetherplan::jobs::try_execute_next(&queue).unwrap().unwrap();
+    assert_eq!(ran.status, tetherplan::jobs::store::JobStatus::Done);
+    let job = common::get(&app, &format!("/api/v1/jobs/{}", sub["id"])).await;
+    (StatusCode::OK, job["result"].clone())
 }
 
 /// The system of the plan's documented example, flying at 300 m.

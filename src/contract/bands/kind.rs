@@ -2,13 +2,14 @@
 //! deployment chart's), `plan_bands` and `envelope_bands`. Progress counts
 //! samples; each is chunked by sample and stops when cancelled.
 
-use crate::contract::price::Price;
 use std::ops::Range;
 
+use crate::contract::price::Price;
+
 use crate::contract::analysis::{Analysis, Items, to_json, too_large};
+use crate::contract::bands::dto::{BandsRequest, BandsResponse};
 use crate::contract::bands::envelope::{self, EnvelopeBandsRequest, EnvelopeBandsResponse};
 use crate::contract::bands::plan::{self, PlanBandsRequest, PlanBandsResponse};
-use crate::contract::bands::dto::{BandsRequest, BandsResponse};
 use crate::contract::bands::run;
 use crate::contract::envelope::kind::ENVELOPE_CELL_STEP_S;
 use crate::contract::error::{Progress, RequestError};
@@ -35,10 +36,11 @@ pub const PLAN_BASE: u64 = 256 << 10;
 pub const PER_PLAN_SAMPLE: u64 = 9 * est::PER_NUMBER + 300;
 
 /// Seconds per element of one chart point of a bands sample on a uniform
-/// mesh (measured: 6 400 points of 500 elements in 1.2 s on one core).
+/// mesh (measured: 6 400 points of 500 elements in 1.2 s on one core;
+/// through the route 4 000 points of 2 000 elements in 2.14 CPU-s).
 const BAND_ELEMENT_POINT_S: f64 = 4e-7;
 /// Seconds per converged chart point of a bands sample (measured: 9 600
-/// points in 0.06 s).
+/// points in 0.06 s; through the route 200 000 points in 1.04 CPU-s).
 const BAND_CONVERGED_POINT_S: f64 = 1e-5;
 /// Seconds per sample × schedule instant of a plan bands chunk, its wire
 /// result included (measured: 3 000 samples × 2 003 instants in 1.36 s on
@@ -81,6 +83,22 @@ impl Analysis for BandsRequest {
         }
         Ok(())
     }
+    /// Chart points (samples × rates) × the mesh's cost of a point.
+    fn price(&self) -> Option<Price> {
+        let points = run::evaluations(self);
+        let per_point = match self.system.discretisation().ok()? {
+            Discretisation::Elements(n) => n as f64 * BAND_ELEMENT_POINT_S,
+            _ => BAND_CONVERGED_POINT_S,
+        };
+        Some(Price {
+            cpu_s: points as f64 * per_point,
+            field: "uncertainty.samples".into(),
+            counts: format!(
+                "{points} chart points (samples × rates) on {} elements",
+                self.system.model.mesh_elements()
+            ),
+        })
+    }
     fn run(&self, progress: &dyn Progress) -> Result<BandsResponse, RequestError> {
         run::bands(self, Parallelism::Rayon, progress)
     }
@@ -106,7 +124,11 @@ impl Analysis for BandsRequest {
             most_per_chunk: None,
         })
     }
-    fn run_items(&self, range: Range<usize>, progress: &dyn Progress) -> Result<String, RequestError> {
+    fn run_items(
+        &self,
+        range: Range<usize>,
+        progress: &dyn Progress,
+    ) -> Result<String, RequestError> {
         run::bands_chunk(self, range, Parallelism::Rayon, progress)
     }
     fn assemble(&self, parts: &[String]) -> Result<String, RequestError> {
@@ -175,7 +197,11 @@ impl Analysis for PlanBandsRequest {
             most_per_chunk: Some((MAX_PLAN_BAND_CHUNK_VALUES / instants.max(1)).max(1)),
         })
     }
-    fn run_items(&self, range: Range<usize>, progress: &dyn Progress) -> Result<String, RequestError> {
+    fn run_items(
+        &self,
+        range: Range<usize>,
+        progress: &dyn Progress,
+    ) -> Result<String, RequestError> {
         plan::plan_bands_chunk(self, range, Parallelism::Rayon, progress)
     }
     fn assemble(&self, parts: &[String]) -> Result<String, RequestError> {
@@ -257,7 +283,11 @@ impl Analysis for EnvelopeBandsRequest {
             most_per_chunk: None,
         })
     }
-    fn run_items(&self, range: Range<usize>, progress: &dyn Progress) -> Result<String, RequestError> {
+    fn run_items(
+        &self,
+        range: Range<usize>,
+        progress: &dyn Progress,
+    ) -> Result<String, RequestError> {
         envelope::envelope_bands_chunk(self, range, Parallelism::Rayon, progress)
     }
     fn assemble(&self, parts: &[String]) -> Result<String, RequestError> {

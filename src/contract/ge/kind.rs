@@ -5,6 +5,7 @@
 
 use std::ops::Range;
 
+use crate::contract::price::Price;
 use crate::contract::analysis::{Analysis, Items, to_json, too_large, validate_by_cancelled_run};
 use crate::contract::error::{Progress, RequestError};
 use crate::contract::estimate::{self as est, Estimate as E, Estimate};
@@ -209,6 +210,12 @@ impl Analysis for AnyChartRequest {
             }
         }
     }
+    fn price(&self) -> Option<Price> {
+        match self {
+            Self::LinearString(r) => crate::contract::string::price::chart(r),
+            Self::GeometricallyExact(r) => crate::contract::ge::price::chart(r),
+        }
+    }
     fn run(&self, progress: &dyn Progress) -> Result<AnyChartResponse, RequestError> {
         match self {
             Self::LinearString(r) => {
@@ -306,6 +313,14 @@ impl Analysis for AnyFrequencyResponseRequest {
             ));
         }
         Ok(())
+    }
+    /// Wind forcing on the string (the GE base excitation is bounded by
+    /// its frequency limit alone).
+    fn price(&self) -> Option<Price> {
+        match self {
+            Self::Wind(r) => crate::contract::transient::price::frequency_response(r),
+            Self::Base(_) => None,
+        }
     }
     fn run(&self, progress: &dyn Progress) -> Result<AnyFrequencyResponseResponse, RequestError> {
         charts::frequency_response_any(self, Parallelism::Rayon, progress)

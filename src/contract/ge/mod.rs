@@ -11,6 +11,7 @@ pub mod critical;
 pub mod kind;
 pub mod model;
 pub mod numerics;
+pub mod price;
 pub mod simulate;
 pub mod stability;
 

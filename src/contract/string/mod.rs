@@ -4,5 +4,6 @@
 pub mod chunks;
 pub mod dto;
 pub mod kind;
+pub mod price;
 pub mod run;
 pub mod tension;

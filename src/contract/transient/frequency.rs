@@ -99,14 +99,16 @@ pub fn frequency_response_runs(req: &FrequencyResponseRequest) -> usize {
     req.frequencies_rad_s.count()
 }
 
-/// Runs a [`FrequencyResponseRequest`]: the runs fan out on rayon when
-/// `parallelism` says so (results identical to serial). Progress counts
-/// finished runs.
-pub fn frequency_response(
-    req: &FrequencyResponseRequest,
-    parallelism: Parallelism,
-    progress: &dyn Progress,
-) -> Result<FrequencyResponseResponse, RequestError> {
+/// A frequency response as a request sets it up: the model, the profile,
+/// the frequencies and the configuration of each run.
+struct Setup {
+    model: crate::numerics::string::StringModel,
+    profile: crate::numerics::profile::Profile,
+    frequencies: Vec<f64>,
+    config: transient::TransientConfig,
+}
+
+fn setup(req: &FrequencyResponseRequest) -> Result<Setup, RequestError> {
     let model = req.system.model()?;
     let sys = model.system;
     let profile = req.profile.profile(sys.initial_length_m)?;
@@ -139,6 +141,43 @@ pub fn frequency_response(
         Some(aero),
         None,
     )?;
+    Ok(Setup {
+        model,
+        profile,
+        frequencies,
+        config,
+    })
+}
+
+/// The size of the runs a request asks for: runs, time steps of each and
+/// elements, as the runs fix them (None: the request is invalid, and its
+/// run says why).
+pub fn run_size(req: &FrequencyResponseRequest) -> Option<(usize, usize, usize)> {
+    let Setup {
+        model,
+        profile,
+        frequencies,
+        config,
+    } = setup(req).ok()?;
+    let plan = transient::plan(&model, &profile, &config).ok()?;
+    Some((frequencies.len(), plan.steps, model.elements()))
+}
+
+/// Runs a [`FrequencyResponseRequest`]: the runs fan out on rayon when
+/// `parallelism` says so (results identical to serial). Progress counts
+/// finished runs.
+pub fn frequency_response(
+    req: &FrequencyResponseRequest,
+    parallelism: Parallelism,
+    progress: &dyn Progress,
+) -> Result<FrequencyResponseResponse, RequestError> {
+    let Setup {
+        model,
+        profile,
+        frequencies,
+        config,
+    } = setup(req)?;
+    let sys = model.system;
     let fr = transient::frequency_response(
         &model,
         &profile,

@@ -4,7 +4,9 @@
 use crate::contract::analysis::{Analysis, validate_by_cancelled_run};
 use crate::contract::error::{Progress, RequestError};
 use crate::contract::estimate::{self as est, Estimate as E, Estimate};
+use crate::contract::price::Price;
 use crate::contract::transient::any::{self, AnySimulateRequest, AnySimulateResponse};
+use crate::contract::{ge, transient};
 
 impl Analysis for AnySimulateRequest {
     const NAME: &'static str = "simulate";
@@ -13,13 +15,20 @@ impl Analysis for AnySimulateRequest {
     const DESCRIPTION: &'static str = "`model.kind` picks the model: `linear_string` (default) or\n\
         `geometrically_exact`. Runs longer than the solve timeout are\n\
         stopped (504): submit them as jobs with `\"kind\": \"simulate\"`.";
-    const ABOUT: &'static str = "Transient run (linear string, or `\"model\": {\"kind\": \"geometrically_exact\"}`).";
+    const ABOUT: &'static str =
+        "Transient run (linear string, or `\"model\": {\"kind\": \"geometrically_exact\"}`).";
     type Response = AnySimulateResponse;
     fn parse(body: &[u8]) -> Result<Self, RequestError> {
         any::parse_simulate(body)
     }
     fn prepare(&self) -> Result<(), RequestError> {
         validate_by_cancelled_run(|p| any::simulate_any(self, p))
+    }
+    fn price(&self) -> Option<Price> {
+        match self {
+            Self::LinearString(r) => transient::price::simulate(r),
+            Self::GeometricallyExact(r) => ge::price::simulate(r),
+        }
     }
     fn run(&self, progress: &dyn Progress) -> Result<AnySimulateResponse, RequestError> {
         any::simulate_any(self, progress)

@@ -7,6 +7,7 @@ pub mod aero;
 pub mod any;
 pub mod frequency;
 pub mod kind;
+pub mod price;
 pub mod simulate;
 
 pub use frequency::{

@@ -289,22 +289,64 @@ pub(super) fn config_from(
     })
 }
 
+/// A run as a request sets it up: the model, the profile and the
+/// configuration (its time step fixed by [`transient::plan`]).
+struct Setup {
+    model: crate::numerics::string::StringModel,
+    profile: crate::numerics::profile::Profile,
+    config: TransientConfig,
+}
+
+fn setup(req: &SimulateRequest) -> Result<Setup, RequestError> {
+    let model = req.system.model()?;
+    let profile = req.profile.profile(model.system.initial_length_m)?;
+    let aero = match &req.aero {
+        Some(a) => Some(a.body().aerodynamics(
+            a.flow.flow()?,
+            model.system.aerostat_mass_kg,
+            "aero",
+        )?),
+        None => None,
+    };
+    let config = config_from(
+        req.duration_s,
+        req.time_step_s,
+        req.samples,
+        &req.initial,
+        aero,
+        req.eigenvalues.as_ref(),
+    )?;
+    Ok(Setup {
+        model,
+        profile,
+        config,
+    })
+}
+
+/// The size of the run a request asks for: time steps and elements, as the
+/// run fixes them (None: the request is invalid, and its run says why).
+pub fn run_size(req: &SimulateRequest) -> Option<(usize, usize)> {
+    let Setup {
+        model,
+        profile,
+        config,
+    } = setup(req).ok()?;
+    let plan = transient::plan(&model, &profile, &config).ok()?;
+    Some((plan.steps, model.elements()))
+}
+
 /// Runs a [`SimulateRequest`]. Progress counts time steps.
 pub fn simulate(
     req: &SimulateRequest,
     progress: &dyn Progress,
 ) -> Result<SimulateResponse, RequestError> {
-    let model = req.system.model()?;
+    let Setup {
+        model,
+        profile,
+        config,
+    } = setup(req)?;
     let sys = model.system;
-    let profile = req.profile.profile(sys.initial_length_m)?;
     let breaking_strength_n = req.system.cable.breaking_strength()?;
-    let aero = match &req.aero {
-        Some(a) => Some(
-            a.body()
-                .aerodynamics(a.flow.flow()?, sys.aerostat_mass_kg, "aero")?,
-        ),
-        None => None,
-    };
     let initial_tip = match req.initial {
         InitialStateInput::Shape { tip_deflection_m }
         | InitialStateInput::Mode {
@@ -319,15 +361,7 @@ pub fn simulate(
         )
         .into());
     }
-    let displaced_air_mass_kg = aero.as_ref().map(|a| a.displaced_air_mass_kg);
-    let config = config_from(
-        req.duration_s,
-        req.time_step_s,
-        req.samples,
-        &req.initial,
-        aero,
-        req.eigenvalues.as_ref(),
-    )?;
+    let displaced_air_mass_kg = config.aero.as_ref().map(|a| a.displaced_air_mass_kg);
     let run = transient::simulate(&model, &profile, &config, &ProgressObserver(progress))
         .map_err(from_transient)?;
     if matches!(run.outcome, RunOutcome::Cancelled { .. }) {

@@ -1,10 +1,12 @@
 //! The `windows` analysis kind (SPEC §12, issue 32, [`Analysis`]): launch
-//! windows from a forecast; distinct winds beyond [`MAX_SYNC_PLANS`] go to
-//! the job queue (progress in plans).
+//! windows from a forecast; distinct winds beyond what the synchronous
+//! budget pays for ([`PLAN_S`] each) go to the job queue (progress in
+//! plans).
 
 use crate::contract::analysis::{Analysis, too_large};
 use crate::contract::error::{Progress, RequestError};
 use crate::contract::estimate::{self as est, Estimate};
+use crate::contract::price::Price;
 use crate::contract::windows::{self, WindowsRequest, WindowsResponse};
 use crate::limits::Limits;
 
@@ -13,6 +15,11 @@ use crate::limits::Limits;
 pub const MAX_SYNC_PLANS: usize = 2_500;
 /// One period of the answer: its wind, reason and a dozen numbers.
 pub const PER_PERIOD: u64 = 24 * est::PER_NUMBER + 1200;
+
+/// One plan of a distinct wind with its stability in that wind (measured
+/// through the route: 5 distinct hours 1.60 CPU-s, 10 hours 3.20, 30 hours
+/// 9.67: 0.32 s a plan), s.
+pub const PLAN_S: f64 = 0.4;
 
 impl Analysis for WindowsRequest {
     const NAME: &'static str = "windows";
@@ -28,8 +35,9 @@ impl Analysis for WindowsRequest {
         (one), its gust the mean times its gust ratio; the answer echoes\n\
         that §9 `wind` per hour. With an ensemble each hour has\n\
         `probability_go` (Wilson interval) and the 10/50/90 % of\n\
-        `max_altitude_m`, each window its probability. Synchronously at\n\
-        most 2 500 distinct winds; larger: a job with `\"kind\": \"windows\"`.";
+        `max_altitude_m`, each window its probability. Synchronously as\n\
+        many distinct winds as 2 CPU-seconds allow (a plan each, priced at\n\
+        0.4 s: 5); more: a job with `\"kind\": \"windows\"`.";
     const ABOUT: &'static str = "Launch windows by the hour from a forecast (Open-Meteo JSON, METAR, TAF or CSV): each period judged as the plan judges its wind (progress bar in plans).";
     type Response = WindowsResponse;
     fn parse(body: &[u8]) -> Result<Self, RequestError> {
@@ -51,6 +59,15 @@ impl Analysis for WindowsRequest {
         }
         Ok(())
     }
+    /// A plan (its stability in the hour's wind) per distinct wind.
+    fn price(&self) -> Option<Price> {
+        let plans = windows::prepare(self).ok()?.plan_count();
+        Some(Price {
+            cpu_s: plans as f64 * PLAN_S,
+            field: "forecast.data".into(),
+            counts: format!("{plans} distinct winds, a plan each,"),
+        })
+    }
     fn run(&self, progress: &dyn Progress) -> Result<WindowsResponse, RequestError> {
         windows::windows(self, progress)
     }
@@ -58,7 +75,11 @@ impl Analysis for WindowsRequest {
         // The answer lists the first member's periods (parsing is cheap;
         // an unparsable forecast is refused by `prepare`).
         let periods = windows::source::parse_forecast(&self.forecast)
-            .map_or(0, |f| f.members.first().map_or(0, |m| m.periods.len())) as u64;
-        Estimate::new("forecast.data", est::SMALL_ANSWER + periods.saturating_mul(PER_PERIOD))
+            .map_or(0, |f| f.members.first().map_or(0, |m| m.periods.len()))
+            as u64;
+        Estimate::new(
+            "forecast.data",
+            est::SMALL_ANSWER + periods.saturating_mul(PER_PERIOD),
+        )
     }
 }
