@@ -10,7 +10,7 @@ use criterion::Criterion;
 use serde_json::json;
 use tetherplan::contract::bands::{self, BandsRequest};
 use tetherplan::contract::run::NoProgress;
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 fn request(samples: usize, count: usize) -> BandsRequest {
     request_with(samples, count, 1e-4)

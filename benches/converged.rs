@@ -9,9 +9,10 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
-use tetherplan::numerics::chart::{self, Discretisation, Parallelism};
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::params::AerostatSystem;
 use tetherplan::numerics::string::StringModel;
+use tetherplan::numerics::string::chart::{self, Discretisation};
 use tetherplan::numerics::string::converged::{self, DEFAULT_RELATIVE_TOLERANCE as TOL};
 
 fn benches(c: &mut Criterion) {

@@ -12,11 +12,11 @@
 use std::time::Instant;
 
 use criterion::Criterion;
-use tetherplan::numerics::chart::Parallelism;
 use tetherplan::numerics::ge::chart::{GeChartRequest, GeChartSystem, deployment_chart};
 use tetherplan::numerics::ge::critical::{
     CriticalConfig, CriticalProblem, StartState, critical_time,
 };
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::profile::Profile;
 
 fn critical_12(c: &mut Criterion) {

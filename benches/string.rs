@@ -6,10 +6,11 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
-use tetherplan::numerics::chart::{self, Parallelism};
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::params::{AerostatSystem, Kinematics};
 use tetherplan::numerics::profile::Profile;
 use tetherplan::numerics::string::StringModel;
+use tetherplan::numerics::string::chart;
 use tetherplan::numerics::string::critical::{self, SearchConfig, constant_rate_lengthening};
 
 fn benches(c: &mut Criterion) {

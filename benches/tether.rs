@@ -6,7 +6,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::tether::envelope::{EnvelopeProblem, Limits, WindShape};
 use tetherplan::numerics::tether::envelope_ge::{DEFAULT_ELEMENTS, GeStabilitySpec, solve_ge};
 use tetherplan::numerics::tether::presets::CablePreset;

@@ -6,7 +6,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 
 use tetherplan::numerics::aero::{Aerodynamics, AerostatBody, AirFlow, ForceModel, SteadyFlow};
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::params::AerostatSystem;
 use tetherplan::numerics::profile::Profile;
 use tetherplan::numerics::string::StringModel;

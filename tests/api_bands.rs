@@ -11,7 +11,7 @@ use tetherplan::contract::bands;
 use tetherplan::contract::run::NoProgress;
 use tetherplan::jobs::store::JobStatus;
 use tetherplan::jobs::try_execute_next;
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 mod common;
 use common::{app, error, send_text as send};

@@ -9,7 +9,7 @@ use tetherplan::contract::run::NoProgress;
 use tetherplan::contract::{self, envelope, equilibrium};
 use tetherplan::jobs::store::JobStatus;
 use tetherplan::jobs::try_execute_next;
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 use utoipa::PartialSchema;
 
 mod common;

@@ -10,7 +10,7 @@ use tetherplan::contract::ge_charts::{self, GeBaseFrequencyResponseRequest, GeCh
 use tetherplan::contract::run::NoProgress;
 use tetherplan::jobs::store::JobStatus;
 use tetherplan::jobs::try_execute_next;
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 mod common;
 use common::{app, error, get, post_text as post};

@@ -19,7 +19,7 @@ use tetherplan::contract::envelope::envelope;
 use tetherplan::contract::equilibrium::dto::EquilibriumRequest;
 use tetherplan::contract::equilibrium::equilibrium;
 use tetherplan::contract::run::NoProgress;
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 const RHO_A: f64 = 0.078;
 const F: f64 = 1000.0;

@@ -15,7 +15,7 @@ use tetherplan::contract::run::{self, NoProgress};
 use tetherplan::contract::{self};
 use tetherplan::jobs::store::{JobBackend, JobStatus, JobStore};
 use tetherplan::jobs::{JobQueue, try_execute_next};
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 mod common;
 use common::{Answer, with};

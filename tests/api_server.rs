@@ -10,7 +10,7 @@ use serde_json::{Value, json};
 use tetherplan::contract;
 use tetherplan::contract::dto::ChartRequest;
 use tetherplan::contract::run::{self, NoProgress};
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 mod common;
 use common::http::{Reply, connect, exchange, spawn_listening};

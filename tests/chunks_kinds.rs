@@ -148,7 +148,7 @@ fn chunked_string_charts_are_the_single_process_chart() {
             .unwrap();
     let sync = tetherplan::contract::run::chart(
         &req,
-        tetherplan::numerics::chart::Parallelism::Rayon,
+        tetherplan::numerics::parallel::Parallelism::Rayon,
         &NoProgress,
     )
     .unwrap();

@@ -12,7 +12,7 @@ use tetherplan::contract::run::NoProgress;
 use tetherplan::jobs::kinds::JobSubmission;
 use tetherplan::jobs::store::{ClaimPolicy, JobStatus, JobStore};
 use tetherplan::jobs::{JobQueue, work_once};
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 fn ge_chart_request() -> Value {
     json!({

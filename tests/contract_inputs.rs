@@ -3,7 +3,7 @@
 use tetherplan::contract::dto::{ChartRequest, CriticalRequest, SafeRateRequest, StabilityRequest};
 use tetherplan::contract::run::{self, NoProgress};
 use tetherplan::contract::{RequestError, parse};
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 const SYSTEM: &str = r#""cable": {"mass_per_length_kg_m": 0.078},
     "aerostat": {"net_buoyancy_n": 1000, "mass_kg": 10},

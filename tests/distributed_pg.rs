@@ -24,7 +24,7 @@ use std::time::{Duration, Instant};
 use serde_json::{Value, json};
 use tetherplan::contract::ge_charts::{self, GeChartRequest};
 use tetherplan::contract::run::NoProgress;
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 const LEASE_S: &str = "2";
 

@@ -14,7 +14,7 @@ use serde_json::{Value, json};
 use tetherplan::contract::bands::{self, BandsRequest, BandsResponse};
 use tetherplan::contract::dto::ChartRequest;
 use tetherplan::contract::run::{self, NoProgress};
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 const G: f64 = 9.81;
 

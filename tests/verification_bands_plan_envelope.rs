@@ -26,7 +26,7 @@
 use serde_json::{Value, json};
 use tetherplan::contract::bands::{self, EnvelopeBandsResponse, PlanBandsResponse};
 use tetherplan::contract::run::NoProgress;
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 
 /// xorshift64* (Vigna 2016): the test's own generator.
 struct XorShift(u64);

@@ -6,7 +6,7 @@
 use serde_json::{Value, json};
 use tetherplan::contract::dto::{ChartRequest, CriticalRequest, SafeRateRequest};
 use tetherplan::contract::{self, run};
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::params::AerostatSystem;
 use tetherplan::numerics::string::converged::{self, Converged};
 use tetherplan::numerics::string::critical::Onset;

@@ -17,7 +17,7 @@ use serde_json::{Value, json};
 use tetherplan::contract::envelope::dto::{EnvelopeRequest, EnvelopeResponse};
 use tetherplan::contract::envelope::envelope;
 use tetherplan::contract::run::NoProgress;
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::tether::envelope_ge::{GeStabilitySpec, cell_stability, ge_system};
 
 const RATE: f64 = 30.0;

@@ -11,7 +11,6 @@
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use tetherplan::numerics::chart::Parallelism;
 use tetherplan::numerics::ge::base::{
     BaseExcitationProblem, FrequencyResponse, ResponsePoint, frequency_response, resonance_peaks,
 };
@@ -23,9 +22,10 @@ use tetherplan::numerics::ge::critical::{
 };
 use tetherplan::numerics::ge::element::TipLoad;
 use tetherplan::numerics::ge::extensible::ExtensibleString;
+use tetherplan::numerics::ge::reduced::{self as ge_reduced, ReducedFrequencies};
 use tetherplan::numerics::ge::solver::{LengthHistory, NewtonConfig};
 use tetherplan::numerics::ge::{GeModel, Section, TipBody};
-use tetherplan::numerics::ge_reduced::{self, ReducedFrequencies};
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::params::AerostatSystem;
 use tetherplan::numerics::profile::Profile;
 use tetherplan::numerics::string::StringModel;

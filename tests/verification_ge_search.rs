@@ -15,7 +15,6 @@
 //! The runs take about a second each; each test fans them out on rayon.
 
 use rayon::prelude::*;
-use tetherplan::numerics::chart::Parallelism;
 use tetherplan::numerics::ge::chart::{
     ClosedFormVerdict, GeChartRequest, GeChartSystem, deployment_chart,
 };
@@ -23,6 +22,7 @@ use tetherplan::numerics::ge::critical::{
     CriticalConfig, CriticalProblem, GeCriticalTime, GeOnset, StartState, critical_time,
 };
 use tetherplan::numerics::ge::solver::Scheme;
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::profile::Profile;
 
 fn never() -> bool {

@@ -2,11 +2,12 @@
 //! numbers and the analytic limits of SPEC §1. Tolerances are stated at
 //! each assertion.
 
-use tetherplan::numerics::chart::{self, Parallelism};
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::params::{AerostatSystem, Kinematics};
 use tetherplan::numerics::profile::Profile;
 use tetherplan::numerics::qep;
 use tetherplan::numerics::string::StringModel;
+use tetherplan::numerics::string::chart;
 use tetherplan::numerics::string::critical::{
     self, ImmediateCause, Onset, SafeRate, SearchConfig, SearchMethod, constant_rate_lengthening,
 };

@@ -7,12 +7,12 @@
 use std::f64::consts::PI;
 
 use tetherplan::numerics::aero::{Aerodynamics, AerostatBody, AirFlow, ForceModel, SteadyFlow};
-use tetherplan::numerics::chart::Parallelism;
+use tetherplan::numerics::parallel::Parallelism;
 use tetherplan::numerics::params::{AerostatSystem, NondimState};
 use tetherplan::numerics::profile::Profile;
-use tetherplan::numerics::reduced::ReducedModel;
 use tetherplan::numerics::string::StringModel;
 use tetherplan::numerics::string::critical::{Onset, SearchConfig, critical_time};
+use tetherplan::numerics::string::reduced::ReducedModel;
 use tetherplan::numerics::string::transient::{
     self, EigenTracking, InitialState, RunOutcome, Sample, Silent, TransientConfig, TransientRun,
     modal_energies,

@@ -3,19 +3,17 @@
 //! Inputs are SI; inside, the models work non-dimensionally (SPEC §1).
 
 pub mod aero;
-pub mod chart;
 pub mod dynamics;
 pub mod forecast;
 pub mod ge;
-pub mod ge_reduced;
 pub mod mesh;
 pub mod monitor;
 pub mod newmark;
+pub mod parallel;
 pub mod params;
 pub mod plan;
 pub mod profile;
 pub mod qep;
-pub mod reduced;
 pub mod string;
 pub mod tether;
 pub mod tridiag;

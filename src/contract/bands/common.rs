@@ -12,7 +12,7 @@ use crate::contract::bands::dto::{
     PercentileBand, RejectedSamplesOutput, UncertainInput, UncertaintyInput,
 };
 use crate::contract::{Progress, RequestError};
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{InvalidInput, Range, compact};
 use crate::numerics::uncertainty::{self, Distribution, Ensemble};
 

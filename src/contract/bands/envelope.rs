@@ -27,7 +27,7 @@ use crate::contract::bands::common::{
 use crate::contract::bands::dto::{PercentileBand, RejectedSamplesOutput, UncertainInput};
 use crate::contract::envelope::dto::{EnvelopeRequest, EnvelopeResponse};
 use crate::contract::{Progress, RequestError, parse_value};
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::envelope::EnvelopeProblem;
 use crate::numerics::tether::{EquilibriumConfig, EquilibriumProblem};

@@ -15,7 +15,8 @@ use crate::contract::envelope::kind::ENVELOPE_CELL_STEP_S;
 use crate::contract::error::{Progress, RequestError};
 use crate::contract::estimate::{self as est, Estimate};
 use crate::limits::Limits;
-use crate::numerics::chart::{Discretisation, Parallelism};
+use crate::numerics::parallel::Parallelism;
+use crate::numerics::string::chart::Discretisation;
 
 /// Chart points (samples × rates) a synchronous bands request may have.
 pub const MAX_SYNC_BAND_EVALUATIONS: usize = 200_000;

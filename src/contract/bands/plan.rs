@@ -38,7 +38,7 @@ use crate::contract::bands::run::{RawSystem, SystemField};
 use crate::contract::dto::SystemInput;
 use crate::contract::plan::{PlanRequest, PlanResponse};
 use crate::contract::{Progress, RequestError, parse_value};
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{AerostatSystem, InvalidInput};
 use crate::numerics::plan::STABILITY_MARGIN;
 use crate::numerics::uncertainty;

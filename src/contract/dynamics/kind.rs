@@ -14,7 +14,7 @@ use crate::contract::dynamics::{
 use crate::contract::error::{Progress, RequestError};
 use crate::contract::estimate::{self as est, Estimate};
 use crate::limits::Limits;
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 
 /// One kept sample: 7 numbers and their keys.
 pub const PER_DYNAMICS_SAMPLE: u64 = 7 * est::PER_NUMBER + 140;

@@ -1,23 +1,25 @@
 //! A dynamics request checked and turned into the numerical problem
 //! ([`crate::numerics::dynamics::DynamicsProblem`]) and its configuration.
 //! Every bound is the schema's; every error names its field in plain words.
+//! The run's own bounds (segments, steps and work, samples, shapes, ρ∞)
+//! are checked by [`crate::numerics::dynamics::limits`], named here by the
+//! request's fields; the answer's size (shape nodes) and the run's length
+//! are the contract's.
 
 use super::dto::*;
 use crate::contract::system::WindFlowInput;
-use crate::contract::system::validate::{check_rest, require_count, require_range};
+use crate::contract::system::validate::{check_rest, require_range};
+use crate::numerics::dynamics::limits::{
+    check_sample_count, check_segments, check_shape_count, check_shape_times,
+    check_spectral_radius, check_steps,
+};
 use crate::numerics::dynamics::{
-    self, Aerostat, DynamicsConfig, DynamicsProblem, GustHistory, LengthSchedule, SpectrumModel,
-    Tether, Turbulence,
+    Aerostat, DynamicsConfig, DynamicsProblem, GustHistory, LengthSchedule, SpectrumModel, Tether,
+    Turbulence,
 };
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::{EquilibriumConfig, WindProfile};
 
-/// Most segments through the contract.
-pub const MAX_SEGMENTS: usize = 1000;
-/// Most kept samples.
-pub const MAX_SAMPLE_COUNT: usize = 200_000;
-/// Most kept shapes.
-pub const MAX_SHAPES: usize = 1000;
 /// Most shape nodes kept (shapes × (segments + 1)).
 pub const MAX_SHAPE_NODES: usize = 200_000;
 /// Longest run (s).
@@ -334,28 +336,12 @@ impl DynamicsRequest {
         check_rest(self.winch.as_ref(), None, self.lift_reserve_nondim)?;
         let duration = require_range("duration_s", self.duration_s, 0.0, true, MAX_DURATION_S)?;
         let n = &self.numerics;
-        let segments = require_count("numerics.segments", n.segments, 2, MAX_SEGMENTS)?;
+        let segments = check_segments("numerics.segments", n.segments)?;
         let dt = require_range("numerics.time_step_s", n.time_step_s, 1e-4, false, 10.0)?;
-        let rho_inf = require_range(
-            "numerics.spectral_radius_nondim",
-            n.spectral_radius_nondim,
-            0.0,
-            false,
-            1.0,
-        )?;
-        let steps = ((duration / dt) - 1e-9).ceil().max(1.0);
-        if steps > dynamics::MAX_STEPS as f64 || steps * segments as f64 > dynamics::MAX_WORK {
-            return Err(InvalidInput::new(
-                "duration_s",
-                format!(
-                    "needs {steps:.0} steps of {segments} segments; a run takes at most {} steps and {:e} segment-steps (lengthen numerics.time_step_s or shorten the run)",
-                    dynamics::MAX_STEPS,
-                    dynamics::MAX_WORK
-                ),
-            ));
-        }
-        let steps = steps as usize;
-        let count = require_count("sample_count", self.sample_count, 2, MAX_SAMPLE_COUNT)?;
+        let rho_inf =
+            check_spectral_radius("numerics.spectral_radius_nondim", n.spectral_radius_nondim)?;
+        let steps = check_steps("duration_s", "numerics.time_step_s", duration, dt, segments)?;
+        let count = check_sample_count("sample_count", self.sample_count)?;
         let sample_interval = duration / (count - 1) as f64;
         let shape_times = match &self.shape_times_s {
             Some(_) if self.shape_count.is_some() => {
@@ -367,23 +353,16 @@ impl DynamicsRequest {
                 ));
             }
             Some(times) => {
-                if times.len() > MAX_SHAPES {
-                    return Err(InvalidInput::new(
-                        "shape_times_s",
-                        format!("at most {MAX_SHAPES} times, got {}", times.len()),
-                    ));
-                }
+                check_shape_times("shape_times_s", times)?;
                 for (i, t) in times.iter().enumerate() {
                     require_range(&format!("shape_times_s[{i}]"), *t, 0.0, false, duration)?;
                 }
                 times.clone()
             }
             None => {
-                let k = require_count(
+                let k = check_shape_count(
                     "shape_count",
                     self.shape_count.unwrap_or(super::dto::DEFAULT_SHAPE_COUNT),
-                    0,
-                    MAX_SHAPES,
                 )?;
                 match k {
                     0 => vec![],

@@ -13,7 +13,7 @@
 use super::dto::{EnvelopeRequest, EnvelopeResponse};
 use super::{envelope_of, length_limits};
 use crate::contract::{Progress, RequestError};
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 
 /// Wind rows of the request.
 pub fn envelope_row_count(req: &EnvelopeRequest) -> usize {

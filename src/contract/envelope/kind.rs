@@ -14,7 +14,7 @@ use crate::contract::envelope::{
 use crate::contract::error::{Progress, RequestError};
 use crate::contract::estimate::{self as est, Estimate};
 use crate::limits::Limits;
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 
 /// Seconds per sample × cell × integration step of a string envelope cell
 /// (measured with envelope bands: 200 samples × 42 cells × 100 steps in

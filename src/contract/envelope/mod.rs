@@ -14,7 +14,7 @@ use crate::contract::equilibrium::dto::{ResolvedAerostatOutput, ResolvedCableOut
 use crate::contract::equilibrium::{require_count, require_range};
 use crate::contract::system::grid::GridBounds;
 use crate::contract::{Progress, RequestError};
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::envelope::{
     EnvelopeProblem, Limit, Limits, MAX_ENVELOPE_POINTS, WindShape,

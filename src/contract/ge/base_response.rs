@@ -14,12 +14,12 @@ use crate::contract::ge::numerics::newton_config;
 use crate::contract::ge::{GeAerostatInput, GeModelInput, NewtonInput};
 use crate::contract::system::grid::BaseFrequencyGridInput;
 use crate::contract::{Progress, RequestError};
-use crate::numerics::chart::Parallelism;
 use crate::numerics::ge::base::{self, BaseExcitationProblem};
 use crate::numerics::ge::element::TipLoad;
+use crate::numerics::ge::reduced;
 use crate::numerics::ge::solver::LengthHistory;
 use crate::numerics::ge::{GeModel, TipBody};
-use crate::numerics::ge_reduced;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 use crate::numerics::profile::Profile;
 
@@ -233,7 +233,7 @@ pub fn ge_base_frequency_response(
     let rate_nondim = rate.map(|v| v * scale / l0);
     let stiffness_ratio = crate::contract::ge::simulate::stiffness_ratio_of(&section, l0);
     let bands = rate_nondim.and_then(|v| {
-        ge_reduced::resonance_bands(stiffness_ratio, epsilon, v, duration / scale).map(|b| {
+        reduced::resonance_bands(stiffness_ratio, epsilon, v, duration / scale).map(|b| {
             b.iter()
                 .map(|b| ResonanceBandOutput {
                     low_rad_s: b.low / scale,

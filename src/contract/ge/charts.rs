@@ -25,11 +25,11 @@ use crate::contract::ge::{GeAerostatInput, GeModelKind, NewtonInput};
 use crate::contract::system::WindFlowInput;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::aero::{AerostatBody, ForceModel, SteadyFlow};
-use crate::numerics::chart::Parallelism;
 use crate::numerics::ge::chart::{
     self as ge_chart_core, GeChartRequest as CoreChart, GeChartSystem, GeChartWind,
 };
 use crate::numerics::ge::critical::{CriticalConfig, GeOnset};
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 use crate::numerics::tether::wind::WindProfile;
 

@@ -18,7 +18,7 @@ use crate::contract::ge::stability::{self, AnyStabilityRequest, AnyStabilityResp
 use crate::contract::string::dto::{ProfileInput, SystemInput};
 use crate::contract::string::{chunks, kind as string, run};
 use crate::limits::Limits;
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 
 /// Elements a synchronous GE stability answer may have.
 pub const MAX_SYNC_GE_STABILITY_ELEMENTS: usize = 100;

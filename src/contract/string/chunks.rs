@@ -3,7 +3,7 @@
 //!
 //! The items are the chart's rates (each with every buoyancy): a chunk
 //! computes the points of its rates with the same point evaluation as the
-//! single-process chart ([`crate::numerics::chart::deployment_chart_cancellable`];
+//! single-process chart ([`crate::numerics::string::chart::deployment_chart_cancellable`];
 //! each point is independent of the others), and carries every number as
 //! its IEEE-754 bits, so that the chart put together from the chunks in
 //! order ([`chart_from_chunks`]) is the single-process answer, byte for
@@ -14,8 +14,9 @@ use serde::{Deserialize, Serialize};
 use crate::contract::dto::{ChartPointOutput, ChartRequest, ChartResponse, ChartSeriesOutput};
 use crate::contract::run::chart_elements;
 use crate::contract::{Progress, RequestError};
-use crate::numerics::chart::{self, Parallelism};
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::AerostatSystem;
+use crate::numerics::string::chart;
 
 /// The rates of the chart, in order.
 fn rates(req: &ChartRequest) -> Result<Vec<f64>, RequestError> {

@@ -9,8 +9,9 @@ use crate::contract::string::chunks::chart_rate_count;
 use crate::contract::string::dto::{ChartRequest, SafeRateRequest, SafeRateResponse, StabilityRequest};
 use crate::contract::string::run::{self, MAX_MODES};
 use crate::limits::Limits;
-use crate::numerics::chart::{self, Discretisation, MAX_CHART_POINTS, Parallelism};
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{InvalidInput, require_finite, require_positive};
+use crate::numerics::string::chart::{self, Discretisation, MAX_CHART_POINTS};
 
 /// Seconds per element of one point of a string chart on a uniform mesh
 /// (measured: 300 rates × 3 buoyancies at 400 elements in 0.21-0.23 s on

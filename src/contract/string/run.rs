@@ -3,12 +3,13 @@
 
 use crate::contract::dto::*;
 pub use crate::contract::error::{NoProgress, Progress, RequestError};
-use crate::numerics::chart::{self, Parallelism};
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{
     AerostatSystem, InvalidInput, Kinematics, require_finite, require_positive,
 };
 use crate::numerics::profile::Profile;
 use crate::numerics::string::StringModel;
+use crate::numerics::string::chart;
 use crate::numerics::string::converged::{self, ConvergedConfig, ConvergedSafeRate};
 use crate::numerics::string::critical::{
     self, ImmediateCause, Onset, SafeRate, SearchConfig, SearchMethod,

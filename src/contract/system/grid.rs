@@ -190,12 +190,12 @@ impl GridInput {
 }
 
 impl GridInput {
-    /// Rates (m/s): a range through [`crate::numerics::chart::rate_grid`]
+    /// Rates (m/s): a range through [`crate::numerics::string::chart::rate_grid`]
     /// (its checks and values), a list checked value by value (each above
     /// 0 and at most 1000, at most `MAX_CHART_POINTS`); `at` names the grid.
     pub fn rates(&self, at: &str) -> Result<Vec<f64>, InvalidInput> {
         match self {
-            Self::Range(r) => crate::numerics::chart::rate_grid(r.min, r.max, r.count)
+            Self::Range(r) => crate::numerics::string::chart::rate_grid(r.min, r.max, r.count)
                 .map_err(|e| InvalidInput::new(e.field.replacen("rates_m_s", at, 1), e.reason)),
             Self::List(_) => self.values(at, RateGridInput::BOUNDS),
         }
@@ -330,7 +330,7 @@ bounded_grid!(
         min: 1e-6,
         exclusive_min: false,
         max: 1000.0,
-        max_count: crate::numerics::chart::MAX_CHART_POINTS,
+        max_count: crate::numerics::string::chart::MAX_CHART_POINTS,
         unit: "m/s",
     }
 );

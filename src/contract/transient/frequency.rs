@@ -16,7 +16,7 @@ use crate::contract::dto::{Groups, ProfileInput, SystemInput};
 use crate::contract::run::{Progress, RequestError, groups};
 use crate::contract::system::grid::FrequencyGridInput;
 use crate::numerics::aero::AirFlow;
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{InvalidInput, require_finite};
 use crate::numerics::string::transient::{self, RunOutcome};
 

@@ -12,7 +12,7 @@ use crate::contract::dto::{EigenvalueOutput, Groups, ProfileInput, SystemInput};
 use crate::contract::run::{Progress, RequestError, groups};
 use crate::numerics::aero::Aerodynamics;
 use crate::numerics::params::{AerostatSystem, InvalidInput, require_finite};
-use crate::numerics::reduced::ReducedModel;
+use crate::numerics::string::reduced::ReducedModel;
 use crate::numerics::string::transient::{
     self, EigenTracking, InitialState, MAGNITUDE_CAP_LENGTHS, Observer, RunOutcome,
     TransientConfig, TransientError, TransientRun,

@@ -45,7 +45,7 @@
 
 pub mod blocks;
 mod integrator;
-mod limits;
+pub mod limits;
 pub mod model;
 mod outputs;
 mod problem;

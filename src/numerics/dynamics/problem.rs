@@ -4,7 +4,7 @@
 //! ([`DynamicsConfig`]); and their checks (fields named as in the JSON
 //! contract).
 
-use super::limits::{MAX_SAMPLES, MAX_SEGMENTS, MAX_SHAPES, MAX_STEPS, MAX_WORK, MIN_SEGMENTS};
+use super::limits;
 use super::model::{Length, Parameters};
 use super::wind::{GustHistory, Turbulence};
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
@@ -287,45 +287,22 @@ pub enum DynamicsError {
 }
 
 pub(super) fn validate_config(config: &DynamicsConfig) -> Result<(), InvalidInput> {
-    if !(MIN_SEGMENTS..=MAX_SEGMENTS).contains(&config.segments) {
-        return Err(InvalidInput::new(
-            "segments",
-            format!(
-                "must be between {MIN_SEGMENTS} and {MAX_SEGMENTS}, got {}",
-                config.segments
-            ),
-        ));
-    }
+    limits::check_segments("segments", config.segments)?;
     require_positive("time_step_s", config.time_step_s)?;
     require_positive("duration_s", config.duration_s)?;
     require_positive("sample_interval_s", config.sample_interval_s)?;
-    if !(0.0..=1.0).contains(&config.spectral_radius) {
-        return Err(InvalidInput::new(
-            "spectral_radius",
-            format!("must lie in [0, 1], got {}", config.spectral_radius),
-        ));
-    }
-    let steps = (config.duration_s / config.time_step_s).ceil();
-    if steps > MAX_STEPS as f64 || steps * config.segments as f64 > MAX_WORK {
-        return Err(InvalidInput::new(
-            "duration_s",
-            format!(
-                "needs {steps:.0} steps of {} segments: more than {MAX_STEPS} steps or {MAX_WORK:e} segment-steps",
-                config.segments
-            ),
-        ));
-    }
-    if config.duration_s / config.sample_interval_s > MAX_SAMPLES as f64 {
-        return Err(InvalidInput::new(
-            "sample_interval_s",
-            format!("would keep more than {MAX_SAMPLES} samples"),
-        ));
-    }
-    if config.shape_times_s.len() > MAX_SHAPES {
-        return Err(InvalidInput::new(
-            "shape_times_s",
-            format!("at most {MAX_SHAPES} shapes"),
-        ));
-    }
-    Ok(())
+    limits::check_spectral_radius("spectral_radius", config.spectral_radius)?;
+    limits::check_steps(
+        "duration_s",
+        "time_step_s",
+        config.duration_s,
+        config.time_step_s,
+        config.segments,
+    )?;
+    limits::check_sample_interval(
+        "sample_interval_s",
+        config.duration_s,
+        config.sample_interval_s,
+    )?;
+    limits::check_shape_times("shape_times_s", &config.shape_times_s)
 }

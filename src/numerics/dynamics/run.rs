@@ -4,6 +4,7 @@
 
 use super::blocks::{V2, norm};
 use super::integrator::{Air, Alpha, Stepper};
+use super::limits;
 use super::model::{Evaluation, Length, Parameters};
 use super::outputs::{Extreme, Recorder, Sample, Shape, SlackEvent};
 use super::problem::{DynamicsConfig, DynamicsError, DynamicsProblem, validate_config};
@@ -101,9 +102,7 @@ pub fn simulate_from(
     );
     st.initial_acceleration();
 
-    let steps = ((config.duration_s / config.time_step_s) - 1e-9)
-        .ceil()
-        .max(1.0) as usize;
+    let steps = limits::step_count(config.duration_s, config.time_step_s) as usize;
     let h = config.duration_s / steps as f64;
     let start_top = st.x[n - 1];
     let wind_probe = [

@@ -23,7 +23,7 @@ use super::solver::{
     self, BaseMotion, Damping, Drive, EndLoads, Integrator, LengthHistory, NewtonConfig, State,
 };
 use super::{GeModel, Section};
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{InvalidInput, require_positive};
 
 /// Largest number of forcing frequencies of one sweep.

@@ -16,7 +16,7 @@ use super::critical::{
 use super::extensible::ExtensibleString;
 use super::{GeModel, Section, TipBody};
 use crate::numerics::aero::{Aerodynamics, AerostatBody, AirFlow, ForceModel, SteadyFlow};
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 use crate::numerics::profile::Profile;
 

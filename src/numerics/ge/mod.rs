@@ -60,6 +60,7 @@ pub mod qs_mesh;
 pub mod qs_wind;
 pub mod qs_wind_onset;
 pub mod quasi_static;
+pub mod reduced;
 pub mod solver;
 pub mod stability;
 pub mod start;

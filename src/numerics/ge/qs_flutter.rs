@@ -15,6 +15,7 @@
 use nalgebra::Complex;
 
 use super::GeModel;
+use super::banded::{BandLu, BandMatrix};
 use super::solver::SystemMatrices;
 
 /// A complex scalar.
@@ -31,123 +32,27 @@ pub const PLATEAU_RTOL: f64 = 1e-9;
 /// accepted.
 pub const LOOSE_RTOL: f64 = 1e-7;
 
-/// A square complex band matrix with `kl` sub- and `ku` super-diagonals,
-/// row-major with the storage of the LU's widened upper band (as
-/// [`super::banded::Band`]).
-#[derive(Clone, Debug)]
-pub struct ComplexBand {
-    n: usize,
-    kl: usize,
-    ku: usize,
-    data: Vec<C64>,
-}
+/// `T(λ)`: a square complex band matrix (storage and LU of
+/// [`BandMatrix`], as the real tangents').
+pub type ComplexBand = BandMatrix<C64>;
 
-impl ComplexBand {
-    fn width(&self) -> usize {
-        2 * self.kl + self.ku + 1
-    }
+/// The factors of a [`ComplexBand`].
+pub type ComplexBandLu = BandLu<C64>;
 
-    #[inline]
-    fn idx(&self, i: usize, j: usize) -> usize {
-        i * self.width() + (j + self.kl - i)
-    }
-
+impl BandMatrix<C64> {
     /// `T(λ) = λ² M + λ C + K` of `sys`.
     pub fn qep(sys: &SystemMatrices, lambda: C64) -> Self {
         let k = &sys.stiffness;
         let (n, kl, ku) = (k.n, k.kl, k.ku);
-        let mut t = Self {
-            n,
-            kl,
-            ku,
-            data: vec![C64::new(0.0, 0.0); n * (2 * kl + ku + 1)],
-        };
+        let mut t = Self::zeros(n, kl, ku);
         let l2 = lambda * lambda;
         for i in 0..n {
             for j in i.saturating_sub(kl)..=(i + ku).min(n - 1) {
                 let v = l2 * sys.mass.get(i, j) + lambda * sys.damping.get(i, j) + k.get(i, j);
-                let x = t.idx(i, j);
-                t.data[x] = v;
+                t.set(i, j, v);
             }
         }
         t
-    }
-
-    /// LU with partial pivoting; `None` at a zero or non-finite pivot.
-    pub fn factor(mut self) -> Option<ComplexBandLu> {
-        let (n, kl, ku) = (self.n, self.kl, self.ku);
-        let mut pivots = vec![0usize; n];
-        for k in 0..n {
-            let last_row = (k + kl).min(n - 1);
-            let mut p = k;
-            let mut best = self.data[self.idx(k, k)].norm();
-            for r in k + 1..=last_row {
-                let v = self.data[self.idx(r, k)].norm();
-                if v > best {
-                    best = v;
-                    p = r;
-                }
-            }
-            if !best.is_finite() || best <= 0.0 {
-                return None;
-            }
-            pivots[k] = p;
-            let last_col = (k + kl + ku).min(n - 1);
-            if p != k {
-                for j in k..=last_col {
-                    let (a, b) = (self.idx(k, j), self.idx(p, j));
-                    self.data.swap(a, b);
-                }
-            }
-            let inv = 1.0 / self.data[self.idx(k, k)];
-            for r in k + 1..=last_row {
-                let rk = self.idx(r, k);
-                let l = self.data[rk] * inv;
-                self.data[rk] = l;
-                if l.re != 0.0 || l.im != 0.0 {
-                    for j in k + 1..=last_col {
-                        let kj = self.data[self.idx(k, j)];
-                        let rj = self.idx(r, j);
-                        self.data[rj] -= l * kj;
-                    }
-                }
-            }
-        }
-        Some(ComplexBandLu { a: self, pivots })
-    }
-}
-
-/// The factors of a [`ComplexBand`].
-#[derive(Clone, Debug)]
-pub struct ComplexBandLu {
-    a: ComplexBand,
-    pivots: Vec<usize>,
-}
-
-impl ComplexBandLu {
-    /// Solves `A x = b` in place.
-    pub fn solve_in_place(&self, b: &mut [C64]) {
-        let a = &self.a;
-        let n = a.n;
-        for k in 0..n {
-            let p = self.pivots[k];
-            if p != k {
-                b.swap(k, p);
-            }
-            let bk = b[k];
-            if bk.re != 0.0 || bk.im != 0.0 {
-                for r in k + 1..=(k + a.kl).min(n - 1) {
-                    b[r] -= a.data[a.idx(r, k)] * bk;
-                }
-            }
-        }
-        for i in (0..n).rev() {
-            let mut s = b[i];
-            for j in i + 1..=(i + a.kl + a.ku).min(n - 1) {
-                s -= a.data[a.idx(i, j)] * b[j];
-            }
-            b[i] = s / a.data[a.idx(i, i)];
-        }
     }
 }
 
@@ -268,7 +173,7 @@ pub fn residual(sys: &SystemMatrices, pair: &EigenPair) -> f64 {
     for i in 0..n {
         let mut s = C64::new(0.0, 0.0);
         for j in i.saturating_sub(t.kl)..=(i + t.ku).min(n - 1) {
-            let a = t.data[t.idx(i, j)];
+            let a = t.get(i, j);
             scale = scale.max(a.norm());
             s += a * pair.vector[j];
         }
@@ -344,7 +249,7 @@ mod tests {
         let mut b = vec![C64::new(0.0, 0.0); n];
         for (i, bi) in b.iter_mut().enumerate() {
             for j in i.saturating_sub(kl)..=(i + ku).min(n - 1) {
-                *bi += t.data[t.idx(i, j)] * x[j];
+                *bi += t.get(i, j) * x[j];
             }
         }
         t.factor().unwrap().solve_in_place(&mut b);

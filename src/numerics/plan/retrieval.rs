@@ -1,7 +1,7 @@
 //! How an oscillation responds to a schedule: the transient run of the
 //! schedule itself (FE string, Newmark, [`crate::numerics::string::transient`])
 //! from a small first-mode disturbance, and the WKB growth of the
-//! one-mode model (thesis (3.12), [`crate::numerics::reduced`]):
+//! one-mode model (thesis (3.12), [`crate::numerics::string::reduced`]):
 //!
 //! ```text
 //! A(l) ∝ [ψ(l)(2m̃ + l)]^(-1/2),   ψ = √[(α/l + γ)/(2m̃ + l)],   Ẽ ∝ ψ
@@ -20,8 +20,8 @@ use crate::numerics::params::{Kinematics, NondimState};
 use crate::numerics::plan::schedule::{self, PlanOutcome, Schedule};
 use crate::numerics::plan::{BindingLimit, PlanProblem};
 use crate::numerics::profile::Profile;
-use crate::numerics::reduced::ReducedModel;
 use crate::numerics::string::StringModel;
+use crate::numerics::string::reduced::ReducedModel;
 use crate::numerics::string::transient::{
     self, InitialState, Observer, RunOutcome, TransientConfig, TransientError,
 };

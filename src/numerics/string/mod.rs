@@ -2,9 +2,11 @@
 //! operators, matrices at a state, the stability spectrum, and the
 //! critical-time and safe-rate searches built on them.
 
+pub mod chart;
 pub mod converged;
 pub mod critical;
 pub mod operators;
+pub mod reduced;
 pub mod transient;
 
 use std::sync::Arc;

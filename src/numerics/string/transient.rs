@@ -26,8 +26,8 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use crate::numerics::aero::{Aerodynamics, AirFlow};
-use crate::numerics::chart::Parallelism;
 use crate::numerics::newmark::{Newmark, NewmarkParameters, NewmarkState, StepError};
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{
     InvalidInput, Kinematics, NondimState, require_finite, require_positive,
 };

@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::numerics::aero::SteadyFlow;
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{InvalidInput, require_finite, require_positive};
 use crate::numerics::tether::equilibrium::{Equilibrium, EquilibriumConfig, EquilibriumProblem};
 use crate::numerics::tether::wind::WindProfile;

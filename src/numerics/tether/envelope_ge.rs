@@ -58,7 +58,6 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
-use crate::numerics::chart::Parallelism;
 use crate::numerics::ge::GeModel;
 use crate::numerics::ge::air_load::AirLoads;
 use crate::numerics::ge::element::TipLoad;
@@ -75,6 +74,7 @@ use crate::numerics::ge::quasi_static::{QsConfig, WindStateStability, wind_stabi
 use crate::numerics::ge::stability::{GeStateFailure, StateMotion};
 use crate::numerics::ge::tether_system::{GeTetherOptions, GeTetherSystem, ge_tether_system};
 use crate::numerics::ge::wind_criterion;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{InvalidInput, Kinematics, require_positive};
 use crate::numerics::tether::envelope::{
     Envelope, EnvelopePoint, EnvelopeProblem, judge_with, summarise,

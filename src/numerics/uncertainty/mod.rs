@@ -25,7 +25,7 @@ use rayon::prelude::*;
 pub use percentiles::{Probability, Quantile};
 pub use sampling::Distribution;
 
-use crate::numerics::chart::Parallelism;
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::InvalidInput;
 
 /// Most samples of one ensemble.

@@ -8,6 +8,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
+use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{AerostatSystem, InvalidInput};
 use crate::numerics::string::StringModel;
 use crate::numerics::string::converged;
@@ -16,13 +17,6 @@ use crate::numerics::string::operators::StringOperators;
 
 /// Largest number of points one chart may have.
 pub const MAX_CHART_POINTS: usize = 1_000_000;
-
-/// Where the sweep runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Parallelism {
-    Serial,
-    Rayon,
-}
 
 /// One point of a series.
 #[derive(Clone, Copy, Debug, PartialEq)]
