@@ -9,6 +9,14 @@
 
 (function () {
   const S = window.tetherplanShared;
+  // What this panel reads from the system card (shared/system.js): the tether,
+  // the aerostat and gravity in calm air, and the card's starting length
+  // (replaced by this panel's L₀).
+  const CARD = S.declareCard("transient", [
+    "cable.preset", "cable.diameter_m if preset", "cable.mass_per_length_kg_m", "cable.breaking_strength_n",
+    "aerostat.preset", "aerostat.net_buoyancy_n", "aerostat.mass_kg",
+    "gravity_m_s2", "initial_length_m",
+  ]);
   const SOURCE = "transient";
   // Runs with more work than this (simulated seconds × elements; 600 s at 50
   // elements) go through a job. So does any run the server refuses directly
@@ -46,7 +54,7 @@
   // The tether, aerostat and gravity of the card; L0 from this panel; the
   // chart's element count (blank there: the default mesh).
   function readSystem(errors) {
-    const sys = S.readSystem(errors, "calm");
+    const sys = S.readSystem(errors, CARD);
     sys.initial_length_m = num("initial_length_m", errors);
     const elements = num("model.elements", errors, { integer: true, optional: true, fallback: 50 });
     sys.model = elements === undefined ? { kind: "linear_string" } : { kind: "linear_string", elements };
