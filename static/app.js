@@ -1,11 +1,15 @@
 // The deployment-chart page: reads the form, asks the API for a chart
 // (directly, or as a background job when it is large), plots t* and h*
 // against rate with uPlot, and renders API errors next to the field they
-// name. No build step: plain browser JavaScript.
+// name. No build step: plain browser JavaScript. index.html loads it as a
+// classic script (`<script src="app.js">`, as before the panels became
+// modules): it imports the shared code itself and starts once the page's
+// modules have run (DOMContentLoaded), so its place among the tags does not matter.
 "use strict";
 
-(function () {
-  const S = window.tetherplanShared;
+(async function () {
+  const ready = document.readyState === "loading" ? new Promise((r) => document.addEventListener("DOMContentLoaded", r, { once: true })) : null;
+  const [{ default: S }] = await Promise.all([import("./shared/index.js"), ready]);
   // What this panel reads from the system card (shared/system.js): the tether,
   // the aerostat and gravity in calm air, and the starting length.
   const CARD = S.declareCard("chart", [

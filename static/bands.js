@@ -5,8 +5,9 @@
 // sampling errors and the uncertainty inputs. Needs uPlot and shared/.
 "use strict";
 
+import S from "./shared/index.js";
+
 (function () {
-  const S = window.tetherplanShared;
   // What this panel reads from the system card (shared/system.js): the tether
   // and the aerostat in calm air, gravity and the starting length.
   const CARD = S.declareCard("bands", [

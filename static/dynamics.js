@@ -8,8 +8,9 @@
 // tensions of the mean wind and of the gust check.
 "use strict";
 
+import S from "./shared/index.js";
+
 (function () {
-  const S = window.tetherplanShared;
   // What this panel reads from the system card (shared/system.js): the tether,
   // the aerostat with its aerodynamics, gravity, the safety factor and today's wind.
   const CARD = S.declareCard("dynamics", [

@@ -6,11 +6,12 @@
 // its binding limit (tension, stability, slack, ceiling), the highest
 // altitude per wind marked, tables of the largest operating wind per length
 // and the highest altitude per wind, and CSV/PNG export with every input
-// recorded. Self-contained: only window.tetherplanCommon is shared.
+// recorded. Self-contained: it uses shared/ alone.
 "use strict";
 
+import S from "./shared/index.js";
+
 (function () {
-  const S = window.tetherplanShared;
   // What this panel reads from the system card (shared/system.js): the tether,
   // the aerostat with its aerodynamics, gravity, the safety factor and today's
   // wind, whose profile the envelope scales to each grid speed.

@@ -11,8 +11,9 @@
 // disables Print and the downloads until a plan is current again.
 "use strict";
 
+import S from "./shared/index.js";
+
 (function () {
-  const S = window.tetherplanShared;
   // What this panel reads from the system card (shared/system.js): all of it,
   // the system, today's wind, the winch, the reserve and the start.
   const CARD = S.declareCard("plan", [
@@ -546,5 +547,7 @@
   toggleAerostat();
   toggleWind();
   state.runPlan = runPlan;
+  // Another panel that changes the plan's inputs (windows.js) asks for a plan with this event.
+  document.addEventListener("tetherplan:plan-request", () => runPlan());
   runPlan();
 })();

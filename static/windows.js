@@ -11,8 +11,9 @@
 // panel and kept in the URL (`units_speed`, `units_length`); the API stays SI.
 "use strict";
 
+import S from "./shared/index.js";
+
 (function () {
-  const S = window.tetherplanShared;
   // What this panel reads from the system card (shared/system.js): what the
   // plan reads (each window is planned as today is).
   const CARD = S.declareCard("windows", [
@@ -207,7 +208,7 @@
     set("wind.gust.peak_factor_nondim", "");
     set("wind.gust.gust_m_s", h.wind.gust?.gust_m_s ?? "");
     set("wind.air_density_kg_m3", h.wind.air_density_kg_m3);
-    window.tetherplanPlan?.runPlan?.();
+    document.dispatchEvent(new CustomEvent("tetherplan:plan-request"));
   }
 
   async function readFile(file) {

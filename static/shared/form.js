@@ -5,7 +5,7 @@
 // same names, other panels' with their prefix: `envelope.tether_lengths_m.max`).
 "use strict";
 
-window.tetherplanShared = window.tetherplanShared || {};
+import shared from "./core.js";
 
 (function (shared) {
   const visible = (el) => !!el && !el.closest("[hidden]");
@@ -211,4 +211,4 @@ window.tetherplanShared = window.tetherplanShared || {};
     visible, named, readNumber, compact, labelOf, plainMessage, inputFor, clearFieldError, clearErrors,
     showFieldError, showFormError, renderApiError, showInputErrors, writeUrl, readUrl,
   });
-})(window.tetherplanShared);
+})(shared);

@@ -12,7 +12,7 @@
 // FIELDS. The reader knows no panel.
 "use strict";
 
-window.tetherplanShared = window.tetherplanShared || {};
+import shared from "./core.js";
 
 (function (shared) {
   const card = () => document.getElementById("system-card");
@@ -123,4 +123,4 @@ window.tetherplanShared = window.tetherplanShared || {};
   }
 
   Object.assign(shared, { readSystem, declareCard, cardDeclarations: declared });
-})(window.tetherplanShared);
+})(shared);
