@@ -1,11 +1,22 @@
 // The deployment-chart page: reads the form, asks the API for a chart
 // (directly, or as a background job when it is large), plots t* and h*
 // against rate with uPlot, and renders API errors next to the field they
-// name. No build step: plain browser JavaScript.
+// name. No build step: plain browser JavaScript. index.html loads it as a
+// classic script (`<script src="app.js">`, as before the panels became
+// modules): it imports the shared code itself and starts once the page's
+// modules have run (DOMContentLoaded), so its place among the tags does not matter.
 "use strict";
 
-(function () {
-  const S = window.tetherplanShared;
+(async function () {
+  const ready = document.readyState === "loading" ? new Promise((r) => document.addEventListener("DOMContentLoaded", r, { once: true })) : null;
+  const [{ default: S }] = await Promise.all([import("./shared/index.js"), ready]);
+  // What this panel reads from the system card (shared/system.js): the tether,
+  // the aerostat and gravity in calm air, and the starting length.
+  const CARD = S.declareCard("chart", [
+    "cable.preset", "cable.diameter_m if preset", "cable.mass_per_length_kg_m", "cable.breaking_strength_n",
+    "aerostat.preset", "aerostat.net_buoyancy_n", "aerostat.mass_kg",
+    "gravity_m_s2", "initial_length_m",
+  ]);
   // Charts with more work than this (points × elements; 5000 points at 50 elements)
   // run as a background job with progress; so does any chart the direct route
   // refuses as too large (422 `too_large`) or while the server is busy (503).
@@ -52,7 +63,7 @@
 
   // The system of the card, in calm air, and the chart's mesh.
   function readSystem(errors) {
-    const sys = S.readSystem(errors, "calm");
+    const sys = S.readSystem(errors, CARD);
     // No element count: the server converges every answer and gives the safe side of its error.
     sys.model = $("#elements").value.trim() === ""
       ? { kind: "linear_string" }

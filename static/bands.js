@@ -5,8 +5,16 @@
 // sampling errors and the uncertainty inputs. Needs uPlot and shared/.
 "use strict";
 
+import S from "./shared/index.js";
+
 (function () {
-  const S = window.tetherplanShared;
+  // What this panel reads from the system card (shared/system.js): the tether
+  // and the aerostat in calm air, gravity and the starting length.
+  const CARD = S.declareCard("bands", [
+    "cable.preset", "cable.diameter_m if preset", "cable.mass_per_length_kg_m", "cable.breaking_strength_n",
+    "aerostat.preset", "aerostat.net_buoyancy_n", "aerostat.mass_kg",
+    "gravity_m_s2", "initial_length_m",
+  ]);
   const SOURCE = "bands";
   // [id, label, default, name (the request path; the σ are not one)]
   const fields = [
@@ -49,7 +57,7 @@
   const roots = () => [document.getElementById("bands-form"), document.getElementById("plan-form")];
 
   function request(errors) {
-    const sys = S.readSystem(errors, "calm");
+    const sys = S.readSystem(errors, CARD);
     const inputs = [{ field: "aerostat.net_buoyancy_n", distribution: "normal", mean: sys.aerostat.net_buoyancy_n, std_dev: num("bands-lift-sd") }];
     if (sys.cable.mass_per_length_kg_m != null) {
       inputs.push({ field: "cable.mass_per_length_kg_m", distribution: "normal", mean: sys.cable.mass_per_length_kg_m, std_dev: num("bands-rhoa-sd") });

@@ -8,8 +8,19 @@
 // tensions of the mean wind and of the gust check.
 "use strict";
 
+import S from "./shared/index.js";
+
 (function () {
-  const S = window.tetherplanShared;
+  // What this panel reads from the system card (shared/system.js): the tether,
+  // the aerostat with its aerodynamics, gravity, the safety factor and today's wind.
+  const CARD = S.declareCard("dynamics", [
+    "cable.preset", "cable.diameter_m", "cable.mass_per_length_kg_m", "cable.breaking_strength_n",
+    "cable.normal_drag_coefficient_nondim", "cable.axial_stiffness_n",
+    "aerostat.preset", "aerostat.net_buoyancy_n", "aerostat.mass_kg",
+    "aerostat.drag_coefficient_nondim", "aerostat.reference_area_m2", "aerostat.lift_coefficient_nondim",
+    "gravity_m_s2", "required_safety_factor_nondim",
+    "wind.air_density_kg_m3", "wind.flow", "wind.gust",
+  ]);
   const form = document.getElementById("dynamics-form");
   if (!form) return;
   const $ = (id) => document.getElementById(id);
@@ -66,7 +77,7 @@
 
   // The system (card + today's wind) with this panel's inputs.
   function base(errors, history) {
-    const sys = S.readSystem(errors, "wind");
+    const sys = S.readSystem(errors, CARD);
     return {
       cable: sys.cable,
       aerostat: sys.aerostat,

@@ -6,11 +6,23 @@
 // its binding limit (tension, stability, slack, ceiling), the highest
 // altitude per wind marked, tables of the largest operating wind per length
 // and the highest altitude per wind, and CSV/PNG export with every input
-// recorded. Self-contained: only window.tetherplanCommon is shared.
+// recorded. Self-contained: it uses shared/ alone.
 "use strict";
 
+import S from "./shared/index.js";
+
 (function () {
-  const S = window.tetherplanShared;
+  // What this panel reads from the system card (shared/system.js): the tether,
+  // the aerostat with its aerodynamics, gravity, the safety factor and today's
+  // wind, whose profile the envelope scales to each grid speed.
+  const CARD = S.declareCard("envelope", [
+    "cable.preset", "cable.diameter_m", "cable.mass_per_length_kg_m", "cable.breaking_strength_n",
+    "cable.normal_drag_coefficient_nondim", "cable.axial_stiffness_n",
+    "aerostat.preset", "aerostat.net_buoyancy_n", "aerostat.mass_kg",
+    "aerostat.drag_coefficient_nondim", "aerostat.reference_area_m2", "aerostat.lift_coefficient_nondim",
+    "gravity_m_s2", "required_safety_factor_nondim",
+    "wind.air_density_kg_m3", "wind.flow", "wind.gust",
+  ]);
   const form = document.getElementById("envelope-form");
   if (!form) return;
   const $ = (id) => document.getElementById(id);
@@ -30,7 +42,7 @@
   const num = (name, errors, opts) => S.readNumber(form, name, errors, opts);
 
   function readRequest(errors) {
-    const sys = S.readSystem(errors, "wind");
+    const sys = S.readSystem(errors, CARD);
     return S.compact({
       cable: sys.cable,
       aerostat: sys.aerostat,

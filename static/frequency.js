@@ -1,17 +1,29 @@
 // The frequency-response panel (SPEC §2): one transient run per wind
 // frequency ω of u = U₀ sin(ωt), with the deployment, initial state and
-// aerostat body of the transient-run panel (transient.js, whose readers,
-// plot and solve helpers it reuses through window.tetherplanTransient.lib).
+// aerostat body of the transient-run form (read by shared/run.js, with its
+// plot and solve helpers; this panel does not need transient.js).
 // Posts /api/v1/frequency-response (or a job when there are many
 // frequencies), plots the peak tip amplitude against ω and a heat map of the
 // envelope over (time, ω), and exports CSV. No build step.
 "use strict";
 
+import S from "./shared/index.js";
+import {
+  COLORS, state, num, readSystem, readProfile, readInitial, readBody, clearErrors, showInputErrors,
+  fmt, peakEnvelope, log10, pow10, plotSize, makePlot, solve, finish,
+} from "./shared/run.js";
+
 (function () {
-  const state = window.tetherplanTransient;
+  // What this panel reads from the system card (shared/system.js): as the
+  // transient run, the tether, the aerostat and gravity in calm air, and the
+  // card's starting length (replaced by the transient form's L₀).
+  const CARD = S.declareCard("frequency", [
+    "cable.preset", "cable.diameter_m if preset", "cable.mass_per_length_kg_m", "cable.breaking_strength_n",
+    "aerostat.preset", "aerostat.net_buoyancy_n", "aerostat.mass_kg",
+    "gravity_m_s2", "initial_length_m",
+  ]);
   const frForm = document.getElementById("fr-form");
-  if (!state?.lib?.S || !frForm) return;
-  const { S, num, readSystem, readProfile, readInitial, readBody, makePlot, plotSize, fmt, log10, pow10, peakEnvelope, COLORS, solve, finish, clearErrors, showInputErrors } = state.lib;
+  if (!frForm || typeof uPlot === "undefined") return;
   const { colour, ticks, inputLines, sig } = S;
   const download = (text, name) => S.download(text, name, "text/csv");
   const $ = (sel) => document.querySelector(sel);
@@ -20,7 +32,7 @@
   const SYNC_FREQUENCIES = 16;
 
   function readFrequencyRequest(errors) {
-    const req = readSystem(errors);
+    const req = readSystem(errors, CARD);
     req.profile = readProfile(errors);
     req.duration_s = num("duration_s", errors);
     req.initial = readInitial(errors);
@@ -224,11 +236,22 @@
     if (state.fr.result && $("#fr-status").dataset.state === "ready") setFrStatus("stale", "Inputs changed: sweep again.");
     updateFrequencyHint();
   });
-  state.lib.updateFrequencyHint = updateFrequencyHint;
-  state.lib.resizeFrequency = () => {
-    state.fr.plot?.setSize(plotSize($("#fr-plot-peak")));
-    drawHeatmap();
-  };
+  // The transient form's inputs (deployment, initial state, body) and the
+  // chart form's elements are this panel's too; so is the system card.
+  const transientForm = $("#transient-form");
+  transientForm?.addEventListener("input", updateFrequencyHint);
+  transientForm?.addEventListener("change", updateFrequencyHint);
+  $("#chart-form")?.addEventListener("input", updateFrequencyHint);
+  document.addEventListener("tetherplan:system-input", updateFrequencyHint);
+
+  let resizeTimer = null;
+  window.addEventListener("resize", () => {
+    clearTimeout(resizeTimer);
+    resizeTimer = setTimeout(() => {
+      state.fr.plot?.setSize(plotSize($("#fr-plot-peak")));
+      drawHeatmap();
+    }, 100);
+  });
 
   // ---------- downloads ----------
 

@@ -11,8 +11,21 @@
 // disables Print and the downloads until a plan is current again.
 "use strict";
 
+import S from "./shared/index.js";
+
 (function () {
-  const S = window.tetherplanShared;
+  // What this panel reads from the system card (shared/system.js): all of it,
+  // the system, today's wind, the winch, the reserve and the start.
+  const CARD = S.declareCard("plan", [
+    "cable.preset", "cable.diameter_m", "cable.mass_per_length_kg_m", "cable.breaking_strength_n",
+    "cable.normal_drag_coefficient_nondim", "cable.axial_stiffness_n",
+    "aerostat.preset", "aerostat.net_buoyancy_n", "aerostat.mass_kg",
+    "aerostat.drag_coefficient_nondim", "aerostat.reference_area_m2", "aerostat.lift_coefficient_nondim",
+    "gravity_m_s2", "required_safety_factor_nondim",
+    "wind.air_density_kg_m3", "wind.flow", "wind.gust",
+    "winch.max_rate_m_s", "winch.max_acceleration_m_s2", "winch.max_jerk_m_s3",
+    "lift_reserve_nondim", "initial_length_m",
+  ]);
   const form = document.getElementById("plan-form");
   if (!form) return;
   const $ = (id) => document.getElementById(id);
@@ -106,7 +119,7 @@
   }
 
   function readRequest(errors) {
-    const body = S.readSystem(errors, "plan");
+    const body = S.readSystem(errors, CARD);
     body.target_elevation_m = S.readNumber(roots, "target_elevation_m", errors);
     const floor = S.readNumber(roots, "min_altitude_m", errors, { optional: true, fallback: undefined });
     if (floor != null) body.min_altitude_m = floor;
@@ -534,5 +547,7 @@
   toggleAerostat();
   toggleWind();
   state.runPlan = runPlan;
+  // Another panel that changes the plan's inputs (windows.js) asks for a plan with this event.
+  document.addEventListener("tetherplan:plan-request", () => runPlan());
   runPlan();
 })();

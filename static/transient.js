@@ -3,102 +3,35 @@
 // (directly, or as a background job with progress when long), and plots the
 // tip deflection with its envelope, the energy and the first natural
 // frequency against time (uPlot). API errors are shown next to the field they
-// name. The frequency-response panel (frequency.js) reuses its readers and
-// plots through window.tetherplanTransient.lib. No build step.
+// name. Its readers, plots and solve helpers are in shared/run.js, which the
+// frequency-response panel (frequency.js) uses too. No build step.
 "use strict";
 
+import S from "./shared/index.js";
+import {
+  COLORS, state, num, readSystem, readProfile, readInitial, readBody, clearErrors, showInputErrors,
+  fmt, peakEnvelope, log10, pow10, plotSize, makePlot, solve, finish,
+} from "./shared/run.js";
+
 (function () {
-  const S = window.tetherplanShared;
-  const SOURCE = "transient";
+  // What this panel reads from the system card (shared/system.js): the tether,
+  // the aerostat and gravity in calm air, and the card's starting length
+  // (replaced by this panel's L₀).
+  const CARD = S.declareCard("transient", [
+    "cable.preset", "cable.diameter_m if preset", "cable.mass_per_length_kg_m", "cable.breaking_strength_n",
+    "aerostat.preset", "aerostat.net_buoyancy_n", "aerostat.mass_kg",
+    "gravity_m_s2", "initial_length_m",
+  ]);
   // Runs with more work than this (simulated seconds × elements; 600 s at 50
   // elements) go through a job. So does any run the server refuses directly
   // (422 `too_large`, 503 busy, 504 timeout).
   const JOB_WORK = 30_000;
-  const COLORS = { tip: "#0072b2", envelope: "#d55e00", energy: "#009e73", vibration: "#cc79a7", freq: "#0072b2", wind: "#d55e00" };
 
   const $ = (sel) => document.querySelector(sel);
   const form = $("#transient-form");
   if (!form || typeof uPlot === "undefined") return;
 
-  // Shared with the browser test and the console: requests, answers, what is plotted.
-  const state = {
-    request: null,
-    result: null,
-    via: null,
-    envelope: null,
-    resonance: null,
-    firstUnstable: null,
-    jobProgress: [],
-    plots: { tip: null, energy: null, freq: null },
-    fr: { request: null, result: null, via: null, peak: null, jobProgress: [], plot: null },
-    jobs: { run: {}, fr: {} },
-  };
-  state.lib = {};
-  window.tetherplanTransient = state;
-
   // ---------- inputs ----------
-
-  // This section's inputs first, then the chart form's (elements) and the system card's.
-  const roots = [$("#transient"), $("#chart-form"), $("#plan-form")];
-  const num = (field, errors, opts) => S.readNumber(roots, field, errors, opts);
-  const inputFor = (field) => S.inputFor(roots, field);
-
-  // The tether, aerostat and gravity of the card; L0 from this panel; the
-  // chart's element count (blank there: the default mesh).
-  function readSystem(errors) {
-    const sys = S.readSystem(errors, "calm");
-    sys.initial_length_m = num("initial_length_m", errors);
-    const elements = num("model.elements", errors, { integer: true, optional: true, fallback: 50 });
-    sys.model = elements === undefined ? { kind: "linear_string" } : { kind: "linear_string", elements };
-    return sys;
-  }
-
-  function readProfile(errors) {
-    const kind = $("#tr-profile").value;
-    if (kind === "trapezoidal") {
-      return {
-        kind,
-        cruise_rate_m_s: num("profile.cruise_rate_m_s", errors),
-        ramp_up_s: num("profile.ramp_up_s", errors),
-        ramp_down_s: num("profile.ramp_down_s", errors),
-        target_length_m: num("profile.target_length_m", errors),
-      };
-    }
-    const rate = num("profile.rate_m_s", errors);
-    const profile = { kind: "constant_rate", rate_m_s: kind === "shortening" && rate != null ? -Math.abs(rate) : rate };
-    const stop = num("profile.target_length_m", errors, { optional: kind !== "shortening" });
-    if (stop !== undefined) profile.target_length_m = stop;
-    return profile;
-  }
-
-  function readInitial(errors) {
-    const kind = $("#tr-initial").value;
-    if (kind === "shape") return { kind, tip_deflection_m: num("initial.tip_deflection_m", errors) };
-    if (kind === "tip_force") return { kind, force_n: num("initial.force_n", errors), duration_s: num("initial.duration_s", errors) };
-    return { kind: "rest" };
-  }
-
-  // The aerostat as an aerodynamic body (AeroBodyInput): the sphere radius
-  // from this panel; the drag coefficient, reference area and air density
-  // from the system card (the numbers the plan and the envelope use).
-  const cardRoots = () => [$("#system-card"), $("#plan-form")];
-  // Where the API's `aero` fields are entered on the page.
-  const CARD_FIELDS = {
-    "aero.model.drag_coefficient_nondim": "aerostat.drag_coefficient_nondim",
-    "aero.model.reference_area_m2": "aerostat.reference_area_m2",
-    "aero.air_density_kg_m3": "wind.air_density_kg_m3",
-  };
-  function readBody(errors) {
-    const fromCard = (name, opts) => S.readNumber(cardRoots(), name, errors, opts);
-    const model = $("#tr-force-model").value === "drag"
-      ? S.compact({
-          kind: "drag",
-          drag_coefficient_nondim: fromCard("aerostat.drag_coefficient_nondim"),
-          reference_area_m2: fromCard("aerostat.reference_area_m2", { optional: true }),
-        })
-      : { kind: "thesis" };
-    return { model, radius_m: num("aero.radius_m", errors), air_density_kg_m3: fromCard("wind.air_density_kg_m3") };
-  }
 
   function readFlow(errors) {
     const kind = $("#tr-wind").value;
@@ -122,7 +55,7 @@
   }
 
   function readSimulateRequest(errors) {
-    const req = readSystem(errors);
+    const req = readSystem(errors, CARD);
     req.profile = readProfile(errors);
     req.duration_s = num("duration_s", errors);
     req.samples = num("samples", errors, { integer: true });
@@ -140,83 +73,12 @@
   const work = (req) => (req.duration_s || 0) * (req.model.elements || 50);
   const runWantsJob = (req) => work(req) > JOB_WORK;
 
-  // ---------- errors next to fields, status and jobs ----------
-
-  const clearErrors = () => S.clearErrors(SOURCE);
-  // Renders an API error body next to its field (or in `fallback`); returns a summary.
-  function renderApiError(status, body, fallback) {
-    const field = body?.error?.field;
-    const onCard = field && Object.keys(CARD_FIELDS).find((k) => field === k || field.startsWith(`${k}.`));
-    if (onCard) {
-      body = { ...body, error: { ...body.error, field: CARD_FIELDS[onCard] } };
-      const text = S.renderApiError(cardRoots(), status, body, fallback, SOURCE);
-      return `Fix the highlighted field (in the system card above): ${text}`;
-    }
-    const input = inputFor(field);
-    const text = S.renderApiError(roots, status, body, fallback, SOURCE);
-    if (!input) return text;
-    const where = input.closest("#transient") ? "" : input.closest("#chart-form") ? " (in the chart form above)" : " (in the system card above)";
-    return `Fix the highlighted field${where}: ${text}`;
-  }
-  function showInputErrors(errors, statusFn) {
-    S.showInputErrors(roots, errors, SOURCE);
-    statusFn("error", "Fix the highlighted fields.");
-  }
+  // ---------- status and jobs ----------
 
   const setRunStatus = S.statusSetter($("#tr-status"), $("#tr-results"));
   const runJob = S.jobRunner("tr-", { log: state.jobProgress, slot: state.jobs.run });
 
   // ---------- numbers ----------
-
-  function fmt(v, digits = 3) {
-    if (v == null || !Number.isFinite(v)) return "–";
-    const a = Math.abs(v);
-    return a !== 0 && (a >= 1e5 || a < 1e-3) ? v.toExponential(digits - 1) : S.sig3(v, digits);
-  }
-
-  // Centered sliding maximum of `values` over `half` samples either side.
-  function slidingMax(values, half) {
-    const n = values.length;
-    const out = new Array(n);
-    // Monotone deque: O(n).
-    const dq = [];
-    let head = 0;
-    let next = 0;
-    for (let i = 0; i < n; i++) {
-      const hi = Math.min(n - 1, i + half);
-      while (next <= hi) {
-        while (dq.length > head && values[dq[dq.length - 1]] <= values[next]) dq.pop();
-        dq.push(next++);
-      }
-      while (dq[head] < i - half) head++;
-      out[i] = values[dq[head]];
-    }
-    return out;
-  }
-
-  // An upper envelope of |y|: straight lines through its dominant peaks (the
-  // samples that are the largest within `half` samples either side), never
-  // below |y| itself.
-  function peakEnvelope(abs, half) {
-    const n = abs.length;
-    if (n < 3) return abs.slice();
-    const local = slidingMax(abs, half);
-    const peaks = [0];
-    for (let i = 1; i < n - 1; i++) if (abs[i] > 0 && abs[i] === local[i] && i - peaks[peaks.length - 1] > half) peaks.push(i);
-    const out = new Array(n);
-    for (let k = 1; k < peaks.length; k++) {
-      const a = peaks[k - 1];
-      const b = peaks[k];
-      for (let i = a; i <= b; i++) {
-        const line = abs[a] + ((abs[b] - abs[a]) * (i - a)) / (b - a || 1);
-        out[i] = Math.max(line, abs[i]);
-      }
-    }
-    // After the last peak: hold it (the run ends mid-swing).
-    const last = peaks[peaks.length - 1];
-    for (let i = last; i < n; i++) out[i] = Math.max(abs[last], abs[i]);
-    return out;
-  }
 
   // The first time ω₁(t) crosses ω, interpolated in the eigenvalue track.
   function resonance(track, omega) {
@@ -239,24 +101,6 @@
   }
 
   // ---------- plots ----------
-
-  const axis = { stroke: "#333", grid: { stroke: "#e5e5e5" }, ticks: { stroke: "#ccc" } };
-
-  // Log scale: uPlot's log axes find no ticks across the 60 decades of a
-  // diverged run, so the data are plotted as log₁₀ on a linear axis whose
-  // labels and legend values are shown as powers of ten.
-  const log10 = (a) => a.map((v) => (v > 0 ? Math.log10(v) : null));
-  // 10^k as a short label: 0.01 … 10000 plainly, else 1e60 or 3.2e59.
-  function powLabel(k, digits = 2) {
-    if (k >= -2 && k <= 4) return String(Number((10 ** k).toPrecision(digits)));
-    const e = Math.floor(k + 1e-9);
-    const m = Number((10 ** (k - e)).toPrecision(digits));
-    return m === 1 ? `1e${e}` : m >= 10 ? `1e${e + 1}` : `${m}e${e}`;
-  }
-  const pow10 = (u, v) => (v == null ? "–" : powLabel(v, 3));
-  const logAxis = { ...axis, values: (u, splits) => splits.map((v) => powLabel(v)) };
-
-  const plotSize = (el, aspect = 0.6) => S.plotSize(el, { aspect, max: 340 });
 
   // A hatch pattern (device pixels) for the region past the onset of instability.
   let hatch = null;
@@ -333,28 +177,6 @@
       ],
     },
   };
-
-  function makePlot(el, series, data, xLabel, yLabel, extra = {}) {
-    el.textContent = "";
-    // Legend values: blank until the cursor is on the plot (not a row of "–").
-    const blankIdle = series.map((s) => (s.value ? { ...s, value: (u, v, ...rest) => (v == null ? "" : s.value(u, v, ...rest)) } : s));
-    return new uPlot(
-      {
-        ...plotSize(el),
-        series: blankIdle,
-        scales: { x: { time: false } },
-        axes: [
-          { ...axis, label: xLabel },
-          extra.log ? { ...logAxis, label: yLabel, size: 62 } : { ...axis, label: yLabel, size: 62 },
-        ],
-        legend: { live: true, markers: { dash: (u, i) => (u.series[i].dash ? "dashed" : "solid"), fill: () => "transparent" } },
-        cursor: { drag: { x: true, y: false } },
-        plugins: extra.plugins || [],
-      },
-      data,
-      el,
-    );
-  }
 
   // Why the run ended, in words (the API's stopped_reason).
   function stopReason(res) {
@@ -498,27 +320,6 @@
 
   // ---------- submitting ----------
 
-  // Runs `req` directly or as a job; resolves to {result, via} or {status, error}.
-  async function solve(path, kind, req, useJob, setStatus, job, what) {
-    if (useJob) {
-      setStatus("busy", `Submitting a job (${what})…`);
-      return job(kind, req, what, setStatus);
-    }
-    setStatus("busy", `Computing (${what})…`);
-    const r = await S.api("POST", path, req);
-    if (S.needsJob(r)) {
-      setStatus("busy", "The server asked for a background job…");
-      return job(kind, req, what, setStatus);
-    }
-    return r.ok ? { result: r.body, via: "direct" } : { status: r.status, error: r.body };
-  }
-
-  function finish(outcome, render, setStatus, errorEl) {
-    if (outcome.result) render(outcome.result);
-    else if (outcome.error?.error?.code === "cancelled") setStatus("idle", "Job cancelled.");
-    else setStatus("error", renderApiError(outcome.status, outcome.error, errorEl));
-  }
-
   let runBusy = false;
   form.addEventListener("submit", async (ev) => {
     ev.preventDefault();
@@ -564,7 +365,6 @@
     const errors = [];
     const req = readSimulateRequest(errors);
     $("#tr-hint").textContent = errors.length ? "" : runWantsJob(req) ? "long run · runs as a background job" : "";
-    state.lib.updateFrequencyHint?.();
   }
 
   const stale = () => {
@@ -608,11 +408,8 @@
       for (const [key, sel] of [["tip", "#tr-plot-tip"], ["energy", "#tr-plot-energy"], ["freq", "#tr-plot-freq"]]) {
         state.plots[key]?.setSize(plotSize($(sel)));
       }
-      state.lib.resizeFrequency?.();
     }, 100);
   });
 
-  // What frequency.js reuses: the readers, the plot and the solve helpers.
-  Object.assign(state.lib, { S, roots, num, readSystem, readProfile, readInitial, readBody, makePlot, plotSize, fmt, log10, pow10, peakEnvelope, COLORS, solve, finish, clearErrors, showInputErrors, renderApiError });
   updateHints();
 })();

@@ -11,8 +11,21 @@
 // panel and kept in the URL (`units_speed`, `units_length`); the API stays SI.
 "use strict";
 
+import S from "./shared/index.js";
+
 (function () {
-  const S = window.tetherplanShared;
+  // What this panel reads from the system card (shared/system.js): what the
+  // plan reads (each window is planned as today is).
+  const CARD = S.declareCard("windows", [
+    "cable.preset", "cable.diameter_m", "cable.mass_per_length_kg_m", "cable.breaking_strength_n",
+    "cable.normal_drag_coefficient_nondim", "cable.axial_stiffness_n",
+    "aerostat.preset", "aerostat.net_buoyancy_n", "aerostat.mass_kg",
+    "aerostat.drag_coefficient_nondim", "aerostat.reference_area_m2", "aerostat.lift_coefficient_nondim",
+    "gravity_m_s2", "required_safety_factor_nondim",
+    "wind.air_density_kg_m3", "wind.flow", "wind.gust",
+    "winch.max_rate_m_s", "winch.max_acceleration_m_s2", "winch.max_jerk_m_s3",
+    "lift_reserve_nondim", "initial_length_m",
+  ]);
   const plan = document.getElementById("plan");
   if (!S || !plan) return;
   const KNOT = 1852 / 3600;
@@ -88,7 +101,7 @@
     const text = $("windows-data").value;
     if (!text.trim()) return;
     const errors = [];
-    const sys = S.readSystem(errors, "plan");
+    const sys = S.readSystem(errors, CARD);
     const format = detect(text);
     let data = text;
     if (format === "open_meteo") {
@@ -209,7 +222,7 @@
     set("wind.gust.peak_factor_nondim", "");
     set("wind.gust.gust_m_s", h.wind.gust?.gust_m_s ?? "");
     set("wind.air_density_kg_m3", h.wind.air_density_kg_m3);
-    window.tetherplanPlan?.runPlan?.();
+    document.dispatchEvent(new CustomEvent("tetherplan:plan-request"));
   }
 
   async function readFile(file) {

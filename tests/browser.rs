@@ -31,6 +31,10 @@
 //!   launch-windows panel: the day's timeline; a NO-GO hour turns the plan NO-GO.
 //! * `docs_page.mjs` runs every POST operation's "Try it out" in `/docs`
 //!   with the document's example (each must answer 2xx) under the CSP.
+//! * `panels_page.mjs` checks the page's panels as units: each panel's
+//!   system-card declaration gets exactly the paths it lists from the card's
+//!   reader; the frequency-response panel sweeps with `transient.js` absent;
+//!   the panels' script tags in reverse order still plan GO.
 //!
 //! The two run one after the other (a lock), not side by side on 2 cores.
 //!
@@ -234,4 +238,9 @@ fn dynamics_page_in_headless_chromium() {
 #[test]
 fn windows_page_in_headless_chromium() {
     run_page_script("windows_page.mjs");
+}
+
+#[test]
+fn panels_page_in_headless_chromium() {
+    run_page_script("panels_page.mjs");
 }

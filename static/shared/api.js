@@ -1,10 +1,10 @@
 // The page's HTTP: the JSON fetch wrapper (with the API token asked for once
 // per browser session), background jobs with progress and cancel, and the
-// unwrapping of a job's errors onto the request's own fields. Loaded first;
-// every panel uses window.tetherplanShared.{api, runJob, needsJob}.
+// unwrapping of a job's errors onto the request's own fields. Every panel
+// uses S.{api, jobRunner, needsJob} (S: index.js).
 "use strict";
 
-window.tetherplanShared = window.tetherplanShared || {};
+import shared from "./core.js";
 
 (function (shared) {
   // Servers with tokens configured answer 401 without one: asked for once,
@@ -124,4 +124,4 @@ window.tetherplanShared = window.tetherplanShared || {};
   }
 
   Object.assign(shared, { api, unwrapJobError, needsJob, sleep, jobRunner, statusSetter });
-})(window.tetherplanShared);
+})(shared);

@@ -4,7 +4,7 @@
 // with their captions, a drawn legend and the inputs.
 "use strict";
 
-window.tetherplanShared = window.tetherplanShared || {};
+import shared from "./core.js";
 
 (function (shared) {
   function download(content, name, type = "text/plain") {
@@ -113,4 +113,4 @@ window.tetherplanShared = window.tetherplanShared || {};
   }
 
   Object.assign(shared, { download, flatten, sig, inputLines, wrap, plotsPng });
-})(window.tetherplanShared);
+})(shared);

@@ -5,7 +5,7 @@
 // same names, other panels' with their prefix: `envelope.tether_lengths_m.max`).
 "use strict";
 
-window.tetherplanShared = window.tetherplanShared || {};
+import shared from "./core.js";
 
 (function (shared) {
   const visible = (el) => !!el && !el.closest("[hidden]");
@@ -45,82 +45,6 @@ window.tetherplanShared = window.tetherplanShared || {};
 
   // Leaves out keys whose value is undefined (optional inputs left blank).
   const compact = (obj) => Object.fromEntries(Object.entries(obj).filter(([, v]) => v !== undefined));
-
-  // ---------- the system card ----------
-
-  // The §9 system from the card (and the plan form's wind and starting length).
-  // `use`: "plan" (everything), "wind" (the envelope: no winch; today's wind,
-  // whose profile the envelope scales to each grid speed), "calm" (string analyses in calm air: the
-  // tether's mass and rating, the aerostat's lift and mass).
-  function readSystem(errors, use = "plan") {
-    const roots = [card(), document.getElementById("plan-form")];
-    const n = (name, opts) => readNumber(roots, name, errors, opts);
-    const preset = named(roots, "cable.preset")?.value || "";
-    const cable = compact({
-      preset: preset || undefined,
-      diameter_m: use === "calm" && !preset ? undefined : n("cable.diameter_m", { optional: use === "calm" }),
-      mass_per_length_kg_m: n("cable.mass_per_length_kg_m", { optional: !!preset }),
-      breaking_strength_n: n("cable.breaking_strength_n", { optional: true }),
-      normal_drag_coefficient_nondim: use === "calm" ? undefined : n("cable.normal_drag_coefficient_nondim", { optional: true }),
-      axial_stiffness_n: use === "calm" ? undefined : n("cable.axial_stiffness_n", { optional: true }),
-    });
-    // A named aerostat fills what is left blank.
-    const body = named(roots, "aerostat.preset")?.value || "";
-    const a = (name) => n(name, { optional: !!body });
-    const aerostat = compact({ preset: body || undefined, net_buoyancy_n: a("aerostat.net_buoyancy_n"), mass_kg: a("aerostat.mass_kg") });
-    if (use !== "calm") {
-      Object.assign(aerostat, compact({
-        drag_coefficient_nondim: a("aerostat.drag_coefficient_nondim"),
-        reference_area_m2: a("aerostat.reference_area_m2"),
-        lift_coefficient_nondim: a("aerostat.lift_coefficient_nondim"),
-      }));
-    }
-    const sys = { cable, aerostat, gravity_m_s2: n("gravity_m_s2") };
-    if (use === "calm") {
-      sys.initial_length_m = n("initial_length_m");
-      return sys;
-    }
-    sys.required_safety_factor_nondim = n("required_safety_factor_nondim");
-    sys.wind = { air_density_kg_m3: n("wind.air_density_kg_m3"), flow: readFlow(roots, errors) };
-    const gust = readGust(roots, errors);
-    if (gust) sys.wind.gust = gust;
-    if (use === "wind") return sys;
-    sys.winch = compact({
-      max_rate_m_s: n("winch.max_rate_m_s"),
-      max_acceleration_m_s2: n("winch.max_acceleration_m_s2"),
-      max_jerk_m_s3: n("winch.max_jerk_m_s3", { optional: true }),
-    });
-    sys.lift_reserve_nondim = n("lift_reserve_nondim");
-    sys.initial_length_m = n("initial_length_m");
-    return sys;
-  }
-
-  // Today's wind: uniform, or a log law through the speed at the reference height.
-  function readFlow(roots, errors) {
-    const n = (name, opts) => readNumber(roots, name, errors, opts);
-    const kind = named(roots, "wind.flow.kind")?.value || "uniform";
-    if (kind === "power_law") {
-      return { kind, coefficient_m_s: n("wind.flow.speed_m_s"), exponent_nondim: n("wind.flow.exponent_nondim"),
-        reference_height_m: n("wind.flow.power_reference_height_m") };
-    }
-    const flow = { kind, speed_m_s: n("wind.flow.speed_m_s") };
-    if (kind === "log_law") {
-      flow.reference_height_m = n("wind.flow.reference_height_m");
-      flow.roughness_length_m = n("wind.flow.roughness_length_m");
-    }
-    return flow;
-  }
-
-  // The gusts (SPEC §10): a turbulence intensity (with its peak factor) or a
-  // gust speed; both blank: none. Both given go to the API, which says which to drop.
-  function readGust(roots, errors) {
-    const n = (name) => readNumber(roots, name, errors, { optional: true, fallback: undefined });
-    const intensity = n("wind.gust.turbulence_intensity_nondim");
-    const speed = n("wind.gust.gust_m_s");
-    if (intensity == null && speed == null) return null;
-    const peak = intensity == null ? undefined : n("wind.gust.peak_factor_nondim");
-    return compact({ turbulence_intensity_nondim: intensity ?? undefined, peak_factor_nondim: peak ?? undefined, gust_m_s: speed ?? undefined });
-  }
 
   // ---------- errors beside their fields, in plain words ----------
 
@@ -284,7 +208,7 @@ window.tetherplanShared = window.tetherplanShared || {};
   }
 
   Object.assign(shared, {
-    visible, named, readNumber, compact, readSystem, labelOf, plainMessage, inputFor, clearFieldError, clearErrors,
+    visible, named, readNumber, compact, labelOf, plainMessage, inputFor, clearFieldError, clearErrors,
     showFieldError, showFormError, renderApiError, showInputErrors, writeUrl, readUrl,
   });
-})(window.tetherplanShared);
+})(shared);

@@ -4,7 +4,7 @@
 // heat maps (envelope, frequency response).
 "use strict";
 
-window.tetherplanShared = window.tetherplanShared || {};
+import shared from "./core.js";
 
 (function (shared) {
   // Fixed decimals (large values in exponent form).
@@ -162,4 +162,4 @@ window.tetherplanShared = window.tetherplanShared || {};
   }
 
   Object.assign(shared, { fixed, sig3, legendValue, plotSize, decadesOnly, makePlot, ticks, colour, colourBar, heatCells, heatFrame, heatScale });
-})(window.tetherplanShared);
+})(shared);
