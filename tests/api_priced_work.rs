@@ -167,6 +167,23 @@ fn ge_system() -> Value {
            "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0}, "initial_length_m": 1.0})
 }
 
+/// The thesis' base-excited GE cable (E* 5, scaled time), 16 frequencies,
+/// `steps` steps of each run on `elements` elements.
+fn base_excitation(elements: usize, steps: usize) -> Value {
+    let scale = (0.078f64 / 1000.0).sqrt();
+    json!({
+        "excitation": "base",
+        "cable": {"mass_per_length_kg_m": 0.078},
+        "model": {"kind": "geometrically_exact", "elements": elements, "bending_stiffness_n_m2": 1000.0,
+                  "stiffness_ratio": 5.0, "inertia_ratio": 1.0},
+        "amplitude_m": 1e-3,
+        "frequencies_rad_s": {"min": 1.0 / scale, "max": 3.5 / scale, "count": 16},
+        "duration_s": steps as f64 * 0.05 * scale,
+        "time_step_s": 0.05 * scale,
+        "profile": {"kind": "constant_rate", "rate_m_s": 0.005 / scale}
+    })
+}
+
 /// A CSV forecast of `hours` hours, each with its own wind (no two alike).
 fn hourly_csv(hours: usize) -> String {
     let mut s = String::from("time,height_m,speed_m_s,gust_m_s\n");
@@ -264,6 +281,28 @@ fn kind_shapes() -> Vec<Shape> {
             body: Box::new(|n| {
                 let mut b = example("/api/v1/frequency-response");
                 b["frequencies_rad_s"] = json!({"min": 1.0, "max": 4.0, "count": 16});
+                b["model"] = json!({"kind": "linear_string", "elements": n});
+                b
+            }),
+        },
+        Shape {
+            name: "frequency response: GE base excitation, 16 frequencies, many steps",
+            path: "/api/v1/frequency-response",
+            top: 2_000_000,
+            body: Box::new(|n| base_excitation(10, n)),
+        },
+        Shape {
+            name: "frequency response: GE base excitation, 16 frequencies, many elements",
+            path: "/api/v1/frequency-response",
+            top: 2000,
+            body: Box::new(|n| base_excitation(n, 400)),
+        },
+        Shape {
+            name: "safe rate: string, many elements",
+            path: "/api/v1/safe-rate",
+            top: 2000,
+            body: Box::new(|n| {
+                let mut b = example("/api/v1/safe-rate");
                 b["model"] = json!({"kind": "linear_string", "elements": n});
                 b
             }),

@@ -314,12 +314,10 @@ impl Analysis for AnyFrequencyResponseRequest {
         }
         Ok(())
     }
-    /// Wind forcing on the string (the GE base excitation is bounded by
-    /// its frequency limit alone).
     fn price(&self) -> Option<Price> {
         match self {
             Self::Wind(r) => crate::contract::transient::price::frequency_response(r),
-            Self::Base(_) => None,
+            Self::Base(r) => crate::contract::ge::price::base_frequency_response(r),
         }
     }
     fn run(&self, progress: &dyn Progress) -> Result<AnyFrequencyResponseResponse, RequestError> {
