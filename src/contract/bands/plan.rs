@@ -35,8 +35,8 @@ use crate::contract::bands::common::{
 };
 use crate::contract::bands::dto::{PercentileBand, RejectedSamplesOutput, UncertainInput};
 use crate::contract::bands::run::{RawSystem, SystemField};
-use crate::contract::dto::SystemInput;
 use crate::contract::plan::{PlanRequest, PlanResponse};
+use crate::contract::system::input::SystemInput;
 use crate::contract::{Progress, RequestError, parse_value};
 use crate::numerics::chart::Parallelism;
 use crate::numerics::params::{AerostatSystem, InvalidInput};
@@ -471,7 +471,7 @@ pub fn plan_bands_from_chunks(
     parts: &[String],
 ) -> Result<PlanBandsResponse, RequestError> {
     let prep = prepare_plan_bands(req)?;
-    let (plan, instants) = nominal(req, &crate::contract::run::NoProgress)?;
+    let (plan, instants) = nominal(req, &crate::contract::error::NoProgress)?;
     let mut traces = Vec::with_capacity(prep.ensemble.samples);
     for part in parts {
         let wire: Vec<WireTrace> = serde_json::from_str(part)
@@ -578,7 +578,7 @@ fn summarise(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contract::run::NoProgress;
+    use crate::contract::error::NoProgress;
     use serde_json::{Value, json};
 
     fn body(extra: Value) -> Vec<u8> {

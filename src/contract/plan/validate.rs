@@ -3,11 +3,11 @@
 //! flies there), the floor, the forecast with its gusts, and the rest of
 //! the request's numbers, each refused naming its field.
 
-use crate::contract::dto::SystemInput;
+use crate::contract::error::RequestError;
 use crate::contract::plan::dto::*;
 use crate::contract::plan::ge::*;
-use crate::contract::run::RequestError;
 use crate::contract::system::WindInput;
+use crate::contract::system::input::SystemInput;
 use crate::contract::system::validate::{self as system_check, GustWind};
 use crate::numerics::params::{InvalidInput, require_finite, require_positive};
 use crate::numerics::plan::air::{Air, SteadyWind};
