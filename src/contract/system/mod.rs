@@ -13,6 +13,7 @@
 //! boundary; every field name ends in its unit (`_nondim` for pure
 //! numbers); every bound in the schema is the bound the validation applies.
 
+pub mod bounds;
 pub mod grid;
 pub mod input;
 pub mod moved;
