@@ -140,7 +140,7 @@ fn batch_item_texts(job_text: &str) -> Vec<String> {
         .collect()
 }
 
-fn parse<T: contract::dto::SystemRequest>(v: &Value) -> T {
+fn parse<T: contract::system::input::SystemRequest>(v: &Value) -> T {
     contract::parse(&serde_json::to_vec(v).unwrap()).unwrap()
 }
 

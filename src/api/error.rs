@@ -16,7 +16,7 @@ use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 
 use crate::contract::RequestError;
-use crate::contract::dto::ErrorBody;
+use crate::contract::error::ErrorBody;
 use crate::jobs::store::StoreError;
 
 /// An error answer: status, the error body, and `Retry-After` when waiting helps.

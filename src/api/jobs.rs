@@ -17,7 +17,7 @@ use utoipa::{IntoParams, ToSchema};
 use crate::api::AppState;
 use crate::api::auth::Caller;
 use crate::api::error::{ApiError, JsonBody};
-use crate::contract::dto::ErrorBody;
+use crate::contract::error::ErrorBody;
 use crate::jobs::kinds::JobSubmission;
 use crate::jobs::store::{InsertError, JobHead, JobRecord, JobStatus, StoreError};
 use crate::jobs::{JobQueue, SubmitError, Submitter};

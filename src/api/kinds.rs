@@ -18,10 +18,14 @@ use crate::api::error::{ApiError, JsonBody};
 use crate::api::solve::{Deadline, SolveCtx};
 use crate::contract::analysis::Analysis;
 use crate::contract::catalogue::for_each_kind;
-use crate::contract::dto::ErrorBody;
+use crate::contract::error::ErrorBody;
 
 /// Parse, check the synchronous limit, solve: the route of kind `A`.
-async fn solve_kind<A: Analysis>(app: AppState, caller: Caller, body: axum::body::Bytes) -> Result<Response, ApiError> {
+async fn solve_kind<A: Analysis>(
+    app: AppState,
+    caller: Caller,
+    body: axum::body::Bytes,
+) -> Result<Response, ApiError> {
     let resolver = app.clone();
     app.solve(move |ctx: &SolveCtx| {
         // A named system is merged in before the body is parsed.

@@ -16,7 +16,7 @@ use crate::api::AppState;
 use crate::api::auth::Caller;
 use crate::api::error::{ApiError, JsonBody};
 use crate::contract::RequestError;
-use crate::contract::dto::ErrorBody;
+use crate::contract::error::ErrorBody;
 use crate::contract::system::presets::PresetsResponse;
 use crate::contract::system::resolve::check_name;
 use crate::contract::system::{SystemDescription, validate};

@@ -3,27 +3,27 @@
 //! (unknown fields refused in both), and the range checks
 //! ([`crate::contract::ranges`]) run right after.
 
-use crate::contract::dto;
 use crate::contract::error::RequestError;
 use crate::contract::json::parse_value;
 use crate::contract::system;
+use crate::contract::system::input;
 use crate::numerics::params::InvalidInput;
 
 /// Parses a request body (system part and parameters); errors name the
 /// offending field path.
 ///
 /// Both parts refuse unknown fields: the body's keys are split between
-/// them ([`dto::SYSTEM_KEYS`] go to the system), and a key neither knows
+/// them ([`input::SYSTEM_KEYS`] go to the system), and a key neither knows
 /// is named with every key the request takes.
-pub fn parse<T: dto::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
+pub fn parse<T: input::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
     let value = json_object(body)?;
     let (system_part, params_part): (serde_json::Map<_, _>, serde_json::Map<_, _>) = value
         .as_object()
         .expect("json_object gives an object")
         .clone()
         .into_iter()
-        .partition(|(k, _)| dto::SYSTEM_KEYS.contains(&k.as_str()));
-    let system = parse_value::<dto::SystemInput>(&serde_json::Value::Object(system_part))?;
+        .partition(|(k, _)| input::SYSTEM_KEYS.contains(&k.as_str()));
+    let system = parse_value::<input::SystemInput>(&serde_json::Value::Object(system_part))?;
     let params =
         parse_value::<T::Params>(&serde_json::Value::Object(params_part)).map_err(|e| match e {
             RequestError::Invalid(InvalidInput { field, reason })
@@ -41,7 +41,10 @@ pub fn parse<T: dto::SystemRequest>(body: &[u8]) -> Result<T, RequestError> {
 /// Adds the system keys to the "expected one of" list of a top-level
 /// unknown-field message.
 fn with_system_keys(reason: &str) -> String {
-    let system: Vec<String> = dto::SYSTEM_KEYS.iter().map(|k| format!("`{k}`")).collect();
+    let system: Vec<String> = input::SYSTEM_KEYS
+        .iter()
+        .map(|k| format!("`{k}`"))
+        .collect();
     match reason.split_once("; expected ") {
         Some((head, tail)) => {
             let tail = tail.trim_start_matches("one of ").replace(" or ", ", ");

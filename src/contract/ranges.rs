@@ -7,10 +7,10 @@ use crate::contract::dto::*;
 use crate::contract::ge::simulate::{
     EndLoadInput, GeAerostatInput, GeModelInput, GeSimulateRequest, LoadTimeInput,
 };
+use crate::contract::ge::stability::GeStabilityRequest;
 use crate::contract::ge_charts::{
     self, GeBaseFrequencyResponseRequest, GeChartRequest, GeWindInput,
 };
-use crate::contract::ge::stability::GeStabilityRequest;
 use crate::contract::ge_critical::GeCriticalRequest;
 use crate::contract::transient::aero::{
     AeroBodyInput, AirFlowInput, FlowPointInput, ForceModelInput, SteadyFlowInput,
@@ -344,7 +344,7 @@ impl CheckRanges for FrequencyResponseParams {
 // (`crate::contract::parse`), with its system part.
 macro_rules! system_request {
     ($($req:ty => $params:ty),* $(,)?) => {$(
-        impl crate::contract::dto::SystemRequest for $req {
+        impl crate::contract::system::input::SystemRequest for $req {
             type Params = $params;
             fn from_parts(system: SystemInput, params: $params) -> Self {
                 Self { system, params }

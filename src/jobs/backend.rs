@@ -1,7 +1,7 @@
 //! The job store: what a job row (and a chunk row) holds and the
-//! operations a backend offers ([`JobBackend`]); SQLite (`sqlite.rs`) is
+//! operations a backend offers ([`JobBackend`]); SQLite (`sqlite/`) is
 //! the embedded default, and another database (PostgreSQL: `FOR UPDATE
-//! SKIP LOCKED`, `postgres.rs`) implements the same trait. Neither is
+//! SKIP LOCKED`, `postgres/`) implements the same trait. Neither is
 //! named here: both depend on this file, not it on them.
 //!
 //! Status moves `queued → running → done | failed`, or `→ cancelled` from

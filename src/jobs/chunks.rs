@@ -35,11 +35,11 @@ use std::time::{Duration, Instant};
 pub use super::backend::{ChunkLease, ChunkState, ClaimedChunk};
 use super::backend::{ClaimPolicy, JobStatus, StoreError};
 use super::kinds::JobSubmission;
+use super::queue::{JobQueue, error_json};
 pub use super::split::{
     CHUNK_TARGET_S, ChunkPlan, MAX_ITEMS_PER_CHUNK, MIN_CHUNKS, MIN_SPLIT_JOB_S,
 };
-use super::queue::{JobQueue, error_json};
-use crate::contract::dto::ErrorBody;
+use crate::contract::error::ErrorBody;
 use crate::contract::{Progress, RequestError};
 
 /// How often a running chunk looks at its job's status between lease

@@ -14,7 +14,7 @@ use super::chunks;
 use super::kinds::JobSubmission;
 use super::lease::Lease;
 use super::queue::{JobQueue, RunningJob, error_json};
-use crate::contract::dto::ErrorBody;
+use crate::contract::error::ErrorBody;
 use crate::contract::{Progress, RequestError};
 
 impl JobQueue {

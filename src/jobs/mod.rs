@@ -14,6 +14,7 @@
 //! (at once by a restarted process on the same host), and failed after
 //! `max_job_attempts` such claims.
 
+pub mod admission;
 pub mod backend;
 pub mod chunks;
 pub mod estimate;

@@ -13,7 +13,7 @@ use super::backend::{
 };
 use super::kinds::JobSubmission;
 use crate::contract::RequestError;
-use crate::contract::dto::ErrorBody;
+use crate::contract::error::ErrorBody;
 use crate::limits::Limits;
 
 /// Why a submission was refused.

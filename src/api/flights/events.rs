@@ -34,7 +34,7 @@ use crate::api::auth::Caller;
 use crate::api::error::ApiError;
 use crate::api::flights::handlers::flight_of;
 use crate::api::flights::hub::now_ms;
-use crate::contract::dto::ErrorBody;
+use crate::contract::error::ErrorBody;
 use crate::contract::flight::telemetry::TelemetrySampleInput;
 
 /// Samples per event.

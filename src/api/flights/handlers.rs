@@ -13,7 +13,7 @@ use crate::api::auth::Caller;
 use crate::api::error::{ApiError, JsonBody};
 use crate::api::flights::hub::{LiveFlight, now_ms};
 use crate::api::jobs::{blocking, json_response};
-use crate::contract::dto::ErrorBody;
+use crate::contract::error::ErrorBody;
 use crate::contract::flight::dto::*;
 use crate::contract::flight::model::prepare;
 use crate::contract::flight::replan::{ReplanOutput, replan};

@@ -5,8 +5,8 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::contract::dto::SystemInput;
 use crate::contract::system::grid::BandsRateGridInput;
+use crate::contract::system::input::SystemInput;
 
 /// `POST /api/v1/bands`: the deployment chart of one system under
 /// uncertain inputs, as 5/50/95 % bands with their sampling error.

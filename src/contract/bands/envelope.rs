@@ -396,7 +396,7 @@ pub fn envelope_bands_from_chunks(
     let nominal = crate::contract::envelope::envelope(
         &req.envelope,
         Parallelism::Rayon,
-        &crate::contract::run::NoProgress,
+        &crate::contract::error::NoProgress,
     )?;
     let cell_count = nominal.points.len();
     let mut cells = Vec::with_capacity(prep.ensemble.samples);
@@ -487,7 +487,7 @@ fn summarise(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contract::run::NoProgress;
+    use crate::contract::error::NoProgress;
     use serde_json::{Value, json};
 
     fn body(extra: Value) -> Vec<u8> {

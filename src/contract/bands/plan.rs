@@ -35,7 +35,6 @@ use crate::contract::bands::common::{
 };
 use crate::contract::bands::dto::{PercentileBand, RejectedSamplesOutput, UncertainInput};
 use crate::contract::bands::run::{RawSystem, SystemField};
-use crate::contract::dto::SystemInput;
 use crate::contract::plan::{PlanRequest, PlanResponse};
 use crate::contract::{Progress, RequestError, parse_value};
 use crate::numerics::parallel::Parallelism;
@@ -161,21 +160,6 @@ const PLAN_FIELDS: [&str; 7] = [
     "cable.breaking_strength_n",
 ];
 
-fn system_input(req: &PlanRequest) -> SystemInput {
-    SystemInput {
-        cable: req.cable.clone(),
-        aerostat: req.aerostat.clone(),
-        initial_length_m: req.initial_length_m,
-        gravity_m_s2: req.gravity_m_s2,
-        model: req.model.clone(),
-        numerics: Default::default(),
-        wind: None,
-        winch: None,
-        required_safety_factor_nondim: None,
-        lift_reserve_nondim: None,
-    }
-}
-
 /// Parses a plan bands body: the plan part exactly as `POST /api/v1/plan`
 /// parses it (unknown fields refused), `uncertainty` on its own.
 pub fn parse_plan_bands(body: &[u8]) -> Result<PlanBandsRequest, RequestError> {
@@ -199,7 +183,7 @@ pub struct PreparedPlanBands {
 /// Every check that needs no solve.
 pub fn prepare_plan_bands(req: &PlanBandsRequest) -> Result<PreparedPlanBands, RequestError> {
     crate::contract::plan::validate_plan(&req.plan)?;
-    let system = system_input(&req.plan);
+    let system = req.plan.system_input();
     let nominal = system.model()?.system;
     let base = RawSystem::of(&system);
     let u = &req.params.uncertainty;
@@ -471,7 +455,7 @@ pub fn plan_bands_from_chunks(
     parts: &[String],
 ) -> Result<PlanBandsResponse, RequestError> {
     let prep = prepare_plan_bands(req)?;
-    let (plan, instants) = nominal(req, &crate::contract::run::NoProgress)?;
+    let (plan, instants) = nominal(req, &crate::contract::error::NoProgress)?;
     let mut traces = Vec::with_capacity(prep.ensemble.samples);
     for part in parts {
         let wire: Vec<WireTrace> = serde_json::from_str(part)
@@ -578,7 +562,7 @@ fn summarise(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contract::run::NoProgress;
+    use crate::contract::error::NoProgress;
     use serde_json::{Value, json};
 
     fn body(extra: Value) -> Vec<u8> {

@@ -23,9 +23,9 @@ use crate::contract::bands::common::{
 };
 pub use crate::contract::bands::common::{MAX_OUT_OF_RANGE, MAX_SEED};
 use crate::contract::bands::dto::*;
-use crate::contract::dto::SystemInput;
 use crate::contract::system::GridInput;
 use crate::contract::system::grid::BandsRateGridInput;
+use crate::contract::system::input::SystemInput;
 use crate::contract::{Progress, RequestError, parse_value};
 use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{AerostatSystem, InvalidInput, ranges, require_positive};
@@ -670,7 +670,7 @@ fn reject_unknown(given: &Value, known: &Value, prefix: &str) -> Result<(), Inva
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contract::run::NoProgress;
+    use crate::contract::error::NoProgress;
     use serde_json::json;
 
     fn body(extra: Value) -> Vec<u8> {

@@ -7,9 +7,9 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::contract::dto::ProfileInput;
 use crate::contract::equilibrium::dto::{AerostatInput, CableInput, WindFlowInput};
 use crate::contract::system::WinchInput;
+use crate::contract::system::input::ProfileInput;
 
 pub(crate) fn default_gravity() -> f64 {
     9.81

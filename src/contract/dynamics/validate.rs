@@ -8,7 +8,8 @@
 
 use super::dto::*;
 use crate::contract::system::WindFlowInput;
-use crate::contract::system::validate::{check_rest, require_range};
+use crate::contract::system::bounds;
+use crate::contract::system::validate::{check_rest, require_count, require_range};
 use crate::numerics::dynamics::limits::{
     check_sample_count, check_segments, check_shape_count, check_shape_times,
     check_spectral_radius, check_steps,
@@ -318,21 +319,9 @@ impl DynamicsRequest {
         let (tether, breaking_strength_n) = self.tether()?;
         let aerostat = self.aerostat()?;
         let flow = self.wind.flow.profile("wind.flow")?;
-        let air = require_range(
-            "wind.air_density_kg_m3",
-            self.wind.air_density_kg_m3,
-            0.0,
-            true,
-            5.0,
-        )?;
-        let gravity = require_range("gravity_m_s2", self.gravity_m_s2, 0.0, true, 100.0)?;
-        require_range(
-            "required_safety_factor_nondim",
-            self.required_safety_factor_nondim,
-            1.0,
-            false,
-            100.0,
-        )?;
+        let air = bounds::AIR_DENSITY_KG_M3.check_at("wind", self.wind.air_density_kg_m3)?;
+        let gravity = bounds::GRAVITY_M_S2.check(self.gravity_m_s2)?;
+        bounds::REQUIRED_SAFETY_FACTOR.check(self.required_safety_factor_nondim)?;
         check_rest(self.winch.as_ref(), None, self.lift_reserve_nondim)?;
         let duration = require_range("duration_s", self.duration_s, 0.0, true, MAX_DURATION_S)?;
         let n = &self.numerics;

@@ -11,7 +11,7 @@ pub mod stability;
 
 use crate::contract::equilibrium::dto::WindFlowInput;
 use crate::contract::equilibrium::dto::{ResolvedAerostatOutput, ResolvedCableOutput};
-use crate::contract::equilibrium::{require_count, require_range};
+use crate::contract::system::bounds::{self, require_range};
 use crate::contract::system::grid::GridBounds;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::parallel::Parallelism;
@@ -48,20 +48,9 @@ impl EnvelopeRequest {
                 reference_height_m,
             } => (
                 WindShape::PowerLaw {
-                    exponent: require_range(
-                        "wind.flow.exponent_nondim",
-                        *exponent_nondim,
-                        0.0,
-                        false,
-                        2.0,
-                    )?,
-                    reference_height_m: require_range(
-                        "wind.flow.reference_height_m",
-                        *reference_height_m,
-                        0.0,
-                        true,
-                        1e4,
-                    )?,
+                    exponent: bounds::EXPONENT.check_at("wind.flow", *exponent_nondim)?,
+                    reference_height_m: bounds::REFERENCE_HEIGHT_M
+                        .check_at("wind.flow", *reference_height_m)?,
                 },
                 *coefficient_m_s,
             ),
@@ -70,20 +59,8 @@ impl EnvelopeRequest {
                 reference_height_m,
                 roughness_length_m,
             } => {
-                let z0 = require_range(
-                    "wind.flow.roughness_length_m",
-                    *roughness_length_m,
-                    crate::contract::system::validate::MIN_ROUGHNESS_M,
-                    false,
-                    10.0,
-                )?;
-                let zr = require_range(
-                    "wind.flow.reference_height_m",
-                    *reference_height_m,
-                    0.0,
-                    true,
-                    1e4,
-                )?;
+                let z0 = bounds::ROUGHNESS_LENGTH_M.check_at("wind.flow", *roughness_length_m)?;
+                let zr = bounds::REFERENCE_HEIGHT_M.check_at("wind.flow", *reference_height_m)?;
                 WindProfile::log_law(0.0, zr, z0, "wind.flow")?;
                 (
                     WindShape::LogLaw {
@@ -113,7 +90,7 @@ impl EnvelopeRequest {
             WindFlowInput::PowerLaw { .. } => "wind.flow.coefficient_m_s",
             _ => "wind.flow.speed_m_s",
         };
-        let own = require_range(field, speed, 0.0, false, 150.0)?;
+        let own = require_range(field, speed, 0.0, false, bounds::WIND_SPEED_M_S.max)?;
         match &self.wind_speeds_m_s {
             Some(g) => g.values("wind_speeds_m_s", WIND_GRID),
             None => Ok(vec![own]),
@@ -158,15 +135,9 @@ impl EnvelopeRequest {
             wind: WindProfile::calm(),
             air_density_kg_m3: self.wind.air_density()?,
             tether_length_m: lmin,
-            gravity_m_s2: require_range("gravity_m_s2", self.gravity_m_s2, 0.0, true, 100.0)?,
+            gravity_m_s2: bounds::GRAVITY_M_S2.check(self.gravity_m_s2)?,
         };
-        let required = require_range(
-            "required_safety_factor_nondim",
-            self.required_safety_factor_nondim,
-            1.0,
-            false,
-            100.0,
-        )?;
+        let required = bounds::REQUIRED_SAFETY_FACTOR.check(self.required_safety_factor_nondim)?;
         if let Some(c) = self.ceiling_m {
             require_range("ceiling_m", c, 0.0, true, 1e5)?;
         }
@@ -175,9 +146,9 @@ impl EnvelopeRequest {
         }
         self.gust_factor()?;
         if let Some(v) = self.payout_rate_m_s {
-            require_range("payout_rate_m_s", v, 0.0, false, 1000.0)?;
+            bounds::PAYOUT_RATE_M_S.check(v)?;
         }
-        let steps = require_count("integration_steps", self.integration_steps, 8, 100_000)?;
+        let steps = bounds::INTEGRATION_STEPS.check(self.integration_steps)?;
         Ok((
             EnvelopeProblem {
                 base,

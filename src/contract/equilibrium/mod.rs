@@ -12,6 +12,7 @@ use crate::numerics::tether::envelope::{Limits, judge};
 use crate::numerics::tether::{Equilibrium, EquilibriumConfig, EquilibriumProblem};
 use dto::*;
 
+use crate::contract::system::bounds;
 pub(crate) use crate::contract::system::validate::{require_count, require_range};
 
 impl EquilibriumRequest {
@@ -29,19 +30,13 @@ impl EquilibriumRequest {
                 true,
                 1e5,
             )?,
-            gravity_m_s2: require_range("gravity_m_s2", self.gravity_m_s2, 0.0, true, 100.0)?,
+            gravity_m_s2: bounds::GRAVITY_M_S2.check(self.gravity_m_s2)?,
         };
-        require_range(
-            "required_safety_factor_nondim",
-            self.required_safety_factor_nondim,
-            1.0,
-            false,
-            100.0,
-        )?;
+        bounds::REQUIRED_SAFETY_FACTOR.check(self.required_safety_factor_nondim)?;
         if let Some(v) = self.payout_rate_m_s {
-            require_range("payout_rate_m_s", v, 0.0, false, 1000.0)?;
+            bounds::PAYOUT_RATE_M_S.check(v)?;
         }
-        let steps = require_count("integration_steps", self.integration_steps, 8, 100_000)?;
+        let steps = bounds::INTEGRATION_STEPS.check(self.integration_steps)?;
         require_count("shape_samples", self.shape_samples, 2, 10_001)?;
         crate::contract::system::validate::check_rest(
             self.winch.as_ref(),

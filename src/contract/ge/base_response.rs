@@ -9,10 +9,11 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::critical::default_initial_length;
-use crate::contract::dto::{CableInput, ProfileInput};
 use crate::contract::ge::numerics::newton_config;
 use crate::contract::ge::{GeAerostatInput, GeModelInput, NewtonInput};
+use crate::contract::system::CableInput;
 use crate::contract::system::grid::BaseFrequencyGridInput;
+use crate::contract::system::input::ProfileInput;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::ge::base::{self, BaseExcitationProblem};
 use crate::numerics::ge::element::TipLoad;

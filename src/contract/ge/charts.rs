@@ -15,13 +15,14 @@ pub use super::base_response::{
     MAX_RESPONSE_WORK, ResonanceBandOutput, frequency_response_any, ge_base_frequency_response,
     parse_frequency_response,
 };
-use crate::contract::dto::{CableInput, RateGrid};
 use crate::contract::ge::numerics::{
     self as ge_numerics, IntegratorOutput, StartStateInput, default_check, default_dt,
     default_growth, default_horizon, newton_config,
 };
 pub use crate::contract::ge::numerics::{GeChartNumericsInput, GeOnsetKind};
 use crate::contract::ge::{GeAerostatInput, GeModelKind, NewtonInput};
+use crate::contract::string::dto::RateGrid;
+use crate::contract::system::CableInput;
 use crate::contract::system::WindFlowInput;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::aero::{AerostatBody, ForceModel, SteadyFlow};

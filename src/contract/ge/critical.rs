@@ -23,13 +23,15 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::contract::dto::{CableInput, CriticalRequest, CriticalResponse, ProfileInput};
 use crate::contract::ge::numerics::{
     self as ge_numerics, GeChartNumericsInput, GeOnsetKind, IntegratorOutput, StartStateInput,
     newton_config,
 };
 use crate::contract::ge::simulate::stiffness_ratio_of;
 use crate::contract::ge::{GeAerostatInput, GeModelInput, NewtonInput};
+use crate::contract::string::dto::{CriticalRequest, CriticalResponse};
+use crate::contract::system::CableInput;
+use crate::contract::system::input::ProfileInput;
 use crate::contract::{Progress, RequestError, run};
 use crate::numerics::ge::air_load::AirLoads;
 use crate::numerics::ge::chart::closed_form_verdict;

@@ -15,8 +15,8 @@ use crate::contract::ge::charts::{
 };
 use crate::contract::ge::critical::{self, AnyCriticalRequest, AnyCriticalResponse};
 use crate::contract::ge::stability::{self, AnyStabilityRequest, AnyStabilityResponse};
-use crate::contract::string::dto::{ProfileInput, SystemInput};
 use crate::contract::string::{chunks, kind as string, run};
+use crate::contract::system::input::{ProfileInput, SystemInput};
 use crate::limits::Limits;
 use crate::numerics::parallel::Parallelism;
 

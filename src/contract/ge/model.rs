@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::contract::dto::CableInput;
+use crate::contract::system::CableInput;
 use crate::numerics::ge::Section;
 use crate::numerics::ge::tether_system::{INEXTENSIBLE_STRAIN, solid_rotary_inertia_kg_m};
 use crate::numerics::params::{InvalidInput, require_positive};

@@ -7,7 +7,9 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::contract::dto::{CableInput, EigenvalueOutput, ProfileInput};
+use crate::contract::system::CableInput;
+use crate::contract::system::input::ProfileInput;
+use crate::contract::system::output::EigenvalueOutput;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::ge::element::TipLoad;
 use crate::numerics::ge::solver::{
@@ -643,7 +645,7 @@ fn failed_before_start(p: &Prepared, f: solver::NewtonFailure) -> GeSimulateResp
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contract::run::NoProgress;
+    use crate::contract::error::NoProgress;
 
     fn table_7_1() -> serde_json::Value {
         serde_json::json!({

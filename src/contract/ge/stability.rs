@@ -13,13 +13,13 @@ use super::critical::{
     MAX_LENGTH_RATIO, Prepared, default_gravity, default_initial_length, default_load_steps,
     default_modes, finite, is_ge, prepare,
 };
-use crate::contract::dto::{
-    CableInput, EigenvalueOutput, StabilityRequest, StabilityResponse, StateInput,
-};
 use crate::contract::error::RequestError;
 use crate::contract::ge::numerics::{StartStateInput, newton_config};
 use crate::contract::ge::simulate::{GeAerostatInput, GeModelInput, NewtonInput};
+use crate::contract::string::dto::{StabilityRequest, StabilityResponse, StateInput};
 use crate::contract::string::run;
+use crate::contract::system::CableInput;
+use crate::contract::system::output::EigenvalueOutput;
 use crate::numerics::ge::GeModel;
 use crate::numerics::ge::element::TipLoad;
 use crate::numerics::ge::extensible::ExtensibleString;

@@ -4,7 +4,9 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::contract::dto::{AerostatInput, CableInput, Groups, ModelInput};
+use crate::contract::system::input::ModelInput;
+use crate::contract::system::output::Groups;
+use crate::contract::system::{AerostatInput, CableInput};
 use crate::contract::system::{WindInput, default_lift_reserve, default_safety_factor};
 
 pub use crate::contract::system::WinchInput;

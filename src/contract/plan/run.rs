@@ -10,11 +10,12 @@
 
 use std::time::Instant;
 
+use crate::contract::error::{Progress, RequestError};
 use crate::contract::plan::dto::*;
 use crate::contract::plan::ge::*;
 use crate::contract::plan::output::*;
 use crate::contract::plan::validate::{Validated, validate};
-use crate::contract::run::{Progress, RequestError, groups};
+use crate::contract::system::output::groups;
 use crate::numerics::plan::air::Air;
 use crate::numerics::plan::deadline::{self, ExceededBy};
 use crate::numerics::plan::ge_stability::ScheduleCheck;

@@ -3,11 +3,11 @@
 //! flies there), the floor, the forecast with its gusts, and the rest of
 //! the request's numbers, each refused naming its field.
 
-use crate::contract::dto::SystemInput;
+use crate::contract::error::RequestError;
 use crate::contract::plan::dto::*;
 use crate::contract::plan::ge::*;
-use crate::contract::run::RequestError;
 use crate::contract::system::WindInput;
+use crate::contract::system::input::SystemInput;
 use crate::contract::system::validate::{self as system_check, GustWind};
 use crate::numerics::params::{InvalidInput, require_finite, require_positive};
 use crate::numerics::plan::air::{Air, SteadyWind};
@@ -88,23 +88,31 @@ pub(super) fn validate(req: &PlanRequest) -> Result<Validated, InvalidInput> {
     validate_with(req, true)
 }
 
+impl PlanRequest {
+    /// The plan's system as the string model takes it (cable, aerostat,
+    /// initial length, gravity, model): the one plan-to-system conversion,
+    /// used by the plan and its bands.
+    pub fn system_input(&self) -> SystemInput {
+        SystemInput {
+            cable: self.cable.clone(),
+            aerostat: self.aerostat.clone(),
+            initial_length_m: self.initial_length_m,
+            gravity_m_s2: self.gravity_m_s2,
+            model: self.model.clone(),
+            numerics: Default::default(),
+            wind: None,
+            winch: None,
+            required_safety_factor_nondim: None,
+            lift_reserve_nondim: None,
+        }
+    }
+}
+
 /// `resolve`: find the wind target (equilibria; with the GE criterion its
 /// table). Without it (job submission) a GE request's target is only
 /// range-checked.
 pub(super) fn validate_with(req: &PlanRequest, resolve: bool) -> Result<Validated, InvalidInput> {
-    let system_input = SystemInput {
-        cable: req.cable.clone(),
-        aerostat: req.aerostat.clone(),
-        initial_length_m: req.initial_length_m,
-        gravity_m_s2: req.gravity_m_s2,
-        model: req.model.clone(),
-        numerics: Default::default(),
-        wind: None,
-        winch: None,
-        required_safety_factor_nondim: None,
-        lift_reserve_nondim: None,
-    };
-    let model = system_input.model()?;
+    let model = req.system_input().model()?;
     req.winch.check("winch")?;
     let winch = Winch::new(req.winch.max_rate_m_s, req.winch.max_acceleration_m_s2)?;
     let max_jerk_m_s3 = req.winch.max_jerk_m_s3.map(validate_jerk).transpose()?;

@@ -1,204 +1,20 @@
 //! Request and response bodies (JSON, SI units; every field name ends in
 //! its unit, non-dimensional values sit beside them with `_nondim`).
-//! The same types serve the CLI, the HTTP API and the job queue.
+//! The same types serve the CLI, the HTTP API and the job queue. The
+//! parts every domain shares (the system, its model, the profile, the
+//! groups) live in [`crate::contract::system`] and are re-exported here
+//! for the old `contract::dto::…` paths.
 
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 pub use crate::contract::error::{ErrorBody, ErrorDetail};
+pub use crate::contract::system::input::{
+    DEFAULT_ELEMENTS, ModelInput, ModelKind, NumericsInput, ProfileInput, RatePointInput,
+    SYSTEM_KEYS, SystemInput, SystemRequest,
+};
+pub use crate::contract::system::output::{EigenvalueOutput, Groups};
 pub use crate::contract::system::{AerostatInput, CableInput, WinchInput, WindInput};
-
-/// Which cable model, and its discretisation.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct ModelInput {
-    /// Model kind.
-    #[serde(default)]
-    pub kind: ModelKind,
-    /// Number of uniform finite elements (2..=2000). Omitted: every
-    /// stability answer (t*, h*, safe rate, chart points) is converged to
-    /// `numerics.relative_tolerance` on meshes graded toward the roller and
-    /// given on the safe side of its error bound; the spectrum of
-    /// `/stability` and transient runs use 50 elements. Given: that mesh's
-    /// values, with their estimated error.
-    #[serde(default)]
-    #[schema(example = 50, minimum = 2, maximum = 2000)]
-    pub elements: Option<usize>,
-}
-
-impl Default for ModelInput {
-    fn default() -> Self {
-        Self {
-            kind: ModelKind::LinearString,
-            elements: None,
-        }
-    }
-}
-
-/// Elements of the uniform mesh used for spectra and transient runs when
-/// `model.elements` is omitted.
-pub const DEFAULT_ELEMENTS: usize = 50;
-
-impl ModelInput {
-    /// The uniform mesh size: the one asked for, or [`DEFAULT_ELEMENTS`].
-    pub fn mesh_elements(&self) -> usize {
-        self.elements.unwrap_or(DEFAULT_ELEMENTS)
-    }
-}
-
-/// Accuracy of converged answers.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-pub struct NumericsInput {
-    /// Relative tolerance of converged answers (t*, h*, safe rate) when
-    /// `model.elements` is omitted.
-    #[serde(default = "default_relative_tolerance")]
-    #[schema(example = 1e-4, minimum = 1e-8, maximum = 1e-2)]
-    pub relative_tolerance: f64,
-}
-
-impl Default for NumericsInput {
-    fn default() -> Self {
-        Self {
-            relative_tolerance: default_relative_tolerance(),
-        }
-    }
-}
-
-fn default_relative_tolerance() -> f64 {
-    crate::numerics::string::converged::DEFAULT_RELATIVE_TOLERANCE
-}
-
-#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, ToSchema, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub enum ModelKind {
-    /// Linear string with end mass (thesis ch. 2–4).
-    #[default]
-    LinearString,
-}
-
-/// The keys of [`SystemInput`]: a flattened request gives these to the
-/// system part and the rest to its parameters.
-pub const SYSTEM_KEYS: &[&str] = &[
-    "cable",
-    "aerostat",
-    "initial_length_m",
-    "gravity_m_s2",
-    "numerics",
-    "model",
-    "wind",
-    "winch",
-    "required_safety_factor_nondim",
-    "lift_reserve_nondim",
-];
-
-/// The physical system and its model: common to every request.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct SystemInput {
-    pub cable: CableInput,
-    pub aerostat: AerostatInput,
-    /// Initial cable length L0 (m), the length scale.
-    #[serde(default = "default_initial_length")]
-    #[schema(example = 1.0, minimum = 0.001, maximum = 10000.0)]
-    pub initial_length_m: f64,
-    /// Gravitational acceleration (m/s²).
-    #[serde(default = "default_gravity")]
-    #[schema(example = 9.81, minimum = 0.01, maximum = 100.0)]
-    pub gravity_m_s2: f64,
-    #[serde(default)]
-    pub model: ModelInput,
-    /// Accuracy of converged answers.
-    #[serde(default)]
-    pub numerics: NumericsInput,
-    /// The air: accepted with the whole system, but this analysis is in calm
-    /// air, so a non-zero wind is refused (naming `wind.flow`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub wind: Option<WindInput>,
-    /// The winch limits (used by the plan; checked here).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub winch: Option<WinchInput>,
-    /// Safety factor required on the breaking strength (default 5).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(example = 5.0, minimum = 1.0, maximum = 100.0)]
-    pub required_safety_factor_nondim: Option<f64>,
-    /// Lift reserve (used by the plan; checked here).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(example = 0.05, minimum = 0.0, maximum = 0.9)]
-    pub lift_reserve_nondim: Option<f64>,
-}
-
-fn default_initial_length() -> f64 {
-    1.0
-}
-
-fn default_gravity() -> f64 {
-    9.81
-}
-
-/// A deployment profile L(t). Positive rates lengthen, negative shorten.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-#[serde(deny_unknown_fields)]
-pub enum ProfileInput {
-    /// L = L0 + v t.
-    ConstantRate {
-        /// Winch rate v (m/s); negative retrieves.
-        #[schema(example = 10.0, minimum = -1000.0, maximum = 1000.0)]
-        rate_m_s: f64,
-        /// Length at which the winch stops (m); none: never stops.
-        #[serde(default)]
-        #[schema(minimum = 0.001, maximum = 1e5)]
-        target_length_m: Option<f64>,
-    },
-    /// From rest: L = L0 + a t²/2.
-    ConstantAcceleration {
-        /// Winch acceleration a (m/s²); negative retrieves.
-        #[schema(example = 0.5, minimum = -1000.0, maximum = 1000.0)]
-        acceleration_m_s2: f64,
-        /// Length at which the winch stops (m); none: never stops.
-        #[serde(default)]
-        #[schema(minimum = 0.001, maximum = 1e5)]
-        target_length_m: Option<f64>,
-    },
-    /// Rate ramps linearly from 0 to the cruise rate, holds, and ramps back
-    /// to 0, arriving at rest at the target length (thesis Figs 4.8–4.9).
-    Trapezoidal {
-        /// Cruise rate (m/s); negative retrieves.
-        #[schema(example = 10.0, minimum = -1000.0, maximum = 1000.0)]
-        cruise_rate_m_s: f64,
-        /// Ramp-up time (s), > 0: short is sharp, long is gradual.
-        #[schema(example = 5.0, minimum = 1e-6, maximum = 1e7)]
-        ramp_up_s: f64,
-        /// Ramp-down time (s), > 0.
-        #[schema(example = 5.0, minimum = 1e-6, maximum = 1e7)]
-        ramp_down_s: f64,
-        /// Length at which the winch comes to rest (m).
-        #[schema(example = 1100.0, minimum = 0.001, maximum = 1e5)]
-        target_length_m: f64,
-    },
-    /// Rate interpolated linearly in a table of (time, rate), first time 0;
-    /// the last rate is held after the table.
-    PiecewiseLinearRate {
-        /// The table, times strictly increasing (at most 10000 points).
-        points: Vec<RatePointInput>,
-        /// Length at which the winch stops (m); none: the table decides.
-        #[serde(default)]
-        #[schema(minimum = 0.001, maximum = 1e5)]
-        target_length_m: Option<f64>,
-    },
-}
-
-/// One point of a rate table.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct RatePointInput {
-    /// Time (s).
-    #[schema(example = 0.0, minimum = 0.0, maximum = 1e7)]
-    pub time_s: f64,
-    /// Winch rate at that time (m/s).
-    #[schema(example = 10.0, minimum = -1000.0, maximum = 1000.0)]
-    pub rate_m_s: f64,
-}
 
 /// Instantaneous deployment state for a stability query.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
@@ -303,36 +119,6 @@ pub struct ChartParams {
     #[serde(default)]
     #[schema(minimum = 0.001, maximum = 1e7)]
     pub net_buoyancies_n: Vec<f64>,
-}
-
-/// Scales and non-dimensional groups of the system.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
-pub struct Groups {
-    /// Wave speed sqrt(F/ρA) (m/s).
-    pub wave_speed_m_s: f64,
-    /// Time scale L0/c (s).
-    pub time_scale_s: f64,
-    /// F̃ = F/(ρA g L0).
-    pub buoyancy_ratio_nondim: f64,
-    /// m̃ = m/(ρA L0).
-    pub mass_ratio_nondim: f64,
-    /// F/(ρA g) (m): no rate is safe above it.
-    pub static_lift_limit_m: f64,
-}
-
-/// One eigenvalue λ of λ²M + λC + K = 0.
-#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
-pub struct EigenvalueOutput {
-    /// Re λ (1/s): growth rate if positive.
-    pub re_1_s: f64,
-    /// Im λ (rad/s): circular frequency.
-    pub im_1_s: f64,
-    /// Re λ in units of 1/t̄.
-    pub re_nondim: f64,
-    /// Im λ in units of 1/t̄.
-    pub im_nondim: f64,
-    /// Im λ / 2π (Hz).
-    pub frequency_hz: f64,
 }
 
 /// The deployment state, SI and non-dimensional.
@@ -485,16 +271,4 @@ pub struct ChartResponse {
     /// Whether the points are converged (model.elements omitted); their
     /// t* and h* are then on the safe side of the error bound.
     pub converged: bool,
-}
-
-/// A request made of the common system part and its own parameters;
-/// the two are parsed separately so that every error names its field
-/// (serde loses the path inside `#[serde(flatten)]`).
-pub trait SystemRequest: Sized {
-    type Params: serde::de::DeserializeOwned;
-    fn from_parts(system: SystemInput, params: Self::Params) -> Self;
-    /// The plausible-magnitude checks of both parts (field and range named).
-    fn check_ranges(&self) -> Result<(), crate::numerics::params::InvalidInput> {
-        Ok(())
-    }
 }

@@ -4,14 +4,20 @@
 //! grid type ([`GridInput`]), their validation ([`validate`]), the named
 //! aerostat presets ([`presets`]), and the resolution of a request before
 //! it is parsed ([`resolve`]): a stored named system merged under the
-//! request, the old plan names refused naming their new place.
+//! request, the old plan names refused naming their new place. The request
+//! and answer parts every domain shares ([`input`]: `SystemInput`, the
+//! model, the profile; [`output`]: the groups, an eigenvalue) live here too
+//! (not re-exported: `input` and `output` build on this file).
 //!
 //! Today's `/equilibrium` names are the canonical ones. SI at the
 //! boundary; every field name ends in its unit (`_nondim` for pure
 //! numbers); every bound in the schema is the bound the validation applies.
 
+pub mod bounds;
 pub mod grid;
+pub mod input;
 pub mod moved;
+pub mod output;
 pub mod presets;
 pub mod resolve;
 pub mod validate;

@@ -2,62 +2,21 @@
 //! presets filled in (fields given win), and the plain-words errors that
 //! name the field to fix.
 
+use super::bounds::{
+    self as b, AEROSTAT_MASS_KG, LINK_LENGTH_M, MASS_PER_LENGTH_KG_M, NET_BUOYANCY_N,
+};
+pub use super::bounds::{MAX_GUST_M_S, MIN_ROUGHNESS_M};
 use super::presets::NamedAerostat;
 use super::*;
 use crate::numerics::aero::SteadyFlow;
-use crate::numerics::params::ranges::{AEROSTAT_MASS_KG, MASS_PER_LENGTH_KG_M, NET_BUOYANCY_N};
-use crate::numerics::params::{InvalidInput, compact, require_finite};
+use crate::numerics::params::{InvalidInput, compact};
 use crate::numerics::tether::gust::{
-    DEFAULT_PEAK_FACTOR, DEFAULT_REFERENCE_HEIGHT_M, Gust, MAX_PEAK_FACTOR,
-    MAX_TURBULENCE_INTENSITY, gust_factor_at, gust_profile_at,
+    DEFAULT_PEAK_FACTOR, DEFAULT_REFERENCE_HEIGHT_M, Gust, gust_factor_at, gust_profile_at,
 };
 use crate::numerics::tether::presets::{BodyPreset, CYLINDER_NORMAL_DRAG, CablePreset};
 use crate::numerics::tether::{Body, Cable, WindProfile};
 
-/// `value` finite and within `[min, max]`; `exclusive_min` excludes `min`.
-pub(crate) fn require_range(
-    field: &str,
-    value: f64,
-    min: f64,
-    exclusive_min: bool,
-    max: f64,
-) -> Result<f64, InvalidInput> {
-    require_finite(field, value)?;
-    let low_ok = if exclusive_min {
-        value > min
-    } else {
-        value >= min
-    };
-    if !low_ok || value > max {
-        let low = if exclusive_min { "above" } else { "at least" };
-        return Err(InvalidInput::new(
-            field,
-            format!(
-                "must be {low} {} and at most {}, got {}",
-                compact(min),
-                compact(max),
-                compact(value)
-            ),
-        ));
-    }
-    Ok(value)
-}
-
-/// A count within `[min, max]`.
-pub(crate) fn require_count(
-    field: &str,
-    value: usize,
-    min: usize,
-    max: usize,
-) -> Result<usize, InvalidInput> {
-    if value < min || value > max {
-        return Err(InvalidInput::new(
-            field,
-            format!("must be between {min} and {max}, got {value}"),
-        ));
-    }
-    Ok(value)
-}
+pub(crate) use super::bounds::{require_count, require_range};
 
 fn preset_cable(p: CablePresetName) -> CablePreset {
     match p {
@@ -91,7 +50,7 @@ impl CableInput {
                 "is required with a preset: give the tether's diameter in metres (e.g. 0.006)",
             ));
         };
-        let d = require_range(&Self::field(at, "diameter_m"), d, 0.0, true, 1.0)?;
+        let d = b::DIAMETER_M.check_at(at, d)?;
         Ok(Some(preset_cable(p).at_diameter(d)))
     }
 
@@ -110,8 +69,8 @@ impl CableInput {
         match (self.mass_per_length_kg_m, self.density_kg_m3, self.area_m2) {
             (Some(rho_a), None, None) => check(&f("mass_per_length_kg_m"), rho_a),
             (None, Some(rho), Some(a)) => {
-                require_range(&f("density_kg_m3"), rho, 100.0, false, 30_000.0)?;
-                require_range(&f("area_m2"), a, 1e-9, false, 0.1)?;
+                b::DENSITY_KG_M3.check_at(at, rho)?;
+                b::AREA_M2.check_at(at, a)?;
                 let rho_a = rho * a;
                 if MASS_PER_LENGTH_KG_M.check("", rho_a).is_err() {
                     return Err(InvalidInput::new(
@@ -154,7 +113,7 @@ impl CableInput {
         let preset = self.preset_properties(at)?;
         self.breaking_strength_n
             .or(preset.map(|p| p.breaking_strength_n))
-            .map(|v| require_range(&Self::field(at, "breaking_strength_n"), v, 0.0, true, 1e9))
+            .map(|v| b::BREAKING_STRENGTH_N.check_at(at, v))
             .transpose()
     }
 
@@ -163,7 +122,7 @@ impl CableInput {
         let preset = self.preset_properties(at)?;
         self.axial_stiffness_n
             .or(preset.map(|p| p.axial_stiffness_n))
-            .map(|v| require_range(&Self::field(at, "axial_stiffness_n"), v, 0.0, true, 1e12))
+            .map(|v| b::AXIAL_STIFFNESS_N.check_at(at, v))
             .transpose()
     }
 
@@ -175,19 +134,12 @@ impl CableInput {
     /// either a value or a diameter.
     pub fn bending_stiffness(&self, at: &str) -> Result<Option<f64>, InvalidInput> {
         if let Some(e) = self.bending_stiffness_n_m2 {
-            return require_range(
-                &Self::field(at, "bending_stiffness_n_m2"),
-                e,
-                1e-6,
-                false,
-                1e12,
-            )
-            .map(Some);
+            return b::BENDING_STIFFNESS_N_M2.check_at(at, e).map(Some);
         }
         let Some(d) = self.diameter_m else {
             return Ok(None);
         };
-        let d = require_range(&Self::field(at, "diameter_m"), d, 0.0, true, 1.0)?;
+        let d = b::DIAMETER_M.check_at(at, d)?;
         Ok(
             crate::numerics::tether::presets::default_bending_stiffness_n_m2(
                 self.preset.map(preset_cable),
@@ -201,15 +153,14 @@ impl CableInput {
     /// Checks the fields that are given but not used by a calm-air analysis
     /// (so that a whole system is refused for the same values everywhere).
     pub fn check_given(&self, at: &str) -> Result<(), InvalidInput> {
-        let f = |n: &str| Self::field(at, n);
         if let Some(d) = self.diameter_m {
-            require_range(&f("diameter_m"), d, 0.0, true, 1.0)?;
+            b::DIAMETER_M.check_at(at, d)?;
         }
         if let Some(c) = self.normal_drag_coefficient_nondim {
-            require_range(&f("normal_drag_coefficient_nondim"), c, 0.0, false, 10.0)?;
+            b::NORMAL_DRAG_COEFFICIENT.check_at(at, c)?;
         }
         if let Some(e) = self.bending_stiffness_n_m2 {
-            require_range(&f("bending_stiffness_n_m2"), e, 1e-6, false, 1e12)?;
+            b::BENDING_STIFFNESS_N_M2.check_at(at, e)?;
         }
         self.axial_stiffness(at)?;
         self.breaking_strength_at(at)?;
@@ -226,14 +177,14 @@ impl CableInput {
                 "is needed in wind: give the tether's diameter in metres (the width the wind's drag acts on)",
             ));
         };
-        let d = require_range(&f("diameter_m"), d, 0.0, true, 1.0)?;
+        let d = b::DIAMETER_M.check_at(at, d)?;
         let preset = self.preset_properties(at)?;
         let mass = self.mass_per_length_at(at)?;
         let cn = self
             .normal_drag_coefficient_nondim
             .or(preset.map(|p| p.normal_drag_coefficient))
             .unwrap_or(CYLINDER_NORMAL_DRAG);
-        let cn = require_range(&f("normal_drag_coefficient_nondim"), cn, 0.0, false, 10.0)?;
+        let cn = b::NORMAL_DRAG_COEFFICIENT.check_at(at, cn)?;
         self.check_given(at)?;
         Ok(Cable {
             mass_per_length_kg_m: mass,
@@ -282,7 +233,7 @@ impl AerostatInput {
 
     /// Rigid link length (m), default 0 (GE models).
     pub fn link_length(&self, at: &str) -> Result<f64, InvalidInput> {
-        crate::numerics::params::ranges::LINK_LENGTH_M.check(
+        LINK_LENGTH_M.check(
             &format!("{at}.link_length_m"),
             self.link_length_m.unwrap_or(0.0),
         )
@@ -294,13 +245,7 @@ impl AerostatInput {
             .added_mass_coefficient_nondim
             .or(self.named().and_then(|n| n.added_mass_coefficient_nondim))
             .unwrap_or(0.5);
-        require_range(
-            &format!("{at}.added_mass_coefficient_nondim"),
-            c,
-            0.0,
-            false,
-            10.0,
-        )
+        b::ADDED_MASS_COEFFICIENT.check_at(at, c)
     }
 
     /// The shape preset with its size: the preset's, or a named
@@ -311,10 +256,10 @@ impl AerostatInput {
     ) -> Result<Option<crate::numerics::tether::presets::BodyProperties>, InvalidInput> {
         let f = |n: &str| format!("{at}.{n}");
         if let Some(r) = self.radius_m {
-            require_range(&f("radius_m"), r, 0.0, true, 100.0)?;
+            b::RADIUS_M.check_at(at, r)?;
         }
         if let Some(v) = self.volume_m3 {
-            require_range(&f("volume_m3"), v, 0.0, true, 1e7)?;
+            b::VOLUME_M3.check_at(at, v)?;
         }
         let (shape, size) = match self.preset {
             None => return Ok(None),
@@ -353,16 +298,15 @@ impl AerostatInput {
 
     /// Checks the fields a calm-air analysis does not use.
     pub fn check_given(&self, at: &str) -> Result<(), InvalidInput> {
-        let f = |n: &str| format!("{at}.{n}");
         self.shape(at)?;
         if let Some(c) = self.drag_coefficient_nondim {
-            require_range(&f("drag_coefficient_nondim"), c, 0.0, false, 10.0)?;
+            b::DRAG_COEFFICIENT.check_at(at, c)?;
         }
         if let Some(a) = self.reference_area_m2 {
-            require_range(&f("reference_area_m2"), a, 0.0, true, 1e5)?;
+            b::REFERENCE_AREA_M2.check_at(at, a)?;
         }
         if let Some(c) = self.lift_coefficient_nondim {
-            require_range(&f("lift_coefficient_nondim"), c, -10.0, false, 10.0)?;
+            b::LIFT_COEFFICIENT.check_at(at, c)?;
         }
         self.added_mass_coefficient(at)?;
         self.mass(at)?;
@@ -401,9 +345,9 @@ impl AerostatInput {
         self.check_given(at)?;
         Ok(Body {
             net_buoyancy_n: self.net_buoyancy(at)?,
-            drag_coefficient: require_range(&f("drag_coefficient_nondim"), cd, 0.0, false, 10.0)?,
-            lift_coefficient: require_range(&f("lift_coefficient_nondim"), cl, -10.0, false, 10.0)?,
-            reference_area_m2: require_range(&f("reference_area_m2"), area, 0.0, true, 1e5)?,
+            drag_coefficient: b::DRAG_COEFFICIENT.check_at(at, cd)?,
+            lift_coefficient: b::LIFT_COEFFICIENT.check_at(at, cl)?,
+            reference_area_m2: b::REFERENCE_AREA_M2.check_at(at, area)?,
         })
     }
 }
@@ -413,33 +357,17 @@ impl WindFlowInput {
     pub fn profile(&self, at: &str) -> Result<WindProfile, InvalidInput> {
         let f = |name: &str| format!("{at}.{name}");
         Ok(match self {
-            Self::Uniform { speed_m_s } => WindProfile::uniform(require_range(
-                &f("speed_m_s"),
-                *speed_m_s,
-                -150.0,
-                false,
-                150.0,
-            )?),
+            Self::Uniform { speed_m_s } => {
+                WindProfile::uniform(b::WIND_SPEED_M_S.check_at(at, *speed_m_s)?)
+            }
             Self::PowerLaw {
                 coefficient_m_s,
                 exponent_nondim,
                 reference_height_m,
             } => {
-                let a = require_range(
-                    &f("coefficient_m_s"),
-                    *coefficient_m_s,
-                    -150.0,
-                    false,
-                    150.0,
-                )?;
-                let p = require_range(&f("exponent_nondim"), *exponent_nondim, 0.0, false, 2.0)?;
-                let zr = require_range(
-                    &f("reference_height_m"),
-                    *reference_height_m,
-                    0.0,
-                    true,
-                    1e4,
-                )?;
+                let a = b::WIND_SPEED_M_S.check_field(&f("coefficient_m_s"), *coefficient_m_s)?;
+                let p = b::EXPONENT.check_at(at, *exponent_nondim)?;
+                let zr = b::REFERENCE_HEIGHT_M.check_at(at, *reference_height_m)?;
                 // a (z/z_ref)^p = (a z_ref^-p) z^p
                 WindProfile::Flow(SteadyFlow::PowerLaw {
                     coefficient: if zr == 1.0 { a } else { a * zr.powf(-p) },
@@ -455,20 +383,9 @@ impl WindFlowInput {
                 }
                 let mut table = Vec::with_capacity(points.len());
                 for (i, p) in points.iter().enumerate() {
-                    let z = require_range(
-                        &format!("{at}.points[{i}].elevation_m"),
-                        p.elevation_m,
-                        0.0,
-                        false,
-                        1e5,
-                    )?;
-                    let u = require_range(
-                        &format!("{at}.points[{i}].speed_m_s"),
-                        p.speed_m_s,
-                        -150.0,
-                        false,
-                        150.0,
-                    )?;
+                    let z = b::ELEVATION_M.check_at(&format!("{at}.points[{i}]"), p.elevation_m)?;
+                    let u =
+                        b::WIND_SPEED_M_S.check_at(&format!("{at}.points[{i}]"), p.speed_m_s)?;
                     table.push((z, u));
                 }
                 WindProfile::Flow(SteadyFlow::tabulated(&table, &f("points"))?)
@@ -478,21 +395,9 @@ impl WindFlowInput {
                 reference_height_m,
                 roughness_length_m,
             } => {
-                require_range(&f("speed_m_s"), *speed_m_s, -150.0, false, 150.0)?;
-                require_range(
-                    &f("reference_height_m"),
-                    *reference_height_m,
-                    0.0,
-                    true,
-                    1e4,
-                )?;
-                require_range(
-                    &f("roughness_length_m"),
-                    *roughness_length_m,
-                    MIN_ROUGHNESS_M,
-                    false,
-                    10.0,
-                )?;
+                b::WIND_SPEED_M_S.check_at(at, *speed_m_s)?;
+                b::REFERENCE_HEIGHT_M.check_at(at, *reference_height_m)?;
+                b::ROUGHNESS_LENGTH_M.check_at(at, *roughness_length_m)?;
                 WindProfile::log_law(*speed_m_s, *reference_height_m, *roughness_length_m, at)?
             }
         })
@@ -502,13 +407,7 @@ impl WindFlowInput {
 impl WindInput {
     /// The air density, checked.
     pub fn air_density(&self) -> Result<f64, InvalidInput> {
-        require_range(
-            "wind.air_density_kg_m3",
-            self.air_density_kg_m3,
-            0.0,
-            true,
-            5.0,
-        )
+        b::AIR_DENSITY_KG_M3.check_at("wind", self.air_density_kg_m3)
     }
 
     /// Checks the flow, the density and the gust (calm-air analyses: only
@@ -571,19 +470,10 @@ impl GustInput {
         let f = |n: &str| format!("wind.gust.{n}");
         match (self.turbulence_intensity_nondim, self.gust_m_s) {
             (Some(i), None) => Ok(Gust::Intensity {
-                turbulence_intensity: require_range(
-                    &f("turbulence_intensity_nondim"),
-                    i,
-                    0.0,
-                    false,
-                    MAX_TURBULENCE_INTENSITY,
-                )?,
-                peak_factor: require_range(
-                    &f("peak_factor_nondim"),
+                turbulence_intensity: b::TURBULENCE_INTENSITY.check_at("wind.gust", i)?,
+                peak_factor: b::PEAK_FACTOR.check_at(
+                    "wind.gust",
                     self.peak_factor_nondim.unwrap_or(DEFAULT_PEAK_FACTOR),
-                    0.0,
-                    false,
-                    MAX_PEAK_FACTOR,
                 )?,
             }),
             (None, Some(g)) => {
@@ -594,7 +484,7 @@ impl GustInput {
                     ));
                 }
                 Ok(Gust::AtReference {
-                    gust_m_s: require_range(&f("gust_m_s"), g, 0.0, false, MAX_GUST_M_S)?,
+                    gust_m_s: b::GUST_M_S.check_at("wind.gust", g)?,
                 })
             }
             (Some(_), Some(_)) => Err(InvalidInput::new(
@@ -608,9 +498,6 @@ impl GustInput {
         }
     }
 }
-
-/// Largest gust speed accepted at the reference height (m/s): the flow's bound.
-pub const MAX_GUST_M_S: f64 = 150.0;
 
 impl WindFlowInput {
     /// The height a gust speed refers to (m): a log or power law's own
@@ -631,22 +518,10 @@ impl WindFlowInput {
 impl WinchInput {
     /// Checks the limits against the schema's bounds.
     pub fn check(&self, at: &str) -> Result<(), InvalidInput> {
-        require_range(
-            &format!("{at}.max_rate_m_s"),
-            self.max_rate_m_s,
-            0.0,
-            true,
-            1000.0,
-        )?;
-        require_range(
-            &format!("{at}.max_acceleration_m_s2"),
-            self.max_acceleration_m_s2,
-            0.0,
-            true,
-            100.0,
-        )?;
+        b::MAX_RATE_M_S.check_at(at, self.max_rate_m_s)?;
+        b::MAX_ACCELERATION_M_S2.check_at(at, self.max_acceleration_m_s2)?;
         if let Some(j) = self.max_jerk_m_s3 {
-            require_range(&format!("{at}.max_jerk_m_s3"), j, 0.0, true, 10000.0)?;
+            b::MAX_JERK_M_S3.check_at(at, j)?;
         }
         Ok(())
     }
@@ -654,12 +529,12 @@ impl WinchInput {
 
 /// The safety factor, checked.
 pub fn required_safety_factor(v: f64) -> Result<f64, InvalidInput> {
-    require_range("required_safety_factor_nondim", v, 1.0, false, 100.0)
+    b::REQUIRED_SAFETY_FACTOR.check(v)
 }
 
 /// The lift reserve, checked.
 pub fn lift_reserve(v: f64) -> Result<f64, InvalidInput> {
-    require_range("lift_reserve_nondim", v, 0.0, false, 0.9)
+    b::LIFT_RESERVE.check(v)
 }
 
 /// Checks the system parts a request accepts but does not use.
@@ -672,14 +547,10 @@ pub fn check_rest(
         w.check("winch")?;
     }
     if let Some(l) = initial_length_m {
-        crate::numerics::params::ranges::INITIAL_LENGTH_M.check("initial_length_m", l)?;
+        b::INITIAL_LENGTH_M.check("initial_length_m", l)?;
     }
     if let Some(r) = lift_reserve_nondim {
         lift_reserve(r)?;
     }
     Ok(())
 }
-
-/// Smallest roughness length z0 (m): below it ln(z/z0) overflows in
-/// double precision long before any real surface (smooth ice ≈ 1e-5 m).
-pub const MIN_ROUGHNESS_M: f64 = 1e-6;

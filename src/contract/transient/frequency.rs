@@ -12,9 +12,10 @@ use super::aero::AeroBodyInput;
 use super::simulate::{
     InitialStateInput, ProgressObserver, config_from, from_transient, outcome_name,
 };
-use crate::contract::dto::{Groups, ProfileInput, SystemInput};
-use crate::contract::run::{Progress, RequestError, groups};
+use crate::contract::error::{Progress, RequestError};
 use crate::contract::system::grid::FrequencyGridInput;
+use crate::contract::system::input::{ProfileInput, SystemInput};
+use crate::contract::system::output::{Groups, groups};
 use crate::numerics::aero::AirFlow;
 use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{InvalidInput, require_finite};
@@ -217,8 +218,8 @@ pub fn frequency_response(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contract::error::NoProgress;
     use crate::contract::parse;
-    use crate::contract::run::NoProgress;
 
     const SYSTEM: &str = r#""cable": {"density_kg_m3": 7800, "area_m2": 1e-5},
         "aerostat": {"net_buoyancy_n": 1000, "mass_kg": 10}, "initial_length_m": 1, "model": {"elements": 20}"#;

@@ -8,8 +8,9 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::aero::AeroInput;
-use crate::contract::dto::{EigenvalueOutput, Groups, ProfileInput, SystemInput};
-use crate::contract::run::{Progress, RequestError, groups};
+use crate::contract::error::{Progress, RequestError};
+use crate::contract::system::input::{ProfileInput, SystemInput};
+use crate::contract::system::output::{EigenvalueOutput, Groups, groups};
 use crate::numerics::aero::Aerodynamics;
 use crate::numerics::params::{AerostatSystem, InvalidInput, require_finite};
 use crate::numerics::string::reduced::ReducedModel;
@@ -541,8 +542,8 @@ fn reduced_output(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contract::error::NoProgress;
     use crate::contract::parse;
-    use crate::contract::run::NoProgress;
 
     const SYSTEM: &str = r#""cable": {"density_kg_m3": 7800, "area_m2": 1e-5},
         "aerostat": {"net_buoyancy_n": 1000, "mass_kg": 10}, "initial_length_m": 1, "model": {"elements": 20}"#;

@@ -5,10 +5,10 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::contract::dto::{AerostatInput, CableInput};
-pub use crate::contract::windows::forecast::{ForecastFormat, ForecastInput};
 use crate::contract::plan::dto::PlanStabilityInput;
+use crate::contract::system::{AerostatInput, CableInput};
 use crate::contract::system::{WinchInput, WindInput};
+pub use crate::contract::windows::forecast::{ForecastFormat, ForecastInput};
 
 /// Default roughness length of the log law through one height (m): open
 /// terrain (WMO class "open", Davenport's 0.03 m).

@@ -20,6 +20,19 @@
 //! without it is converted by one `VACUUM` at open), and housekeeping that
 //! deleted anything runs `PRAGMA incremental_vacuum` and a truncating WAL
 //! checkpoint, so the pages of purged jobs go back to the file system.
+//!
+//! The store by part: `schema.rs` the schema versions and their migration,
+//! `rows.rs` the connection, SQL fragments, row reader and fenced writes,
+//! `chunks.rs` the chunk rows, `systems.rs` the named systems; this file
+//! opens the store and implements [`JobBackend`]: the job rows, workers and
+//! housekeeping here, the chunks and systems by calling their files. What
+//! it decides as PostgreSQL does (quota, idempotency) is in
+//! [`crate::jobs::admission`].
+
+mod chunks;
+mod rows;
+mod schema;
+mod systems;
 
 use std::path::Path;
 use std::sync::Mutex;
@@ -27,146 +40,20 @@ use std::time::Duration;
 
 use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
 
-use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
+pub use rows::JobStore;
+use rows::{
+    FENCE, NOW, OLDEST_FINISHED, RELEASE_ENDED_CHUNKS, STORED_BYTES, UNFINISHED_CHUNKS, find_by_key,
+};
+pub use schema::SCHEMA_VERSION;
+use schema::{AUTO_VACUUM_INCREMENTAL, migrate};
+
+use super::admission;
 use super::backend::{
     ChunkLease, ChunkState, ClaimPolicy, ClaimedChunk, ClaimedJob, InsertError, Inserted,
     JobBackend, JobHead, JobRecord, JobStatus, KeyedJob, NewJob, PutSystem, StoreError,
     StoredSystem,
 };
-
-impl From<rusqlite::Error> for StoreError {
-    fn from(e: rusqlite::Error) -> Self {
-        Self(e.to_string())
-    }
-}
-
-const SCHEMA_V1: &str = "
-CREATE TABLE IF NOT EXISTS jobs (
-    id          INTEGER PRIMARY KEY AUTOINCREMENT,
-    kind        TEXT NOT NULL,
-    request     TEXT NOT NULL,
-    status      TEXT NOT NULL CHECK (status IN ('queued', 'running', 'done', 'failed', 'cancelled')),
-    progress    REAL NOT NULL DEFAULT 0,
-    attempts    INTEGER NOT NULL DEFAULT 0,
-    result      TEXT,
-    error       TEXT,
-    created_at  TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
-    started_at  TEXT,
-    finished_at TEXT
-);
-CREATE INDEX IF NOT EXISTS jobs_by_status ON jobs (status, id);
-";
-
-const SCHEMA_V2: &str = "
-ALTER TABLE jobs ADD COLUMN owner TEXT;
-ALTER TABLE jobs ADD COLUMN idempotency_key TEXT;
-ALTER TABLE jobs ADD COLUMN request_hash TEXT;
-ALTER TABLE jobs ADD COLUMN lease_owner TEXT;
-ALTER TABLE jobs ADD COLUMN lease_expires_ms INTEGER;
-ALTER TABLE jobs ADD COLUMN lease_epoch INTEGER NOT NULL DEFAULT 0;
-CREATE UNIQUE INDEX jobs_by_idempotency_key ON jobs (ifnull(owner, ''), idempotency_key)
-    WHERE idempotency_key IS NOT NULL;
-CREATE INDEX jobs_by_owner ON jobs (owner, status);
-";
-
-const SCHEMA_V3: &str = "
-ALTER TABLE jobs ADD COLUMN priority INTEGER NOT NULL DEFAULT 0;
-CREATE INDEX jobs_by_claim ON jobs (status, priority, id);
-CREATE TABLE job_chunks (
-    job_id           INTEGER NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,
-    idx              INTEGER NOT NULL,
-    status           TEXT NOT NULL CHECK (status IN ('pending', 'running', 'done', 'failed')),
-    attempts         INTEGER NOT NULL DEFAULT 0,
-    lease_owner      TEXT,
-    lease_expires_ms INTEGER,
-    lease_epoch      INTEGER NOT NULL DEFAULT 0,
-    result           TEXT,
-    error            TEXT,
-    finished_by      TEXT,
-    PRIMARY KEY (job_id, idx)
-);
-CREATE INDEX job_chunks_by_status ON job_chunks (status, job_id, idx);
-CREATE TABLE workers (
-    id           TEXT PRIMARY KEY,
-    role         TEXT NOT NULL,
-    started_ms   INTEGER NOT NULL,
-    heartbeat_ms INTEGER NOT NULL
-);
-CREATE TABLE IF NOT EXISTS schema_version (
-    version    INTEGER PRIMARY KEY,
-    applied_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now'))
-);
-INSERT OR IGNORE INTO schema_version (version) VALUES (1), (2), (3);
-";
-
-const SCHEMA_V4: &str = "
-CREATE TABLE systems (
-    owner      TEXT NOT NULL,
-    name       TEXT NOT NULL,
-    body       TEXT NOT NULL,
-    created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
-    updated_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
-    PRIMARY KEY (owner, name)
-);
-INSERT OR IGNORE INTO schema_version (version) VALUES (4);
-";
-
-const SCHEMA_V5: &str = "
-ALTER TABLE jobs ADD COLUMN stored_bytes INTEGER NOT NULL DEFAULT 0;
-ALTER TABLE jobs ADD COLUMN chunk_takeovers INTEGER NOT NULL DEFAULT 0;
-CREATE TABLE job_answers (
-    job_id INTEGER NOT NULL,
-    page   INTEGER NOT NULL,
-    data   BLOB NOT NULL,
-    PRIMARY KEY (job_id, page)
-);
-INSERT INTO job_answers (job_id, page, data)
-    SELECT id, 0, CAST(result AS BLOB) FROM jobs WHERE status = 'done' AND result IS NOT NULL;
-UPDATE jobs SET stored_bytes = octet_length(request) + ifnull(octet_length(result), 0)
-    + ifnull(octet_length(error), 0), result = NULL;
-INSERT OR IGNORE INTO schema_version (version) VALUES (5);
-";
-
-/// The current schema version.
-pub const SCHEMA_VERSION: i64 = 5;
-
-/// A job that still has chunks to run: a new claim of it (its coordinator
-/// died) is counted in `chunk_takeovers` and not against its attempts
-/// (`attempts - chunk_takeovers` is compared with the limit), and such a
-/// job is not failed for its attempts: the chunks count their own.
-const UNFINISHED_CHUNKS: &str =
-    "EXISTS (SELECT 1 FROM job_chunks c WHERE c.job_id = jobs.id AND c.status <> 'done')";
-
-/// The chunks of a finished (failed, cancelled) job that were left
-/// running go back to pending: never claimed again (their job is not
-/// running), and none is left `running`.
-const RELEASE_ENDED_CHUNKS: &str =
-    "UPDATE job_chunks SET status = 'pending', lease_expires_ms = NULL
-    WHERE status = 'running'
-      AND job_id IN (SELECT id FROM jobs WHERE status IN ('done', 'failed', 'cancelled'))";
-
-/// Seconds since owner `?1`'s oldest finished job finished (NULL: none).
-const OLDEST_FINISHED: &str = "SELECT (julianday('now') - julianday(min(finished_at))) * 86400
-    FROM jobs WHERE owner IS ?1 AND status IN ('done', 'failed', 'cancelled')";
-
-/// Bytes kept by owner `?1` (NULL: no tokens): its jobs and named systems.
-const STORED_BYTES: &str = "SELECT
-    (SELECT ifnull(sum(stored_bytes), 0) FROM jobs WHERE owner IS ?1)
-    + (SELECT ifnull(sum(octet_length(body)), 0) FROM systems WHERE owner = ifnull(?1, ''))";
-
-const NOW: &str = "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')";
-
-/// The fence of a write: the row is still running under this lease.
-const FENCE: &str = "id = ?1 AND status = 'running' AND lease_owner = ?2 AND lease_epoch = ?3";
-
-/// `PRAGMA auto_vacuum` of a file kept in incremental vacuum.
-const AUTO_VACUUM_INCREMENTAL: i64 = 2;
-
-/// The job table behind one connection, claiming as one worker.
-pub struct JobStore {
-    conn: Mutex<Connection>,
-    worker: WorkerId,
-}
+use super::lease::{Lease, WorkerId, expiry_ms, now_ms};
 
 impl JobStore {
     /// Opens (or creates) the database at `path`, in WAL mode, migrates it,
@@ -226,12 +113,6 @@ impl JobStore {
         }
         Ok(store)
     }
-
-    fn conn(&self) -> std::sync::MutexGuard<'_, Connection> {
-        // A panic while holding the lock leaves the connection usable.
-        self.conn.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
     /// The SQLite journal mode (`wal` for a file database).
     pub fn journal_mode(&self) -> Result<String, StoreError> {
         Ok(self
@@ -271,124 +152,6 @@ impl JobStore {
             exhausted_error: "{}",
         })
     }
-
-    const COLUMNS: &str =
-        "id, kind, status, progress, attempts, created_at, started_at, finished_at, lease_owner";
-
-    fn record(r: &rusqlite::Row<'_>) -> rusqlite::Result<JobRecord> {
-        let status: String = r.get(2)?;
-        Ok(JobRecord {
-            id: r.get(0)?,
-            kind: r.get(1)?,
-            status: JobStatus::parse(&status),
-            progress: r.get(3)?,
-            attempts: r.get(4)?,
-            created_at: r.get(5)?,
-            started_at: r.get(6)?,
-            finished_at: r.get(7)?,
-            worker: r.get(8)?,
-            result: None,
-            error: None,
-        })
-    }
-
-    fn fenced(
-        &self,
-        sql_set: &str,
-        lease: &Lease,
-        extra: Option<&dyn rusqlite::ToSql>,
-    ) -> Result<bool, StoreError> {
-        let sql = format!("UPDATE jobs SET {sql_set} WHERE {FENCE}");
-        let n = match extra {
-            Some(x) => self
-                .conn()
-                .execute(&sql, params![lease.job_id, lease.owner, lease.epoch, x])?,
-            None => self
-                .conn()
-                .execute(&sql, params![lease.job_id, lease.owner, lease.epoch])?,
-        };
-        Ok(n == 1)
-    }
-}
-
-/// The fence of a chunk write: the chunk is still running under this
-/// lease and its job is still running.
-const CHUNK_FENCE: &str = "job_id = ?1 AND idx = ?2 AND status = 'running' AND lease_owner = ?3
-    AND lease_epoch = ?5 AND (SELECT status FROM jobs WHERE id = job_id) = 'running'";
-
-impl JobStore {
-    fn chunk_fenced(
-        &self,
-        sql_set: &str,
-        lease: &ChunkLease,
-        extra: Option<&dyn rusqlite::ToSql>,
-    ) -> Result<bool, StoreError> {
-        let sql = format!("UPDATE job_chunks SET {sql_set} WHERE {CHUNK_FENCE}");
-        let none: Option<i64> = None;
-        let x: &dyn rusqlite::ToSql = extra.unwrap_or(&none);
-        let n = self.conn().execute(
-            &sql,
-            params![
-                lease.job_id,
-                lease.index as i64,
-                lease.owner,
-                x,
-                lease.epoch
-            ],
-        )?;
-        Ok(n == 1)
-    }
-}
-
-fn migrate(conn: &mut Connection) -> Result<(), StoreError> {
-    let version: i64 = conn.query_row("PRAGMA user_version", [], |r| r.get(0))?;
-    if version >= SCHEMA_VERSION {
-        return Ok(());
-    }
-    let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
-    // Re-read under the write lock: another process may have migrated meanwhile.
-    let version: i64 = tx.query_row("PRAGMA user_version", [], |r| r.get(0))?;
-    if version < 1 {
-        tx.execute_batch(SCHEMA_V1)?;
-    }
-    if version < 2 {
-        tx.execute_batch(SCHEMA_V2)?;
-    }
-    if version < 3 {
-        tx.execute_batch(SCHEMA_V3)?;
-    }
-    if version < 4 {
-        tx.execute_batch(SCHEMA_V4)?;
-    }
-    if version < 5 {
-        tx.execute_batch(SCHEMA_V5)?;
-    }
-    tx.pragma_update(None, "user_version", SCHEMA_VERSION)?;
-    tx.commit()?;
-    Ok(())
-}
-
-fn find_by_key(
-    conn: &Connection,
-    owner: Option<&str>,
-    key: &str,
-) -> Result<Option<KeyedJob>, StoreError> {
-    Ok(conn
-        .query_row(
-            "SELECT id, kind, status, request_hash FROM jobs
-             WHERE ifnull(owner, '') = ifnull(?1, '') AND idempotency_key = ?2",
-            params![owner, key],
-            |r| {
-                let status: String = r.get(2)?;
-                Ok(KeyedJob {
-                    id: r.get(0)?,
-                    kind: r.get(1)?,
-                    status: JobStatus::parse(&status),
-                    request_hash: r.get::<_, Option<String>>(3)?.unwrap_or_default(),
-                })
-            },
-        )
-        .optional()?)
 }
 
 impl JobBackend for JobStore {
@@ -408,17 +171,7 @@ impl JobBackend for JobStore {
         if let Some(key) = job.idempotency_key
             && let Some(first) = find_by_key(&tx, job.owner, key)?
         {
-            if first.request_hash != job.request_hash {
-                return Err(InsertError::KeyReused {
-                    key: key.to_string(),
-                    id: first.id,
-                });
-            }
-            return Ok(Inserted::Existing {
-                id: first.id,
-                kind: first.kind,
-                status: first.status,
-            });
+            return admission::replay(first, job, key);
         }
         let count = |sql: &str, p: &[&dyn rusqlite::ToSql]| -> Result<usize, StoreError> {
             let n: i64 = tx.query_row(sql, p, |r| r.get(0))?;
@@ -428,40 +181,21 @@ impl JobBackend for JobStore {
             "SELECT count(*) FROM jobs WHERE status IN ('queued', 'running')",
             &[],
         )?;
-        if pending >= job.max_pending {
-            return Err(InsertError::QueueFull {
-                pending,
-                limit: job.max_pending,
-            });
-        }
+        admission::check_pending(job, pending)?;
         if let Some(owner) = job.owner {
             let mine = count(
                 "SELECT count(*) FROM jobs WHERE owner = ?1 AND status IN ('queued', 'running')",
                 &[&owner],
             )?;
-            if mine >= job.max_pending_per_owner {
-                return Err(InsertError::QuotaFull {
-                    pending: mine,
-                    limit: job.max_pending_per_owner,
-                });
-            }
+            admission::check_owner_pending(job, mine)?;
         }
-        let adding = (job.request.len() as u64).saturating_add(job.reserve_bytes);
+        let adding = admission::job_bytes(job);
         let stored: i64 = tx
             .query_row(STORED_BYTES, [job.owner], |r| r.get(0))
             .map_err(StoreError::from)?;
-        let stored = stored.max(0) as u64;
-        if stored.saturating_add(adding) > job.max_stored_bytes {
-            let oldest_finished_s: Option<f64> = tx
-                .query_row(OLDEST_FINISHED, [job.owner], |r| r.get(0))
-                .map_err(StoreError::from)?;
-            return Err(InsertError::StoreFull {
-                stored,
-                adding,
-                limit: job.max_stored_bytes,
-                oldest_finished_s,
-            });
-        }
+        admission::check_job_store(job, stored, adding, || {
+            Ok(tx.query_row(OLDEST_FINISHED, [job.owner], |r| r.get(0))?)
+        })??;
         tx.execute(
             "INSERT INTO jobs (kind, request, status, owner, idempotency_key, request_hash, priority,
                  stored_bytes)
@@ -473,7 +207,7 @@ impl JobBackend for JobStore {
                 job.idempotency_key,
                 job.request_hash,
                 job.priority,
-                adding.min(i64::MAX as u64) as i64
+                admission::bytes_column(adding)
             ],
         )
         .map_err(StoreError::from)?;
@@ -503,7 +237,7 @@ impl JobBackend for JobStore {
                 "jobs whose process died at every attempt were failed"
             );
         }
-        let expires = now.saturating_add(policy.lease.as_millis().min(i64::MAX as u128) as i64);
+        let expires = now.saturating_add(admission::millis(policy.lease));
         let claimed = tx
             .query_row(
                 &format!(
@@ -761,28 +495,7 @@ impl JobBackend for JobStore {
     }
 
     fn create_chunks(&self, lease: &Lease, count: usize) -> Result<bool, StoreError> {
-        let mut conn = self.conn();
-        let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
-        let held: Option<i64> = tx
-            .query_row(
-                &format!("SELECT id FROM jobs WHERE {FENCE}"),
-                params![lease.job_id, lease.owner, lease.epoch],
-                |r| r.get(0),
-            )
-            .optional()?;
-        if held.is_none() {
-            return Ok(false);
-        }
-        {
-            let mut stmt = tx.prepare(
-                "INSERT OR IGNORE INTO job_chunks (job_id, idx, status) VALUES (?1, ?2, 'pending')",
-            )?;
-            for i in 0..count {
-                stmt.execute(params![lease.job_id, i as i64])?;
-            }
-        }
-        tx.commit()?;
-        Ok(true)
+        chunks::create_chunks(self, lease, count)
     }
 
     fn claim_chunk(
@@ -790,113 +503,31 @@ impl JobBackend for JobStore {
         job: Option<i64>,
         policy: &ClaimPolicy<'_>,
     ) -> Result<Option<ClaimedChunk>, StoreError> {
-        let mut conn = self.conn();
-        let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
-        let now = now_ms();
-        tx.execute(
-            "UPDATE job_chunks SET status = 'failed', error = ?1, lease_expires_ms = NULL
-             WHERE status = 'running' AND ifnull(lease_expires_ms, 0) < ?2 AND attempts >= ?3",
-            params![policy.exhausted_error, now, policy.max_attempts],
-        )?;
-        let expires = now.saturating_add(policy.lease.as_millis().min(i64::MAX as u128) as i64);
-        let claimed = tx
-            .query_row(
-                "UPDATE job_chunks SET status = 'running', attempts = attempts + 1,
-                    lease_owner = ?1, lease_expires_ms = ?2, lease_epoch = lease_epoch + 1
-                 WHERE (job_id, idx) = (
-                     SELECT c.job_id, c.idx FROM job_chunks c JOIN jobs j ON j.id = c.job_id
-                     WHERE j.status = 'running' AND (?4 IS NULL OR c.job_id = ?4)
-                       AND (c.status = 'pending'
-                            OR (c.status = 'running' AND ifnull(c.lease_expires_ms, 0) < ?3))
-                     ORDER BY j.priority, c.job_id, c.idx LIMIT 1)
-                 RETURNING job_id, idx, attempts, lease_epoch",
-                params![self.worker.as_str(), expires, now, job],
-                |r| {
-                    Ok((
-                        r.get::<_, i64>(0)?,
-                        r.get::<_, i64>(1)?,
-                        r.get::<_, u32>(2)?,
-                        r.get::<_, i64>(3)?,
-                    ))
-                },
-            )
-            .optional()?;
-        let Some((job_id, idx, attempts, epoch)) = claimed else {
-            tx.commit()?;
-            return Ok(None);
-        };
-        let request: String =
-            tx.query_row("SELECT request FROM jobs WHERE id = ?1", [job_id], |r| {
-                r.get(0)
-            })?;
-        tx.commit()?;
-        Ok(Some(ClaimedChunk {
-            lease: ChunkLease {
-                job_id,
-                index: idx as usize,
-                owner: self.worker.as_str().to_string(),
-                epoch,
-            },
-            request,
-            attempts,
-        }))
+        chunks::claim_chunk(self, job, policy)
     }
 
     fn renew_chunk(&self, lease: &ChunkLease, duration: Duration) -> Result<bool, StoreError> {
-        self.chunk_fenced("lease_expires_ms = ?4", lease, Some(&expiry_ms(duration)))
+        chunks::renew_chunk(self, lease, duration)
     }
 
     fn finish_chunk(&self, lease: &ChunkLease, result: &str) -> Result<bool, StoreError> {
-        self.chunk_fenced(
-            "status = 'done', result = ?4, lease_expires_ms = NULL, finished_by = lease_owner",
-            lease,
-            Some(&result),
-        )
+        chunks::finish_chunk(self, lease, result)
     }
 
     fn fail_chunk(&self, lease: &ChunkLease, error: &str) -> Result<bool, StoreError> {
-        self.chunk_fenced(
-            "status = 'failed', error = ?4, lease_expires_ms = NULL",
-            lease,
-            Some(&error),
-        )
+        chunks::fail_chunk(self, lease, error)
     }
 
     fn release_chunk(&self, lease: &ChunkLease) -> Result<bool, StoreError> {
-        self.chunk_fenced("status = 'pending', lease_expires_ms = NULL", lease, None)
+        chunks::release_chunk(self, lease)
     }
 
     fn chunk_state(&self, job_id: i64) -> Result<ChunkState, StoreError> {
-        let conn = self.conn();
-        let (total, done): (i64, i64) = conn.query_row(
-            "SELECT count(*), ifnull(sum(status = 'done'), 0) FROM job_chunks WHERE job_id = ?1",
-            [job_id],
-            |r| Ok((r.get(0)?, r.get(1)?)),
-        )?;
-        let failed: Option<String> = conn
-            .query_row(
-                "SELECT error FROM job_chunks WHERE job_id = ?1 AND status = 'failed'
-                 ORDER BY idx LIMIT 1",
-                [job_id],
-                |r| r.get(0),
-            )
-            .optional()?;
-        Ok(ChunkState {
-            total: total as usize,
-            done: done as usize,
-            failed,
-        })
+        chunks::chunk_state(self, job_id)
     }
 
     fn chunk_results(&self, job_id: i64) -> Result<Vec<(usize, String)>, StoreError> {
-        let conn = self.conn();
-        let mut stmt = conn.prepare(
-            "SELECT idx, result FROM job_chunks WHERE job_id = ?1 AND status = 'done' AND result IS NOT NULL ORDER BY idx",
-        )?;
-        let rows = stmt.query_map([job_id], |r| {
-            Ok((r.get::<_, i64>(0)? as usize, r.get::<_, String>(1)?))
-        })?;
-        Ok(rows.collect::<Result<_, _>>()?)
+        chunks::chunk_results(self, job_id)
     }
 
     fn worker_heartbeat(&self, role: &str) -> Result<(), StoreError> {
@@ -949,7 +580,7 @@ impl JobBackend for JobStore {
                  AND finished_at IS NOT NULL AND finished_at <= ?1",
             [&cutoff],
         )?;
-        let since = now_ms() - stale_workers.as_millis().min(i64::MAX as u128) as i64;
+        let since = now_ms() - admission::millis(stale_workers);
         tx.execute("DELETE FROM workers WHERE heartbeat_ms < ?1", [since])?;
         tx.commit()?;
         let free_pages: i64 = conn.query_row("PRAGMA freelist_count", [], |r| r.get(0))?;
@@ -961,7 +592,7 @@ impl JobBackend for JobStore {
     }
 
     fn live_workers(&self, within: Duration) -> Result<usize, StoreError> {
-        let since = now_ms() - within.as_millis().min(i64::MAX as u128) as i64;
+        let since = now_ms() - admission::millis(within);
         let n: i64 = self.conn().query_row(
             "SELECT count(*) FROM workers WHERE heartbeat_ms >= ?1",
             [since],
@@ -978,92 +609,19 @@ impl JobBackend for JobStore {
         max_per_owner: usize,
         max_stored_bytes: u64,
     ) -> Result<PutSystem, StoreError> {
-        let mut conn = self.conn();
-        let tx = conn.transaction_with_behavior(TransactionBehavior::Immediate)?;
-        let jobs_owner = (!owner.is_empty()).then_some(owner);
-        let stored: i64 = tx.query_row(STORED_BYTES, [jobs_owner], |r| r.get(0))?;
-        let replaced: i64 = tx.query_row(
-            "SELECT ifnull(sum(octet_length(body)), 0) FROM systems WHERE owner = ?1 AND name = ?2",
-            params![owner, name],
-            |r| r.get(0),
-        )?;
-        let stored = (stored - replaced).max(0) as u64;
-        if stored.saturating_add(body.len() as u64) > max_stored_bytes {
-            let oldest_finished_s: Option<f64> =
-                tx.query_row(OLDEST_FINISHED, [jobs_owner], |r| r.get(0))?;
-            return Ok(PutSystem::StoreFull {
-                stored,
-                limit: max_stored_bytes,
-                oldest_finished_s,
-            });
-        }
-        let updated = tx.execute(
-            &format!(
-                "UPDATE systems SET body = ?3, updated_at = {NOW} WHERE owner = ?1 AND name = ?2"
-            ),
-            params![owner, name, body],
-        )?;
-        let out = if updated == 1 {
-            PutSystem::Updated
-        } else {
-            let n: i64 = tx.query_row(
-                "SELECT count(*) FROM systems WHERE owner = ?1",
-                params![owner],
-                |r| r.get(0),
-            )?;
-            if n as usize >= max_per_owner {
-                return Ok(PutSystem::Full { max: max_per_owner });
-            }
-            tx.execute(
-                "INSERT INTO systems (owner, name, body) VALUES (?1, ?2, ?3)",
-                params![owner, name, body],
-            )?;
-            PutSystem::Created
-        };
-        tx.commit()?;
-        Ok(out)
+        systems::put_system(self, owner, name, body, max_per_owner, max_stored_bytes)
     }
 
     fn get_system(&self, owner: &str, name: &str) -> Result<Option<StoredSystem>, StoreError> {
-        Ok(self
-            .conn()
-            .query_row(
-                "SELECT name, body, created_at, updated_at FROM systems WHERE owner = ?1 AND name = ?2",
-                params![owner, name],
-                |r| {
-                    Ok(StoredSystem {
-                        name: r.get(0)?,
-                        body: r.get(1)?,
-                        created_at: r.get(2)?,
-                        updated_at: r.get(3)?,
-                    })
-                },
-            )
-            .optional()?)
+        systems::get_system(self, owner, name)
     }
 
     fn delete_system(&self, owner: &str, name: &str) -> Result<bool, StoreError> {
-        let n = self.conn().execute(
-            "DELETE FROM systems WHERE owner = ?1 AND name = ?2",
-            params![owner, name],
-        )?;
-        Ok(n == 1)
+        systems::delete_system(self, owner, name)
     }
 
     fn list_systems(&self, owner: &str) -> Result<Vec<StoredSystem>, StoreError> {
-        let conn = self.conn();
-        let mut stmt = conn.prepare(
-            "SELECT name, created_at, updated_at FROM systems WHERE owner = ?1 ORDER BY name",
-        )?;
-        let rows = stmt.query_map(params![owner], |r| {
-            Ok(StoredSystem {
-                name: r.get(0)?,
-                body: String::new(),
-                created_at: r.get(1)?,
-                updated_at: r.get(2)?,
-            })
-        })?;
-        Ok(rows.collect::<Result<Vec<_>, _>>()?)
+        systems::list_systems(self, owner)
     }
 
     fn pending(&self) -> Result<usize, StoreError> {
