@@ -11,10 +11,6 @@ use tetherplan::config::Limits;
 
 mod common;
 
-fn app() -> axum::Router {
-    common::app_with(1, Limits::default()).0
-}
-
 /// The route's answer; a forecast of more distinct winds than the
 /// synchronous budget pays for (a plan each, issue 34's prices) is refused
 /// `too_large` at once and answered as a `windows` job, as the page does.

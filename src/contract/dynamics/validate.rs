@@ -9,7 +9,7 @@
 use super::dto::*;
 use crate::contract::system::WindFlowInput;
 use crate::contract::system::bounds;
-use crate::contract::system::validate::{check_rest, require_count, require_range};
+use crate::contract::system::validate::{check_rest, require_range};
 use crate::numerics::dynamics::limits::{
     check_sample_count, check_segments, check_shape_count, check_shape_times,
     check_spectral_radius, check_steps,

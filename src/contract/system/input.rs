@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::{AerostatInput, CableInput, WinchInput, WindInput};
-use crate::numerics::chart;
+use crate::numerics::string::chart;
 use crate::numerics::params::{AerostatSystem, InvalidInput};
 use crate::numerics::profile::Profile;
 use crate::numerics::string::StringModel;
