@@ -33,6 +33,8 @@ async fn solve_kind<A: Analysis>(
         let body: &[u8] = resolved.as_deref().unwrap_or(&body);
         let req = A::parse(body)?;
         req.check_sync(ctx)?;
+        // A kind prices only what its run would accept (None otherwise:
+        // the run refuses the input, naming its field).
         let _admitted = match req.price() {
             Some(price) => Some(ctx.charge(&price, A::NAME)?),
             None => None,

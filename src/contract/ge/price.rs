@@ -35,10 +35,14 @@ pub const CHART_ELEMENT_POWER: f64 = 2.4;
 /// `POST /api/v1/simulate` of the GE model (None: invalid).
 pub fn simulate(req: &GeSimulateRequest) -> Option<Price> {
     let steps = (req.duration_s / req.time_step_s).round();
-    if !(steps.is_finite() && steps >= 1.0) {
+    let elements = req.model.elements() as f64;
+    // Past the run's limits the run refuses it, naming the field.
+    if !(steps.is_finite() && steps >= 1.0)
+        || steps > crate::contract::ge::simulate::MAX_STEPS as f64
+        || steps * elements > crate::contract::ge::simulate::MAX_WORK
+    {
         return None;
     }
-    let elements = req.model.elements() as f64;
     let solves = if req.eigenvalues_every_steps > 0 {
         (steps / req.eigenvalues_every_steps as f64).floor() + 1.0
     } else {
@@ -91,7 +95,10 @@ pub fn chart(req: &GeChartRequest) -> Option<Price> {
 /// run per frequency (None: invalid).
 pub fn base_frequency_response(req: &GeBaseFrequencyResponseRequest) -> Option<Price> {
     let steps = (req.duration_s / req.time_step_s).round();
-    if !(steps.is_finite() && steps >= 1.0) {
+    // Past the run's step limit the run refuses it, naming its field.
+    if !(steps.is_finite() && steps >= 1.0)
+        || steps > crate::contract::ge::simulate::MAX_STEPS as f64
+    {
         return None;
     }
     let runs = req.frequencies_rad_s.count() as f64;
