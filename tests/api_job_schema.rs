@@ -32,7 +32,8 @@ fn requests() -> Vec<(&'static str, Value)> {
         if requests.iter().any(|(k, _)| *k == kind.name) {
             continue;
         }
-        let example = &doc["paths"][kind.path]["post"]["requestBody"]["content"]["application/json"]["example"];
+        let example = &doc["paths"][kind.path]["post"]["requestBody"]["content"]["application/json"]
+            ["example"];
         assert!(
             example.is_object(),
             "no request for the kind {} ({}): its route publishes no example",
@@ -64,11 +65,18 @@ fn every_kind_of_the_catalogue_is_checked() {
             .collect()
     };
     let (job, item) = (refs("JobView"), refs("BatchItemOutcome"));
-    assert_eq!(job[..job.len() - 1], item[..], "JobView.result vs BatchItemOutcome.result");
+    assert_eq!(
+        job[..job.len() - 1],
+        item[..],
+        "JobView.result vs BatchItemOutcome.result"
+    );
     assert_eq!(job.last().unwrap(), "#/components/schemas/BatchOutcome");
     assert_eq!(item.len(), KINDS.len());
     for name in ["DynamicsResponse", "DynamicsPeaksResponse"] {
-        assert!(job.contains(&format!("#/components/schemas/{name}")), "{job:?}");
+        assert!(
+            job.contains(&format!("#/components/schemas/{name}")),
+            "{job:?}"
+        );
     }
 }
 

@@ -465,7 +465,11 @@ async fn most_expensive_accepted(
         let (cpu, wall) = (cpu_s() - c0, t0.elapsed().as_secs_f64());
         if status == StatusCode::UNPROCESSABLE_ENTITY && answer["error"]["code"] == "too_large" {
             assert!(wall < 1.0, "{}: a refusal took {wall:.1} s", shape.name);
-            assert!(n > 1, "{}: even a count of 1 is refused: {answer}", shape.name);
+            assert!(
+                n > 1,
+                "{}: even a count of 1 is refused: {answer}",
+                shape.name
+            );
             n = (n as f64 / 1.5) as usize;
             continue;
         }

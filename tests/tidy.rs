@@ -66,8 +66,7 @@ fn module_files(root: &Path) -> Vec<ModuleFile> {
                 .map(|c| c.as_os_str().to_string_lossy().into_owned())
                 .collect();
             // `lib.rs` is the crate's root module, a `mod.rs` of `src/`
-            let is_dir_module = module.last().is_some_and(|m| m == "mod")
-                || module == ["lib"];
+            let is_dir_module = module.last().is_some_and(|m| m == "mod") || module == ["lib"];
             if is_dir_module {
                 module.pop();
             }
@@ -431,7 +430,13 @@ fn the_cycle_finder_sees_a_cycle_through_a_reexport() {
     assert_eq!(found, ["x.rs -> y.rs -> x.rs"], "{names:?} {edges:?}");
     // z.rs's import through the re-export is an arrow to y.rs
     let z = names.iter().position(|n| n == "z.rs").unwrap();
-    assert_eq!(edges[z].iter().map(|&j| names[j].as_str()).collect::<Vec<_>>(), ["y.rs"]);
+    assert_eq!(
+        edges[z]
+            .iter()
+            .map(|&j| names[j].as_str())
+            .collect::<Vec<_>>(),
+        ["y.rs"]
+    );
 }
 
 /// The crate's file-level import graph (`src/`, binaries left out).

@@ -64,7 +64,9 @@ impl From<RequestError> for ApiError {
     fn from(e: RequestError) -> Self {
         let status = match e {
             RequestError::Malformed(_) => StatusCode::BAD_REQUEST,
-            RequestError::Invalid(_) | RequestError::TooLarge(_) => StatusCode::UNPROCESSABLE_ENTITY,
+            RequestError::Invalid(_) | RequestError::TooLarge(_) => {
+                StatusCode::UNPROCESSABLE_ENTITY
+            }
             RequestError::Numerical(_) => StatusCode::INTERNAL_SERVER_ERROR,
             RequestError::Cancelled => StatusCode::SERVICE_UNAVAILABLE,
         };
@@ -125,10 +127,7 @@ fn is_json(content_type: &str) -> bool {
 fn refused_for_budget(e: &(dyn std::error::Error + 'static)) -> bool {
     let mut next: Option<&(dyn std::error::Error + 'static)> = Some(e);
     while let Some(err) = next {
-        if err
-            .downcast_ref::<BodyRefusal>()
-            .is_some()
-        {
+        if err.downcast_ref::<BodyRefusal>().is_some() {
             return true;
         }
         next = err.source();

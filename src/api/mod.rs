@@ -204,4 +204,3 @@ fn warn_if_exposed(addr: std::net::SocketAddr) {
         eprintln!("{msg}");
     }
 }
-

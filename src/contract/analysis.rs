@@ -82,7 +82,11 @@ pub trait Analysis: Serialize + Sized + Send + Sync + 'static {
 
     /// The result (JSON text) of the items `range` (only kinds with
     /// [`Analysis::items`]).
-    fn run_items(&self, _range: Range<usize>, progress: &dyn Progress) -> Result<String, RequestError> {
+    fn run_items(
+        &self,
+        _range: Range<usize>,
+        progress: &dyn Progress,
+    ) -> Result<String, RequestError> {
         to_json(&self.run(progress)?)
     }
 

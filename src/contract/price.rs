@@ -17,7 +17,6 @@
 //!
 //! Each kind prices itself ([`crate::contract::analysis::Analysis::price`]) with its unit costs beside its request (`dynamics/price.rs`, `envelope/price.rs`); the budget and the admission of work in flight are here.
 
-
 /// CPU seconds a synchronous request may cost; past it: a job.
 pub const SYNC_CPU_BUDGET_S: f64 = 2.0;
 

@@ -110,7 +110,6 @@ pub fn work_once(queue: &JobQueue) -> Result<bool, StoreError> {
     Ok(chunks::execute_chunk(queue, None)?.is_some())
 }
 
-
 /// Progress and cancellation of one running job.
 struct JobControl<'a> {
     lease: &'a Lease,
@@ -182,7 +181,6 @@ pub struct Executed {
     pub id: i64,
     pub status: JobStatus,
 }
-
 
 /// Runs the oldest queued job (or one whose lease expired) to its end, if
 /// there is one: the worker's step, also called directly by tests.

@@ -13,10 +13,10 @@ use std::time::Duration;
 
 use rusqlite::{Connection, OptionalExtension, TransactionBehavior, params};
 
+use super::backend::StoreError;
 use super::flights::{
     FlightEntry, FlightRow, FlightStore, MAX_FLIGHTS_PER_OWNER, NewFlight, StoredBatch,
 };
-use super::backend::StoreError;
 use crate::numerics::monitor::Sample;
 
 const SCHEMA_V1: &str = "

@@ -8,9 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
 
-use super::backend::{
-    InsertError, Inserted, JobBackend, JobRecord, JobStatus, NewJob, StoreError,
-};
+use super::backend::{InsertError, Inserted, JobBackend, JobRecord, JobStatus, NewJob, StoreError};
 use super::kinds::JobSubmission;
 use crate::contract::RequestError;
 use crate::contract::error::ErrorBody;

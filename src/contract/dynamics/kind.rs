@@ -80,14 +80,11 @@ impl Analysis for DynamicsRequest {
         dynamics::dynamics(self, progress)
     }
     fn estimate(&self) -> Estimate {
-        let shapes = self
-            .shape_times_s
-            .as_ref()
-            .map_or(
-                self.shape_count
-                    .unwrap_or(crate::contract::dynamics::dto::DEFAULT_SHAPE_COUNT),
-                Vec::len,
-            ) as u64;
+        let shapes = self.shape_times_s.as_ref().map_or(
+            self.shape_count
+                .unwrap_or(crate::contract::dynamics::dto::DEFAULT_SHAPE_COUNT),
+            Vec::len,
+        ) as u64;
         let nodes = shapes.saturating_mul(self.numerics.segments as u64 + 1);
         Estimate::new(
             "sample_count",
@@ -118,7 +115,9 @@ impl Analysis for DynamicsPeaksRequest {
         dynamics::parse_peaks(body)
     }
     fn prepare(&self) -> Result<(), RequestError> {
-        DynamicsPeaksRequest::prepare(self).map(drop).map_err(Into::into)
+        DynamicsPeaksRequest::prepare(self)
+            .map(drop)
+            .map_err(Into::into)
     }
     fn check_sync(&self, _: &Limits) -> Result<(), RequestError> {
         let prepared = DynamicsPeaksRequest::prepare(self)?;
@@ -134,7 +133,10 @@ impl Analysis for DynamicsPeaksRequest {
         Ok(())
     }
     fn price(&self) -> Option<Price> {
-        Some(price::dynamics_peaks(&DynamicsPeaksRequest::prepare(self).ok()?, self.samples))
+        Some(price::dynamics_peaks(
+            &DynamicsPeaksRequest::prepare(self).ok()?,
+            self.samples,
+        ))
     }
     fn run(&self, progress: &dyn Progress) -> Result<DynamicsPeaksResponse, RequestError> {
         peaks::peaks(self, Parallelism::Rayon, progress)
@@ -156,7 +158,11 @@ impl Analysis for DynamicsPeaksRequest {
             most_per_chunk: None,
         })
     }
-    fn run_items(&self, range: Range<usize>, progress: &dyn Progress) -> Result<String, RequestError> {
+    fn run_items(
+        &self,
+        range: Range<usize>,
+        progress: &dyn Progress,
+    ) -> Result<String, RequestError> {
         peaks::peaks_chunk(self, range, Parallelism::Rayon, progress)
     }
     fn assemble(&self, parts: &[String]) -> Result<String, RequestError> {

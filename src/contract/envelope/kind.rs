@@ -1,8 +1,8 @@
 //! The `envelope` analysis kind ([`Analysis`], SPEC §6): progress per wind
 //! row, chunked by wind row.
 
-use crate::contract::envelope::stability::EnvelopeStabilityInput;
 use crate::contract::envelope::price;
+use crate::contract::envelope::stability::EnvelopeStabilityInput;
 use crate::contract::price::Price;
 use std::ops::Range;
 
@@ -115,7 +115,11 @@ impl Analysis for EnvelopeRequest {
             most_per_chunk: None,
         })
     }
-    fn run_items(&self, range: Range<usize>, progress: &dyn Progress) -> Result<String, RequestError> {
+    fn run_items(
+        &self,
+        range: Range<usize>,
+        progress: &dyn Progress,
+    ) -> Result<String, RequestError> {
         to_json(&chunks::envelope_chunk(
             self,
             range,

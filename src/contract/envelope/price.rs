@@ -68,4 +68,3 @@ pub fn ge_envelope(rows: usize, points: usize, elements: Option<usize>) -> Price
         },
     }
 }
-

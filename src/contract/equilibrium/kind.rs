@@ -14,7 +14,8 @@ impl Analysis for EquilibriumRequest {
         aerostat down (RK4, shooting on the altitude). Slack (part of the\n\
         tether on the ground) is an answer, not an error. Presets\n\
         (`cable.preset`, `aerostat.preset`) fill the fields left out.";
-    const ABOUT: &'static str = "Static tether in a steady wind: altitude, blow-down, tensions, shape.";
+    const ABOUT: &'static str =
+        "Static tether in a steady wind: altitude, blow-down, tensions, shape.";
     type Response = EquilibriumResponse;
     fn parse(body: &[u8]) -> Result<Self, RequestError> {
         crate::contract::parse_plain(body)

@@ -5,7 +5,6 @@
 
 use std::ops::Range;
 
-use crate::contract::price::Price;
 use crate::contract::analysis::{Analysis, Items, to_json, too_large, validate_by_cancelled_run};
 use crate::contract::error::{Progress, RequestError};
 use crate::contract::estimate::{self as est, Estimate as E, Estimate};
@@ -15,6 +14,7 @@ use crate::contract::ge::charts::{
 };
 use crate::contract::ge::critical::{self, AnyCriticalRequest, AnyCriticalResponse};
 use crate::contract::ge::stability::{self, AnyStabilityRequest, AnyStabilityResponse};
+use crate::contract::price::Price;
 use crate::contract::string::{chunks, kind as string, run};
 use crate::contract::system::input::{ProfileInput, SystemInput};
 use crate::limits::Limits;
@@ -35,7 +35,11 @@ pub const MAX_SYNC_FREQUENCIES: usize = 16;
 /// end at the onset).
 const GE_ELEMENT_STEP_S: f64 = 8e-6;
 
-fn limit_qep_elements(system: &SystemInput, limits: &Limits, why: &str) -> Result<(), RequestError> {
+fn limit_qep_elements(
+    system: &SystemInput,
+    limits: &Limits,
+    why: &str,
+) -> Result<(), RequestError> {
     let n = system.model.mesh_elements();
     if n > limits.max_sync_qep_elements {
         return Err(too_large(
@@ -113,7 +117,8 @@ impl Analysis for AnyStabilityRequest {
 
 impl Analysis for AnyCriticalRequest {
     const NAME: &'static str = "critical";
-    const SUMMARY: &'static str = "Critical time t* and maximum safe elevation h* of a deployment profile.";
+    const SUMMARY: &'static str =
+        "Critical time t* and maximum safe elevation h* of a deployment profile.";
     const DESCRIPTION: &'static str = "With the closed-form continuum bound beside it. `model.kind` picks\n\
         the model: `linear_string` (default; QEP-based searches —\n\
         accelerating profiles, `confirm_with_qep` — take at most 400\n\
@@ -130,9 +135,9 @@ impl Analysis for AnyCriticalRequest {
     fn prepare(&self) -> Result<(), RequestError> {
         match self {
             Self::LinearString(r) => run::check_critical(r),
-            Self::GeometricallyExact(r) => critical::prepare_critical(r)
-                .map(drop)
-                .map_err(Into::into),
+            Self::GeometricallyExact(r) => {
+                critical::prepare_critical(r).map(drop).map_err(Into::into)
+            }
         }
     }
     fn check_sync(&self, limits: &Limits) -> Result<(), RequestError> {
@@ -253,7 +258,11 @@ impl Analysis for AnyChartRequest {
             }
         }
     }
-    fn run_items(&self, range: Range<usize>, progress: &dyn Progress) -> Result<String, RequestError> {
+    fn run_items(
+        &self,
+        range: Range<usize>,
+        progress: &dyn Progress,
+    ) -> Result<String, RequestError> {
         match self {
             Self::LinearString(r) => chunks::chart_chunk(r, range, Parallelism::Rayon, progress),
             Self::GeometricallyExact(r) => to_json(&charts::ge_chart_points(
@@ -270,9 +279,8 @@ impl Analysis for AnyChartRequest {
             Self::GeometricallyExact(r) => {
                 let mut points = Vec::new();
                 for part in parts {
-                    let chunk: Vec<GeChartPointOutput> = serde_json::from_str(part).map_err(|e| {
-                        RequestError::Malformed(format!("a chunk result: {e}"))
-                    })?;
+                    let chunk: Vec<GeChartPointOutput> = serde_json::from_str(part)
+                        .map_err(|e| RequestError::Malformed(format!("a chunk result: {e}")))?;
                     points.extend(chunk);
                 }
                 to_json(&charts::ge_chart_assemble(r, points)?)

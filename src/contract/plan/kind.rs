@@ -21,7 +21,8 @@ impl Analysis for PlanRequest {
         constant-rate plan; the schedule run on the FE string; with a wind\n\
         forecast, the haul-down deadline. `feasible: false` names the\n\
         binding limit.";
-    const ABOUT: &'static str = "The fastest safe deployment (or retrieval) schedule, with the haul-down deadline.";
+    const ABOUT: &'static str =
+        "The fastest safe deployment (or retrieval) schedule, with the haul-down deadline.";
     type Response = PlanResponse;
     fn parse(body: &[u8]) -> Result<Self, RequestError> {
         super::parse_plan(body)

@@ -6,7 +6,9 @@ use crate::contract::analysis::{Analysis, Items, too_large};
 use crate::contract::error::{Progress, RequestError};
 use crate::contract::estimate::{self as est, Estimate as E, Estimate};
 use crate::contract::string::chunks::chart_rate_count;
-use crate::contract::string::dto::{ChartRequest, SafeRateRequest, SafeRateResponse, StabilityRequest};
+use crate::contract::string::dto::{
+    ChartRequest, SafeRateRequest, SafeRateResponse, StabilityRequest,
+};
 use crate::contract::string::run::{self, MAX_MODES};
 use crate::limits::Limits;
 use crate::numerics::parallel::Parallelism;

@@ -11,10 +11,10 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::{AerostatInput, CableInput, WinchInput, WindInput};
-use crate::numerics::string::chart;
 use crate::numerics::params::{AerostatSystem, InvalidInput};
 use crate::numerics::profile::Profile;
 use crate::numerics::string::StringModel;
+use crate::numerics::string::chart;
 use crate::numerics::string::converged;
 
 /// Which cable model, and its discretisation.

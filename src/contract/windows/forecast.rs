@@ -54,18 +54,20 @@ pub struct ForecastInput {
 /// text formats).
 fn data_schema() -> utoipa::openapi::schema::Schema {
     use utoipa::openapi::schema::{ObjectBuilder, OneOfBuilder, Schema, Type};
-    Schema::OneOf(OneOfBuilder::new()
-        .item(
-            ObjectBuilder::new()
-                .schema_type(Type::Object)
-                .description(Some("`open_meteo`: the JSON object as the API returns it")),
-        )
-        .item(
-            ObjectBuilder::new()
-                .schema_type(Type::String)
-                .description(Some("`metar`, `taf`, `csv`: the report's text")),
-        )
-        .build())
+    Schema::OneOf(
+        OneOfBuilder::new()
+            .item(
+                ObjectBuilder::new()
+                    .schema_type(Type::Object)
+                    .description(Some("`open_meteo`: the JSON object as the API returns it")),
+            )
+            .item(
+                ObjectBuilder::new()
+                    .schema_type(Type::String)
+                    .description(Some("`metar`, `taf`, `csv`: the report's text")),
+            )
+            .build(),
+    )
 }
 
 /// One period of one member: `[start_s, end_s)`.

@@ -42,8 +42,8 @@ use super::solver::{
     NewtonFailure, Scheme, State,
 };
 use super::stability;
-pub use super::start::{StartState, root_axial_force_n};
 use super::start::steady_payout_velocity;
+pub use super::start::{StartState, root_axial_force_n};
 use crate::numerics::aero::Aerodynamics;
 use crate::numerics::params::{InvalidInput, require_non_negative, require_positive};
 use crate::numerics::profile::Profile;

@@ -506,7 +506,11 @@ pub fn static_solve(
 /// residual cannot be reduced further (stiff cables: `EA·ε` per element).
 /// One Newton update: solves `tangent · Δq = −residual`, adds `Δq` to `q`
 /// and returns it; `None` when the tangent is singular.
-pub(crate) fn newton_correction(tangent: Band, residual: &[f64], q: &mut [f64]) -> Option<Vec<f64>> {
+pub(crate) fn newton_correction(
+    tangent: Band,
+    residual: &[f64],
+    q: &mut [f64],
+) -> Option<Vec<f64>> {
     let lu = tangent.factor()?;
     let mut dq: Vec<f64> = residual.iter().map(|x| -x).collect();
     lu.solve_in_place(&mut dq);

@@ -86,9 +86,15 @@ use super::GeModel;
 use super::air_load::AirLoads;
 use super::element::TipLoad;
 use super::qs_critical::{
-    OnsetState, QsSearchConfig, Scan, along_length, along_rate, nearest, onset_state,
-    refine_root, scan_change, search_onset_from,
+    OnsetState, QsSearchConfig, Scan, along_length, along_rate, nearest, onset_state, refine_root,
+    scan_change, search_onset_from,
 };
+pub use super::qs_levels::{
+    BASE_ELEMENTS, ConvergedOnset, ConvergedOutcome, ConvergedSearch, ConvergenceConfig,
+    DEFAULT_RELATIVE_TOLERANCE, MAX_CONVERGED_ELEMENTS, MAX_RELATIVE_TOLERANCE,
+    MIN_RELATIVE_TOLERANCE, NEAR, OnsetKind, ROOT_RTOL, level_rtol, richardson, with_elements,
+};
+use super::qs_levels::{prolong, summarise};
 pub use super::qs_mesh::{
     CalmGuess, FIRST_ELEMENT_IN_LAYERS, bisect_nodes, calm_length_guess, calm_rate_guess,
     graded_nodes,
@@ -96,12 +102,6 @@ pub use super::qs_mesh::{
 use super::qs_wind::{branch_equilibrium, continuum_start};
 use super::quasi_static::{QsConfig, divergence_indicator, wind_equilibrium, wind_stability};
 use super::stability::StateMotion;
-pub use super::qs_levels::{
-    BASE_ELEMENTS, ConvergedOnset, ConvergedOutcome, ConvergedSearch, ConvergenceConfig,
-    DEFAULT_RELATIVE_TOLERANCE, MAX_CONVERGED_ELEMENTS, MAX_RELATIVE_TOLERANCE,
-    MIN_RELATIVE_TOLERANCE, NEAR, OnsetKind, ROOT_RTOL, level_rtol, richardson, with_elements,
-};
-use super::qs_levels::{prolong, summarise};
 use crate::numerics::params::{InvalidInput, Kinematics, require_finite, require_positive};
 
 /// Scan points of the first level.
@@ -298,7 +298,6 @@ impl<K: Fn(f64) -> Kinematics> Level<'_, K> {
     }
 }
 
-
 /// Where the next level looks for its root: below the last by the last
 /// step times the ratio of the last two (first order: a half), 1 % on
 /// the first refinement.
@@ -348,7 +347,6 @@ fn hint(roots: &[(usize, f64)], guess: Option<&CalmGuess>) -> Option<Hint> {
         }
     }
 }
-
 
 /// The converged divergence onset along `p ∈ [lo, hi]` of the state
 /// `kin(p)` (module docs); `model` gives the section, tip and gravity
@@ -543,7 +541,6 @@ pub fn converged_onset(
         equilibria,
     })
 }
-
 
 /// Converged quasi-static critical length of a payout at constant rate
 /// `rate_m_s` between `min_length_m` and `max_length_m`.

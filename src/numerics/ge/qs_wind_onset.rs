@@ -82,13 +82,13 @@
 use super::GeModel;
 use super::air_load::AirLoads;
 use super::element::TipLoad;
-use super::qs_levels::{
-    ConvergedOnset, ConvergedOutcome, ConvergedSearch, ConvergenceConfig, NEAR, OnsetKind,
-    level_rtol, prolong, richardson, summarise, with_elements,
-};
 use super::qs_critical::{nearest, onset_state};
 use super::qs_flutter::{
     C64, EigenPair, prolong_vector, refine_eigenpair, refine_eigenpair_at_scale,
+};
+use super::qs_levels::{
+    ConvergedOnset, ConvergedOutcome, ConvergedSearch, ConvergenceConfig, NEAR, OnsetKind,
+    level_rtol, prolong, richardson, summarise, with_elements,
 };
 use super::qs_wind::{
     MAX_STEP_DISPLACEMENT, MAX_STEP_ROTATION_RAD, branch_equilibrium, continuum_start, on_branch,

@@ -29,8 +29,8 @@
 //! below the 3 % asked of the plan.
 
 use crate::numerics::plan::air::Air;
-pub use crate::numerics::plan::pass::{Knot, Phase, PlanOutcome, Schedule, SegmentLimit};
 use crate::numerics::plan::pass::{Grid, pass, static_check};
+pub use crate::numerics::plan::pass::{Knot, Phase, PlanOutcome, Schedule, SegmentLimit};
 use crate::numerics::plan::{PlanProblem, STABILITY_MARGIN};
 
 /// How a plan is made beyond the problem: the air, and a jerk limit.
