@@ -26,73 +26,14 @@ use tetherplan::contract::ge_charts::{self, GeChartRequest};
 use tetherplan::contract::run::NoProgress;
 use tetherplan::numerics::parallel::Parallelism;
 
+mod common;
+use common::pg::TestDb;
+
 const LEASE_S: &str = "2";
 
 /// A done job's answer as the database keeps it: its pages, in order.
 const STORED_ANSWER: &str = "SELECT convert_from(string_agg(data, ''::BYTEA ORDER BY page), 'UTF8')
     FROM job_answers WHERE job_id = $1";
-
-/// A fresh database, dropped at the end.
-struct TestDb {
-    admin_url: String,
-    name: String,
-    url: String,
-}
-
-fn admin_url() -> String {
-    std::env::var("TETHERPLAN_TEST_PG_URL")
-        .unwrap_or_else(|_| "postgres://postgres:postgres@127.0.0.1:5432/postgres".into())
-}
-
-impl TestDb {
-    /// None (with the reason printed) when PostgreSQL is unreachable and
-    /// `CI` is not set.
-    fn create(test: &str) -> Option<Self> {
-        let admin_url = admin_url();
-        let mut admin = match postgres::Client::connect(&admin_url, postgres::NoTls) {
-            Ok(c) => c,
-            Err(e) => {
-                if std::env::var_os("CI").is_some() {
-                    panic!("PostgreSQL unreachable at {admin_url} with CI set: {e}");
-                }
-                eprintln!(
-                    "SKIPPED {test}: PostgreSQL unreachable at {admin_url} ({e}); \
-                     set TETHERPLAN_TEST_PG_URL or start it (.ci/run shows how)"
-                );
-                return None;
-            }
-        };
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .unwrap()
-            .subsec_nanos();
-        let name = format!("tetherplan_test_{}_{}_{nanos}", test, std::process::id());
-        admin
-            .batch_execute(&format!("CREATE DATABASE {name}"))
-            .unwrap();
-        let base = admin_url.rsplit_once('/').unwrap().0;
-        Some(Self {
-            url: format!("{base}/{name}"),
-            admin_url,
-            name,
-        })
-    }
-
-    fn client(&self) -> postgres::Client {
-        postgres::Client::connect(&self.url, postgres::NoTls).unwrap()
-    }
-}
-
-impl Drop for TestDb {
-    fn drop(&mut self) {
-        if let Ok(mut admin) = postgres::Client::connect(&self.admin_url, postgres::NoTls) {
-            let _ = admin.batch_execute(&format!(
-                "DROP DATABASE IF EXISTS {} WITH (FORCE)",
-                self.name
-            ));
-        }
-    }
-}
 
 /// A child process killed (SIGKILL) when dropped.
 struct Proc {

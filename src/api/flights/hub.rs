@@ -19,6 +19,7 @@ use crate::contract::flight::model::{StoredTable, flight_model, status_output};
 use crate::contract::plan::PlanResponse;
 use crate::jobs::flights::{FlightRow, FlightStore, StoredBatch};
 use crate::jobs::flights_sqlite::SqliteFlights;
+use crate::jobs::postgres::PgStore;
 use crate::jobs::store::{StoreConfig, StoreError};
 use crate::numerics::monitor::{Event, FlightModel, Monitor, Pushed, Sample};
 
@@ -144,20 +145,15 @@ impl FlightHub {
         ))
     }
 
-    /// The flights of the job database: the SQLite file itself; with
-    /// PostgreSQL jobs, a SQLite file `tetherplan-flights.db` beside the
-    /// process (the flight tables are not ported to PostgreSQL yet).
+    /// The flights of the job database: the SQLite file itself, or the
+    /// PostgreSQL database the jobs are in (so another API process on the
+    /// same database serves the same flights after this one is lost).
     pub fn open(config: &StoreConfig) -> Result<Self, StoreError> {
-        let store = match config {
-            StoreConfig::Sqlite(p) => SqliteFlights::open(p)?,
-            StoreConfig::Postgres(_) => {
-                tracing::warn!(
-                    "flights are kept in ./tetherplan-flights.db (SQLite) beside PostgreSQL jobs"
-                );
-                SqliteFlights::open(std::path::Path::new("tetherplan-flights.db"))?
-            }
+        let store: Arc<dyn FlightStore> = match config {
+            StoreConfig::Sqlite(p) => Arc::new(SqliteFlights::open(p)?),
+            StoreConfig::Postgres(url) => Arc::new(PgStore::open_for_flights(url)?),
         };
-        Ok(Self::new(Arc::new(store)))
+        Ok(Self::new(store))
     }
 
     /// The live flight `id` of `owner`, loaded (and replayed) on first

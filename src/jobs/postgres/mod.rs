@@ -29,17 +29,21 @@
 //! 4. `jobs.stored_bytes` (the store quota), `jobs.chunk_takeovers` and
 //!    `job_answers`: a done
 //!    job's answer in pages (`BYTEA`, streamed by `GET /api/v1/jobs/{id}`);
-//!    the answers of version 3 move there, one page each.
+//!    the answers of version 3 move there, one page each;
+//! 5. `flights`, `flight_samples`, `flight_acknowledgements`: the live
+//!    flights (issue 33), as SQLite keeps them (`flights.rs`).
 //!
 //! The store by part: `schema.rs` the migrations, `rows.rs` the
 //! connection, errors in plain words, SQL fragments, row reader and fenced
-//! writes, `chunks.rs` the chunk rows, `systems.rs` the named systems; this
+//! writes, `chunks.rs` the chunk rows, `systems.rs` the named systems, `flights.rs` the live flights
+//! ([`crate::jobs::flights::FlightStore`]); this
 //! file opens the store and implements [`JobBackend`]: the job rows,
 //! workers and housekeeping here, the chunks and systems by calling their
 //! files. What it decides as SQLite does (quota, idempotency) is in
 //! [`crate::jobs::admission`].
 
 mod chunks;
+mod flights;
 mod rows;
 mod schema;
 mod systems;
@@ -80,6 +84,18 @@ impl PgStore {
                 "jobs of a dead process on this host taken over at start-up"
             );
         }
+        Ok(store)
+    }
+
+    /// Connects and migrates the schema, without taking over any job: a
+    /// second handle on the same database for the live flights.
+    pub fn open_for_flights(url: &str) -> Result<Self, StoreError> {
+        let store = Self {
+            url: url.to_string(),
+            client: Mutex::new(None),
+            worker: WorkerId::this_process(),
+        };
+        store.with(|c| migrate(c))?;
         Ok(store)
     }
 }

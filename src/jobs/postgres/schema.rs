@@ -89,10 +89,48 @@ const MIGRATIONS: &[(i32, &str)] = &[
         UPDATE jobs SET stored_bytes = octet_length(request) + coalesce(octet_length(result), 0)
             + coalesce(octet_length(error), 0), result = NULL;",
     ),
+    (
+        5,
+        "CREATE TABLE flights (
+            id              BIGSERIAL PRIMARY KEY,
+            owner           TEXT NOT NULL,
+            name            TEXT NOT NULL,
+            request         TEXT NOT NULL,
+            plan            TEXT NOT NULL,
+            limits          TEXT NOT NULL,
+            ceiling         TEXT NOT NULL,
+            created_at      TEXT NOT NULL DEFAULT to_char(clock_timestamp() AT TIME ZONE 'UTC',
+                                'YYYY-MM-DD\"T\"HH24:MI:SS.MS\"Z\"'),
+            ended_at        TEXT,
+            last_arrival_ms BIGINT,
+            next_seq        BIGINT NOT NULL DEFAULT 1,
+            samples         BIGINT NOT NULL DEFAULT 0
+        );
+        CREATE INDEX flights_by_owner ON flights (owner, id);
+        CREATE TABLE flight_samples (
+            flight_id           BIGINT NOT NULL REFERENCES flights (id) ON DELETE CASCADE,
+            time_s              DOUBLE PRECISION NOT NULL,
+            seq                 BIGINT NOT NULL,
+            tether_length_m     DOUBLE PRECISION,
+            winch_rate_m_s      DOUBLE PRECISION,
+            winch_tension_n     DOUBLE PRECISION,
+            wind_speed_m_s      DOUBLE PRECISION,
+            wind_height_m       DOUBLE PRECISION,
+            aerostat_altitude_m DOUBLE PRECISION,
+            PRIMARY KEY (flight_id, time_s)
+        );
+        CREATE UNIQUE INDEX flight_samples_by_seq ON flight_samples (flight_id, seq);
+        CREATE TABLE flight_acknowledgements (
+            id        BIGSERIAL PRIMARY KEY,
+            flight_id BIGINT NOT NULL REFERENCES flights (id) ON DELETE CASCADE,
+            time_s    DOUBLE PRECISION NOT NULL
+        );
+        CREATE INDEX flight_acknowledgements_by_flight ON flight_acknowledgements (flight_id, id);",
+    ),
 ];
 
 /// The current schema version.
-pub const SCHEMA_VERSION: i32 = 4;
+pub const SCHEMA_VERSION: i32 = 5;
 
 /// Advisory lock key of migrations (inserts take the next key,
 /// `rows::INSERT_LOCK`).
