@@ -69,6 +69,86 @@ pub struct ServeArgs {
     pub body_budget_bytes: usize,
     #[command(flatten)]
     pub jobs: JobArgs,
+    #[command(flatten)]
+    pub mqtt: MqttArgs,
+}
+
+/// The MQTT telemetry feed (`tetherplan serve`; off without `--mqtt-url`).
+#[derive(Clone, Debug, clap::Args)]
+pub struct MqttArgs {
+    /// MQTT broker to take flight telemetry from (`mqtt://host:1883`); the
+    /// server subscribes to `<prefix>/+/telemetry` at QoS 1 in a persistent
+    /// session, `+` a flight's id. Off by default.
+    #[arg(long, env = "TETHERPLAN_MQTT_URL")]
+    pub mqtt_url: Option<String>,
+    /// Topic prefix of the telemetry topics.
+    #[arg(
+        long,
+        env = "TETHERPLAN_MQTT_TOPIC_PREFIX",
+        default_value = "tetherplan/flights"
+    )]
+    pub mqtt_topic_prefix: String,
+    /// MQTT client id: the broker keeps this session's subscription and
+    /// unacknowledged messages while the server is away; give every
+    /// server process its own.
+    #[arg(
+        long,
+        env = "TETHERPLAN_MQTT_CLIENT_ID",
+        default_value = "tetherplan-server"
+    )]
+    pub mqtt_client_id: String,
+}
+
+/// The MQTT feed's settings, when on.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MqttSettings {
+    pub host: String,
+    pub port: u16,
+    pub topic_prefix: String,
+    pub client_id: String,
+}
+
+impl MqttArgs {
+    /// The settings, `None` without a URL; an unusable URL or prefix is an
+    /// error in plain words.
+    pub fn settings(&self) -> Result<Option<MqttSettings>, String> {
+        let Some(url) = self.mqtt_url.as_deref().filter(|u| !u.trim().is_empty()) else {
+            return Ok(None);
+        };
+        let rest = url.trim().strip_prefix("mqtt://").ok_or_else(|| {
+            format!("--mqtt-url `{url}`: must start with mqtt:// (TLS brokers are not supported)")
+        })?;
+        let rest = rest.trim_end_matches('/');
+        let (host, port) = match rest.rsplit_once(':') {
+            Some((h, p)) => (
+                h,
+                p.parse::<u16>()
+                    .map_err(|_| format!("--mqtt-url `{url}`: the port `{p}` is not a number"))?,
+            ),
+            None => (rest, 1883),
+        };
+        if host.is_empty() || host.contains('/') || host.contains('@') {
+            return Err(format!(
+                "--mqtt-url `{url}`: give mqtt://host[:port], without credentials or a path"
+            ));
+        }
+        let prefix = self.mqtt_topic_prefix.trim_matches('/');
+        if prefix.is_empty() || prefix.contains(['+', '#']) {
+            return Err(format!(
+                "--mqtt-topic-prefix `{}`: must be a topic without wildcards (+, #)",
+                self.mqtt_topic_prefix
+            ));
+        }
+        if self.mqtt_client_id.is_empty() || self.mqtt_client_id.len() > 64 {
+            return Err("--mqtt-client-id: 1 to 64 characters".into());
+        }
+        Ok(Some(MqttSettings {
+            host: host.to_string(),
+            port,
+            topic_prefix: prefix.to_string(),
+            client_id: self.mqtt_client_id.clone(),
+        }))
+    }
 }
 
 /// Job limits, leases and API tokens (`tetherplan serve`).
@@ -167,6 +247,8 @@ pub struct Config {
     pub allowed_hosts: Option<String>,
     /// API tokens (empty: no authentication).
     pub api_tokens: Vec<String>,
+    /// The MQTT telemetry feed, as given (checked when the server starts).
+    pub mqtt: MqttArgs,
 }
 
 impl From<ServeArgs> for Config {
@@ -204,6 +286,7 @@ impl From<ServeArgs> for Config {
                 ..ConnectionLimits::default()
             },
             allowed_hosts: a.allowed_hosts,
+            mqtt: a.mqtt,
         }
     }
 }

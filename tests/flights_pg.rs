@@ -91,6 +91,12 @@ fn script(store: &dyn FlightStore) -> Vec<String> {
         row.created_at.len() == 24 && row.created_at.ends_with('Z')
     ));
     out.push(format!(
+        "owners: {:?} {:?} {:?}",
+        store.owner_of(a).unwrap(),
+        store.owner_of(b).unwrap(),
+        store.owner_of(a + b + 1).unwrap()
+    ));
+    out.push(format!(
         "other owner: {:?} {}",
         store.get_flight(a, "owner-b").unwrap().map(|r| r.id),
         store.end_flight(a, "owner-b").unwrap()

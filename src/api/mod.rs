@@ -107,6 +107,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
 /// then stops accepting, lets requests in flight finish, and puts the
 /// running job back in the queue.
 pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
+    let mqtt = config.mqtt.settings()?;
     let store = config
         .store
         .open()
@@ -127,6 +128,9 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
     let state = AppState::new(queue.clone())
         .with_tokens(&config.api_tokens)
         .with_flights(flights);
+    if let Some(settings) = mqtt {
+        flights::mqtt::spawn(state.flights.clone(), settings);
+    }
     let listener = tokio::net::TcpListener::bind(config.addr)
         .await
         .map_err(|e| format!("cannot listen on {}: {e}", config.addr))?;

@@ -76,6 +76,9 @@ pub trait FlightStore: Send + Sync {
     /// [`MAX_FLIGHTS_PER_OWNER`] already.
     fn create_flight(&self, owner: &str, f: &NewFlight<'_>) -> Result<Option<i64>, StoreError>;
     fn get_flight(&self, id: i64, owner: &str) -> Result<Option<FlightRow>, StoreError>;
+    /// The owner of flight `id` (for a feed that names the flight only,
+    /// as the MQTT topics do); `None`: no such flight.
+    fn owner_of(&self, id: i64) -> Result<Option<String>, StoreError>;
     /// Every flight (for a restart's recovery), without its JSON parts.
     fn list_flights(&self, owner: &str) -> Result<Vec<FlightEntry>, StoreError>;
     /// Ends a flight; false when not found (or another token's).

@@ -182,6 +182,15 @@ impl FlightStore for SqliteFlights {
             .optional()?)
     }
 
+    fn owner_of(&self, id: i64) -> Result<Option<String>, StoreError> {
+        Ok(self
+            .conn()
+            .query_row("SELECT owner FROM flights WHERE id = ?1", [id], |r| {
+                r.get(0)
+            })
+            .optional()?)
+    }
+
     fn list_flights(&self, owner: &str) -> Result<Vec<FlightEntry>, StoreError> {
         let conn = self.conn();
         let mut st = conn.prepare(

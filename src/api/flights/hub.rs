@@ -177,6 +177,15 @@ impl FlightHub {
         Ok(Some(live.entry(id).or_insert(flight).clone()))
     }
 
+    /// The live flight `id` whoever owns it (feeds that name the flight
+    /// only: the MQTT topics); `None`: no such flight.
+    pub fn get_any(&self, id: i64) -> Result<Option<Arc<LiveFlight>>, StoreError> {
+        match self.store.owner_of(id)? {
+            Some(owner) => self.get(id, &owner),
+            None => Ok(None),
+        }
+    }
+
     fn load(&self, row: &FlightRow) -> Result<LiveState, StoreError> {
         let bad = |what: &str, e: serde_json::Error| {
             StoreError(format!("flight {}: stored {what}: {e}", row.id))

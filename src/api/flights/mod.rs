@@ -1,11 +1,13 @@
 //! Live flights over HTTP (SPEC §13, issue 33): the routes
-//! ([`handlers`], [`events`]), the flights of a server ([`hub`]) and their
+//! ([`handlers`], [`events`]), the flights of a server ([`hub`]), the MQTT
+//! feed ([`mqtt`]) and their
 //! part of the OpenAPI document ([`FlightsDoc`]). Wired into the router by
 //! [`routes`] and into the document by merging [`FlightsDoc`].
 
 pub mod events;
 pub mod handlers;
 pub mod hub;
+pub mod mqtt;
 
 use axum::Router;
 use axum::routing::{get, post};

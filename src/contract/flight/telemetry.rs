@@ -118,6 +118,23 @@ impl Format {
     }
 }
 
+impl Format {
+    /// From the content itself, for feeds without a content type (MQTT
+    /// payloads): JSON when it starts with `[` or `{`, NMEA when its first
+    /// line holds a `$` sentence, CSV otherwise.
+    pub fn sniff(payload: &[u8]) -> Self {
+        let text = String::from_utf8_lossy(payload);
+        let text = text.trim_start();
+        if text.starts_with('[') || text.starts_with('{') {
+            Self::Json
+        } else if text.lines().next().is_some_and(|l| l.contains('$')) {
+            Self::Nmea
+        } else {
+            Self::Csv
+        }
+    }
+}
+
 fn reject(line: usize, field: &str, reason: impl Into<String>) -> RejectedSampleOutput {
     RejectedSampleOutput {
         line,

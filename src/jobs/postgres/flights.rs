@@ -88,6 +88,15 @@ impl FlightStore for PgStore {
         })
     }
 
+    fn owner_of(&self, id: i64) -> Result<Option<String>, StoreError> {
+        self.with(|c| {
+            Ok(
+                c.query_opt("SELECT owner FROM flights WHERE id = $1", &[&id])?
+                    .map(|r| r.get(0)),
+            )
+        })
+    }
+
     fn list_flights(&self, owner: &str) -> Result<Vec<FlightEntry>, StoreError> {
         self.with(|c| {
             Ok(c.query(
