@@ -31,6 +31,11 @@
 //!   launch-windows panel: the day's timeline; a NO-GO hour turns the plan NO-GO.
 //! * `docs_page.mjs` runs every POST operation's "Try it out" in `/docs`
 //!   with the document's example (each must answer 2xx) under the CSP.
+//! * `live_page.mjs` starts a flight from the page and replays a log by
+//!   posting telemetry itself: the stoplight reads normal, caution, stop (the
+//!   flight's own thresholds), stays stop until Acknowledge, unavailable
+//!   after 2 s of silence; each sample held once; the re-plan; units in
+//!   knots and feet by exact factors kept in the URL; phone and print.
 //! * `panels_page.mjs` checks the page's panels as units: each panel's
 //!   system-card declaration gets exactly the paths it lists from the card's
 //!   reader; the frequency-response panel sweeps with `transient.js` absent;
@@ -243,4 +248,9 @@ fn windows_page_in_headless_chromium() {
 #[test]
 fn panels_page_in_headless_chromium() {
     run_page_script("panels_page.mjs");
+}
+
+#[test]
+fn live_page_in_headless_chromium() {
+    run_page_script("live_page.mjs");
 }

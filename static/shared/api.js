@@ -123,5 +123,5 @@ import shared from "./core.js";
     };
   }
 
-  Object.assign(shared, { api, unwrapJobError, needsJob, sleep, jobRunner, statusSetter });
+  Object.assign(shared, { api, apiToken: storedToken, unwrapJobError, needsJob, sleep, jobRunner, statusSetter });
 })(shared);
