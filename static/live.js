@@ -299,14 +299,16 @@ import { linePlot } from "./live_plot.js";
       ["Wind", S.speedText(s.wind_speed_m_s), s.wind_speed_m_s],
       ["Altitude", S.lengthText(s.aerostat_altitude_m, 1), s.aerostat_altitude_m],
     ] : [];
-    $("live-latest").replaceChildren(...rows.flatMap(([k, text, si]) => {
+    $("live-latest").replaceChildren(...rows.map(([k, text, si]) => {
+      const pair = document.createElement("div");
       const dt = document.createElement("dt");
       dt.textContent = k;
       const dd = document.createElement("dd");
       dd.textContent = text;
       dd.dataset.figure = k.toLowerCase();
       dd.dataset.si = si ?? "";
-      return [dt, dd];
+      pair.append(dt, dd);
+      return pair;
     }));
   }
 
@@ -332,7 +334,11 @@ import { linePlot } from "./live_plot.js";
       lines.push({ cls: "replan", points: st.replan.plan.schedule.map((p) => [t0 + p.time_s, L(p.length_m)]) });
     }
     lines.push({ cls: "flight", points: s.map((p) => [p.time_s, L(p.tether_length_m)]) });
-    linePlot($("live-corridor"), { lines, label: "Tether length against time: plan and flight", unit: S.units.length, height: 200, width });
+    // The plan around now: up to half as long again as flown (at least 60 s).
+    const last = s.at(-1)?.time_s ?? 0;
+    const xMax = Math.max(60, 1.5 * last, st.replan ? st.replan.from_s + 30 : 0);
+    $("live-plan-note").hidden = !!st.plan;
+    linePlot($("live-corridor"), { lines, label: "Tether length against time: plan and flight", unit: S.units.length, height: 200, width, xMax });
     const small = (id, pick, conv, unit, levels, label) =>
       linePlot($(id), { lines: [{ cls: "flight", points: s.map((p) => [p.time_s, conv(p[pick])]) }], levels, label, unit, width });
     small("live-rate", "winch_rate_m_s", L, `${S.units.length}/s`, [], "Winch rate against time");
@@ -374,7 +380,7 @@ import { linePlot } from "./live_plot.js";
     out.dataset.state = r.plan.go ? "go" : "no-go";
     const head = document.createElement("p");
     head.innerHTML = "<strong></strong> ";
-    head.firstChild.textContent = `Re-plan from ${r.from_s.toFixed(1)} s: ${r.mode === "haul_down" ? "HAUL DOWN" : "CONTINUE"}, ${r.plan.go ? "GO" : "NO-GO"}`;
+    head.firstChild.textContent = `Re-plan from ${r.from_s.toFixed(1)} s: ${r.mode === "haul_down" ? "HAUL DOWN" : "CONTINUE"}.`;
     head.append(r.reason);
     const figures = document.createElement("p");
     figures.textContent = `From ${S.lengthText(r.current_length_m, 1)}; measured wind ${S.speedText(r.measured_mean_wind_m_s)}, gust ${S.speedText(r.measured_gust_m_s)}; ` +
@@ -404,5 +410,5 @@ import { linePlot } from "./live_plot.js";
     showReplan();
   });
   listFlights();
-  Object.assign(st, { open, acknowledge, replan, listFlights });
+  Object.assign(st, { open, acknowledge, replanNow: replan, listFlights });
 })();

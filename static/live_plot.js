@@ -17,13 +17,14 @@ const round = (v) => (Math.abs(v) >= 100 ? v.toFixed(0) : Math.abs(v) >= 10 ? v.
 
 // `lines`: [{points: [[x, y], …], cls}]; `levels`: [{y, cls, label}];
 // `label`: what the plot shows (its aria-label); `unit`: of y; `width`: the
-// drawing's width (default the element's).
-export function linePlot(el, { lines, levels = [], label, unit, height = 150, width }) {
+// drawing's width (default the element's); `xMax`: points past it left out.
+export function linePlot(el, { lines, levels = [], label, unit, height = 150, width, xMax = Infinity }) {
   const w = Math.max(220, Math.floor(width || el.clientWidth || 320));
   const m = { l: 52, r: 8, t: 8, b: 20 };
   const xs = [];
   const ys = [];
-  for (const l of lines) for (const [x, y] of l.points) if (Number.isFinite(x) && Number.isFinite(y)) (xs.push(x), ys.push(y));
+  const shown = (x, y) => Number.isFinite(x) && Number.isFinite(y) && x <= xMax;
+  for (const l of lines) for (const [x, y] of l.points) if (shown(x, y)) (xs.push(x), ys.push(y));
   for (const l of levels) if (Number.isFinite(l.y)) ys.push(l.y);
   const svg = node("svg", { viewBox: `0 0 ${w} ${height}`, width: w, height, role: "img", "aria-label": label, class: "live-svg" });
   el.replaceChildren(svg);
@@ -52,7 +53,7 @@ export function linePlot(el, { lines, levels = [], label, unit, height = 150, wi
     svg.append(node("text", { x: w - m.r - 2, y: Y(l.y) - 3, "text-anchor": "end", class: `tick ${l.cls}` }, l.label));
   }
   for (const l of lines) {
-    const pts = l.points.filter(([x, y]) => Number.isFinite(x) && Number.isFinite(y));
+    const pts = l.points.filter(([x, y]) => shown(x, y));
     if (!pts.length) continue;
     const d = pts.map(([x, y], i) => `${i ? "L" : "M"}${X(x).toFixed(1)},${Y(y).toFixed(1)}`).join("");
     svg.append(node("path", { d, class: `line ${l.cls}`, "data-points": pts.length }));

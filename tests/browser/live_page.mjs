@@ -18,7 +18,8 @@
 // arrival numbers), also after a batch sent twice. Re-plan from now shows
 // GET /replan's mode and current length. Units: knots and feet in the header
 // change the shown figures by exactly 1852/3600 and 0.3048, the URL keeps
-// them (`speed=kn&length=ft`) across a reload. Phone (390×844): no
+// them (`speed=kn&length=ft`) across a reload; the plan's verdict follows
+// them too. Phone (390×844): no
 // horizontal scrolling, the stoplight inside the first screen of the panel.
 // Print: the panel alone. Screenshots: tests/artifacts/live_page*.png.
 
@@ -74,6 +75,8 @@ try {
   const response = await page.goto(url, { waitUntil: "load" });
   check(response && response.ok(), `GET / → ${response?.status()}`);
   await page.fill('[name="cable.breaking_strength_n"]', "20000");
+  await page.click("#plan-button");
+  await page.waitForFunction(() => ["go", "no-go"].includes(document.querySelector("#verdict").dataset.state), null, { timeout: 60_000 });
 
   phase = "start";
   await page.fill("#live-flight-name", "browser replay");
@@ -82,24 +85,21 @@ try {
   const { id, plan } = await page.evaluate(() => ({ id: window.tetherplanLive.id, plan: window.tetherplanLive.plan }));
   const flight = (await api("GET", `api/v1/flights/${id}`)).body;
   check(flight.name === "browser replay" && flight.limits.stale_after_s === 2, `the flight is the page's (“${flight.name}”, no data after ${flight.limits.stale_after_s} s)`);
-  const tension = flight.checks.find((c) => c.name === "tension");
-  const caution = tension?.caution_at;
-  const stop = tension?.stop_at;
-  check(Math.abs(stop - 20000 / 5) < 1e-9 && Math.abs(caution - 0.8 * stop) < 1e-9,
-    `tension thresholds from the flight: caution ${caution} N = 0.8 × stop ${stop} N = 20 000 N / 5`);
-  check(plan && plan.t.length > 1, `the committed schedule kept for the corridor (${plan?.t.length} samples)`);
   let seen = await lightReads(page, "unavailable");
   check(seen.state === "unavailable" && flight.state === "unavailable", `before any sample: page “${seen.word}”, API ${flight.state}`);
 
-  // The log: 10 Hz from t, half the schedule's length (behind it), its rate.
+  // The log: 10 Hz from t, the schedule flown at a quarter of its pace
+  // (length L(t/4), rate L'(t/4)/4: behind the plan, well inside the payout
+  // ceiling).
+  const K = 0.25;
   let t = 0;
   let lastPost = 0;
   const sent = [];
   async function replay(seconds, tensionN) {
     const samples = [];
     for (let k = 0; k < Math.round(seconds * 10); k++, t = Math.round(t * 10 + 1) / 10) {
-      const length = 0.5 * interp(plan.t, plan.length, t);
-      const rate = (0.5 * interp(plan.t, plan.length, t + 0.1) - length) / 0.1;
+      const length = interp(plan.t, plan.length, K * t);
+      const rate = (interp(plan.t, plan.length, K * (t + 0.1)) - length) / 0.1;
       samples.push({ time_s: t, tether_length_m: length, winch_rate_m_s: rate, winch_tension_n: tensionN, wind_speed_m_s: 4 + 0.5 * Math.sin(t), aerostat_altitude_m: 0.95 * length });
     }
     sent.push(samples);
@@ -115,6 +115,15 @@ try {
     check(seen.state === expect && answer.state === expect,
       `${what}: ${tensionN.toFixed(0)} N for ${seconds} s → page “${seen.word}” (${seen.why}), API ${answer.state}`);
   }
+  // The first sample pulls the net buoyancy; the thresholds are then known.
+  await replay(0.1, flight.limits.net_buoyancy_n);
+  const judged = (await api("GET", `api/v1/flights/${id}`)).body;
+  const tension = judged.checks.find((c) => c.name === "tension");
+  let caution = tension?.caution_at;
+  let stop = tension?.stop_at;
+  check(Math.abs(stop - 20000 / 5) < 1e-9 && Math.abs(caution - 0.8 * stop) < 1e-9,
+    `tension thresholds from the flight: caution ${caution} N = 0.8 × stop ${stop} N = 20 000 N / 5`);
+  check(plan && plan.t.length > 1, `the committed schedule kept for the corridor (${plan?.t.length} samples)`);
   await step("normal", 3, 0.5 * caution, "normal");
   await step("caution", 2, 0.5 * (caution + stop), "caution");
   await page.locator("#live").screenshot({ path: path.join(artifacts, "live_page_caution.png") });
@@ -149,7 +158,7 @@ try {
   await page.waitForTimeout(300);
   const stored = (await api("GET", `api/v1/flights/${id}`)).body.samples_received;
   const held = await page.evaluate(() => ({ n: window.tetherplanLive.samples.length, distinct: new Set(window.tetherplanLive.samples.map((s) => s.seq)).size }));
-  const total = sent.slice(0, -1).reduce((n, b) => n + b.length, 0);
+  const total = sent.reduce((n, b) => n + b.length, 0);
   check(again.body.duplicates === sent.at(-1).length && held.n === stored && held.distinct === held.n && stored === total,
     `each sample once: sent ${total} (+1 batch again: ${again.body.duplicates} duplicates), stored ${stored}, on the page ${held.n} (${held.distinct} distinct)`);
   const traced = await page.$eval("#live-corridor path.flight", (p) => Number(p.dataset.points));
@@ -168,8 +177,20 @@ try {
   const figures = () => page.$$eval("#live-latest dd", (dds) => Object.fromEntries(dds.map((d) => [d.dataset.figure, { text: d.textContent, si: Number(d.dataset.si) }])));
   let f = await figures();
   check(f.tether.text === `${f.tether.si.toFixed(1)} m` && f.wind.text === `${f.wind.si.toFixed(1)} m/s`, `in SI: tether ${f.tether.text}, wind ${f.wind.text}`);
+  // The plan's verdict too: the tether needed and the wind in its headline.
+  const verdict = () => page.evaluate(() => ({
+    needed: document.querySelector('#verdict dd[data-figure="Tether needed"]').firstChild.textContent,
+    why: document.querySelector("#verdict .why").textContent,
+    lengthSi: window.tetherplanPlan.plan.wind.target_length_m,
+    windSi: window.tetherplanPlan.request.wind.flow.speed_m_s,
+  }));
+  let v = await verdict();
+  check(v.needed === `${v.lengthSi.toFixed(1)} m` && v.why.includes(`${v.windSi.toFixed(1)} m/s wind`), `the verdict in SI: tether needed ${v.needed}, “${v.why.slice(0, 70)}…”`);
   await page.selectOption("#units-speed", "kn");
   await page.selectOption("#units-length", "ft");
+  v = await verdict();
+  check(v.needed === `${(v.lengthSi / FOOT).toFixed(1)} ft` && v.why.includes(`${(v.windSi / KNOT).toFixed(1)} kn wind`),
+    `the verdict in knots and feet: tether needed ${v.lengthSi.toFixed(3)} m shown “${v.needed}”, wind ${v.windSi} m/s shown “${(v.windSi / KNOT).toFixed(1)} kn” (“${v.why.slice(0, 70)}…”)`);
   const inKnotsFeet = async (when) => {
     f = await figures();
     const ft = (f.tether.si / FOOT).toFixed(1);
