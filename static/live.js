@@ -153,12 +153,14 @@ import { linePlot } from "./live_plot.js";
   }
 
   // The stream read with fetch (a server with tokens): reconnects after 1 s
-  // from the last samples event's id, as EventSource does.
+  // from the last samples event's id, as EventSource does. `drop()` ends
+  // the current connection (as a network drop would); the loop reconnects.
   function fetchStream(path, token) {
-    const abort = new AbortController();
     let stopped = false;
+    let abort = null;
     (async () => {
       while (!stopped) {
+        abort = new AbortController();
         try {
           const headers = { accept: "text/event-stream", authorization: `Bearer ${token}` };
           if (st.lastSeq > 0) headers["last-event-id"] = String(st.lastSeq);
@@ -179,10 +181,11 @@ import { linePlot } from "./live_plot.js";
         } catch {
           if (stopped) return;
         }
+        st.reconnects = (st.reconnects || 0) + 1;
         await S.sleep(1000);
       }
     })();
-    return { close: () => ((stopped = true), abort.abort()), kind: "fetch" };
+    return { close: () => ((stopped = true), abort?.abort()), drop: () => abort?.abort(), kind: "fetch" };
   }
   function dispatch(block) {
     let event = "message";
