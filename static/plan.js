@@ -165,6 +165,15 @@ import S from "./shared/index.js";
   }
 
   // One plain line: why GO or NO-GO, naming what decides it. Jargon stays in the details.
+  // The verdict, its tension and deadline lines and key figures, in the page's units.
+  function showVerdict(r, req) {
+    setVerdict(r.go ? "go" : "no-go", r.go ? "GO" : "NO-GO", headline(r, req));
+    tensionLine(r, req);
+    deadlineLine(r, req);
+    keyFigures(r, req);
+  }
+  document.addEventListener("tetherplan:units", () => state.current && state.plan && state.request && showVerdict(state.plan, state.request));
+
   function headline(r, req) {
     const H = req.target_elevation_m;
     const U = req.wind?.flow?.speed_m_s;
@@ -172,20 +181,20 @@ import S from "./shared/index.js";
     if (r.go) {
       const L = w?.target_length_m;
       const angle = w?.blowdown_angle_deg;
-      const blown = angle != null && angle > 0.05 ? `, blown ${fmt(angle, 1)}° off vertical by the ${fmt(U, 1)} m/s wind` : "";
-      return `${r.direction === "retrieval" ? "Haul down" : "Deploy"} to ${fmt(H, 0)} m: pay out ${fmt(L ?? H, 0)} m of tether${blown}; ${duration(r.duration_s)} at the winch.`;
+      const blown = angle != null && angle > 0.05 ? `, blown ${fmt(angle, 1)}° off vertical by the ${S.speedText(U, 1)} wind` : "";
+      return `${r.direction === "retrieval" ? "Haul down" : "Deploy"} to ${S.lengthText(H, 0)}: pay out ${S.lengthText(L ?? H, 0)} of tether${blown}; ${duration(r.duration_s)} at the winch.`;
     }
     switch (r.binding_limit) {
       case "wind_blowdown":
-        return `The ${fmt(U, 1)} m/s wind blows the aerostat down: it reaches at most ${fmt(w?.reachable_altitude_m, 0)} m, short of ${fmt(H, 0)} m.`;
+        return `The ${S.speedText(U, 1)} wind blows the aerostat down: it reaches at most ${S.lengthText(w?.reachable_altitude_m, 0)}, short of ${S.lengthText(H, 0)}.`;
       case "static_lift_limit":
-        return `Not enough lift: ${fmt(H, 0)} m is above the highest altitude the lift holds with its reserve (${fmt(r.limits?.lift_limit_m, 0)} m).`;
+        return `Not enough lift: ${S.lengthText(H, 0)} is above the highest altitude the lift holds with its reserve (${S.lengthText(r.limits?.lift_limit_m, 0)}).`;
       case "tension_limit":
         return "The tether would be overloaded: its tension exceeds the breaking strength divided by the safety factor.";
       case "gust_tension_limit":
-        return `The gust of ${fmt(w?.gust?.reference_speed_m_s, 1)} m/s would overload the tether: ${fmt(r.limits?.gust_peak_tension_n, 0)} N in the gust, above the breaking strength divided by the safety factor (${fmt(r.limits?.allowable_tension_n, 0)} N).`;
+        return `The gust of ${S.speedText(w?.gust?.reference_speed_m_s, 1)} would overload the tether: ${fmt(r.limits?.gust_peak_tension_n, 0)} N in the gust, above the breaking strength divided by the safety factor (${fmt(r.limits?.allowable_tension_n, 0)} N).`;
       case "min_altitude":
-        return `${w?.gust ? `The gust of ${fmt(w.gust.reference_speed_m_s, 1)} m/s blows` : "The wind blows"} the aerostat down to ${fmt(w?.gust?.target_altitude_m ?? req.target_elevation_m, 0)} m, below the lowest altitude allowed (${fmt(req.min_altitude_m, 0)} m).`;
+        return `${w?.gust ? `The gust of ${S.speedText(w.gust.reference_speed_m_s, 1)} blows` : "The wind blows"} the aerostat down to ${S.lengthText(w?.gust?.target_altitude_m ?? req.target_elevation_m, 0)}, below the lowest altitude allowed (${S.lengthText(req.min_altitude_m, 0)}).`;
       case "amplification_limit":
         return "Hauling in lets a swing of the tether grow beyond the limit, even at the slowest rate.";
       case "jerk_limit":
@@ -197,7 +206,7 @@ import S from "./shared/index.js";
         break;
     }
     if (r.feasible && r.haul_down && !r.haul_down.go) {
-      return `The forecast wind passes ${fmt(req.haul_down.max_operating_wind_m_s, 1)} m/s before the aerostat could be brought down.`;
+      return `The forecast wind passes ${S.speedText(req.haul_down.max_operating_wind_m_s, 1)} before the aerostat could be brought down.`;
     }
     return String(r.reason || "").replace(/^no-go:\s*/, "");
   }
@@ -226,9 +235,9 @@ import S from "./shared/index.js";
     } else if (!h) {
       el.textContent = "Haul-down deadline: not worked out (no schedule).";
     } else if (h.wind_exceeds_limit_at_s == null) {
-      el.textContent = `Haul-down deadline: none — the forecast stays below ${fmt(req.haul_down.max_operating_wind_m_s, 1)} m/s.`;
+      el.textContent = `Haul-down deadline: none — the forecast stays below ${S.speedText(req.haul_down.max_operating_wind_m_s, 1)}.`;
     } else if (h.latest_start_s != null && h.latest_start_s >= 0) {
-      const what = h.exceeded_by === "gust" ? `the gust passes ${fmt(req.haul_down.max_gust_m_s, 1)} m/s` : `the wind passes ${fmt(req.haul_down.max_operating_wind_m_s, 1)} m/s`;
+      const what = h.exceeded_by === "gust" ? `the gust passes ${S.speedText(req.haul_down.max_gust_m_s, 1)}` : `the wind passes ${S.speedText(req.haul_down.max_operating_wind_m_s, 1)}`;
       el.textContent = `Haul-down deadline: start hauling down by ${clock(h.latest_start_s)} (in ${duration(h.latest_start_s)}); ${what} at ${clock(h.wind_exceeds_limit_at_s)}.`;
     } else {
       el.textContent = `Haul-down deadline: already passed — ${h.reason}`;
@@ -245,10 +254,10 @@ import S from "./shared/index.js";
     const sf = lim.min_safety_factor_nondim;
     const deg = (x) => (x == null ? "–" : `${fmt(x, 1)}°`);
     const rows = [
-      ["Tether needed", w ? (w.target_length_m == null ? `out of reach (at most ${fmt(w.reachable_altitude_m, 0)} m up)` : `${fmt(w.target_length_m, 1)} m`) : `${fmt(req.target_elevation_m, 1)} m`],
-      ["Altitude in the gust", g ? (g.target_altitude_m == null ? "–" : `${fmt(g.target_altitude_m, 0)} m`) : null],
+      ["Tether needed", w ? (w.target_length_m == null ? `out of reach (at most ${S.lengthText(w.reachable_altitude_m, 0)} up)` : `${S.lengthText(w.target_length_m, 1)}`) : `${S.lengthText(req.target_elevation_m, 1)}`],
+      ["Altitude in the gust", g ? (g.target_altitude_m == null ? "–" : `${S.lengthText(g.target_altitude_m, 0)}`) : null],
       ["Blow-down angle", w?.blowdown_angle_deg == null ? "–" : deg(w.blowdown_angle_deg), g && deg(g.blowdown_angle_deg)],
-      ["Downwind of the winch", w?.target_downwind_m == null ? null : `${fmt(w.target_downwind_m, 0)} m`, g?.target_downwind_m == null ? null : `${fmt(g.target_downwind_m, 0)} m`],
+      ["Downwind of the winch", w?.target_downwind_m == null ? null : `${S.lengthText(w.target_downwind_m, 0)}`, g?.target_downwind_m == null ? null : `${S.lengthText(g.target_downwind_m, 0)}`],
       ["Peak tension", lim.peak_tension_n == null ? "–" : `${fmt(lim.peak_tension_n, 0)} N`, g && lim.gust_peak_tension_n != null ? `${fmt(lim.gust_peak_tension_n, 0)} N` : null],
       ["Safety factor", sf == null ? "not checked" : fmt(sf, 1), g && lim.gust_min_safety_factor_nondim != null ? fmt(lim.gust_min_safety_factor_nondim, 1) : null],
       ["Time at the winch", duration(r.duration_s)],
@@ -270,7 +279,7 @@ import S from "./shared/index.js";
       div.append(dt, dd);
       return div;
     }));
-    if (g) dl.dataset.gust = `${fmt(g.reference_speed_m_s, 1)} m/s`;
+    if (g) dl.dataset.gust = `${S.speedText(g.reference_speed_m_s, 1)}`;
     else delete dl.dataset.gust;
     dl.hidden = false;
   }
@@ -457,10 +466,7 @@ import S from "./shared/index.js";
       summary.textContent = `${b.valid_samples} samples: P(unstable somewhere) ${pc(b.probability_unstable)}; ` +
         `P(below the lift reserve) ${pc(b.probability_below_reserve)}; P(over the rating) ${pc(b.probability_over_rating)}.`;
     }
-    setVerdict(r.go ? "go" : "no-go", r.go ? "GO" : "NO-GO", headline(r, body));
-    tensionLine(r, body);
-    deadlineLine(r, body);
-    keyFigures(r, body);
+    showVerdict(r, body);
     figures(r);
     fillInputs();
     const has = r.schedule.length > 0;

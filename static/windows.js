@@ -6,9 +6,9 @@
 // day's timeline: one cell per forecast period coloured by its verdict
 // (data-verdict go | no-go), its bar as high as the reachable altitude, the
 // launch windows marked beneath. Choosing a cell sets the plan's wind to that
-// period's §9 wind (the fitted flow and gust) and plans again. Speeds are
-// shown in m/s, knots or km/h and heights in metres or feet, chosen in the
-// panel and kept in the URL (`units_speed`, `units_length`); the API stays SI.
+// period's §9 wind (the fitted flow and gust) and plans again. Speeds and
+// heights are shown in the page's units (shared/units.js: chosen in the
+// header, kept in the URL as `speed` and `length`); the API stays SI.
 "use strict";
 
 import S from "./shared/index.js";
@@ -28,16 +28,9 @@ import S from "./shared/index.js";
   ]);
   const plan = document.getElementById("plan");
   if (!S || !plan) return;
-  const KNOT = 1852 / 3600;
-  const SPEED = { "m/s": 1, kn: KNOT, "km/h": 1 / 3.6 };
-  const LENGTH = { m: 1, ft: 0.3048 };
-  const params = new URLSearchParams(window.location.search);
-  const units = {
-    speed: SPEED[params.get("units_speed")] ? params.get("units_speed") : "m/s",
-    length: LENGTH[params.get("units_length")] ? params.get("units_length") : "m",
-  };
-  const sp = (v) => (v == null ? "–" : `${(v / SPEED[units.speed]).toFixed(1)} ${units.speed}`);
-  const len = (v) => (v == null ? "–" : `${Math.round(v / LENGTH[units.length])} ${units.length}`);
+  // The page's units (shared/units.js, chosen in the header); the API stays SI.
+  const sp = (v) => S.speedText(v, 1);
+  const len = (v) => S.lengthText(v, 0);
 
   const section = document.createElement("section");
   section.id = "windows";
@@ -53,10 +46,6 @@ import S from "./shared/index.js";
     <div class="field"><label for="windows-operation">Time aloft (h)</label><input id="windows-operation" inputmode="decimal" value="1"></div>
     <div class="field"><label for="windows-limit">Highest wind at the aerostat (m/s, blank: the plan's limits only)</label>
       <input id="windows-limit" inputmode="decimal" value=""></div>
-    <div class="field"><label for="units-speed">Speeds in</label><select id="units-speed">
-      ${Object.keys(SPEED).map((u) => `<option${u === units.speed ? " selected" : ""}>${u}</option>`).join("")}</select></div>
-    <div class="field"><label for="units-length">Heights in</label><select id="units-length">
-      ${Object.keys(LENGTH).map((u) => `<option${u === units.length ? " selected" : ""}>${u}</option>`).join("")}</select></div>
     <div class="actions"><button type="submit" id="windows-button">Show the day</button></div>
     <p id="windows-error" class="error" role="alert" hidden></p>
   </form>
@@ -82,17 +71,7 @@ import S from "./shared/index.js";
     return "csv";
   }
 
-  function keepUnits() {
-    units.speed = $("units-speed").value;
-    units.length = $("units-length").value;
-    const p = new URLSearchParams(window.location.search);
-    p.set("units_speed", units.speed);
-    p.set("units_length", units.length);
-    history.replaceState(null, "", `${window.location.pathname}?${p.toString()}${window.location.hash}`);
-    if (last) draw(last);
-  }
-  $("units-speed").addEventListener("change", keepUnits);
-  $("units-length").addEventListener("change", keepUnits);
+  document.addEventListener("tetherplan:units", () => last && draw(last));
 
   let last = null;
   async function run() {

@@ -31,6 +31,15 @@
 //!   launch-windows panel: the day's timeline; a NO-GO hour turns the plan NO-GO.
 //! * `docs_page.mjs` runs every POST operation's "Try it out" in `/docs`
 //!   with the document's example (each must answer 2xx) under the CSP.
+//! * `live_page.mjs` starts a flight from the page and replays a log by
+//!   posting telemetry itself: the stoplight reads normal, caution, stop (the
+//!   flight's own thresholds), stays stop until Acknowledge, unavailable
+//!   after 2 s of silence; each sample held once; the re-plan; units in
+//!   knots and feet by exact factors kept in the URL; phone and print.
+//! * `live_token_page.mjs` runs the live panel on a server with API tokens
+//!   (`TETHERPLAN_API_TOKENS`): the page asks for the token once, the events
+//!   are read with fetch (EventSource cannot send it), a dropped stream
+//!   reconnects with Last-Event-ID without a sample twice.
 //! * `panels_page.mjs` checks the page's panels as units: each panel's
 //!   system-card declaration gets exactly the paths it lists from the card's
 //!   reader; the frequency-response panel sweeps with `transient.js` absent;
@@ -116,7 +125,7 @@ fn healthy(port: u16) -> bool {
     response.starts_with("HTTP/1.1 200")
 }
 
-fn start_server(label: &str) -> (Server, String) {
+fn start_server(label: &str, envs: &[(&str, &str)]) -> (Server, String) {
     let stamp = SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .map(|d| d.as_nanos())
@@ -135,6 +144,7 @@ fn start_server(label: &str) -> (Server, String) {
         .arg(dir.join("jobs.db"))
         .arg("--static-dir")
         .arg(repo().join("static"))
+        .envs(envs.iter().copied())
         .stdout(log.try_clone().expect("log handle"))
         .stderr(log)
         .spawn()
@@ -168,6 +178,11 @@ static ONE_BROWSER_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 /// Runs `tests/browser/<script>` against a fresh server; skips (or, with
 /// `CI` set, fails) when a prerequisite is missing.
 fn run_page_script(script: &str) {
+    run_page_script_with(script, &[]);
+}
+
+/// The same with environment variables for the server and the script.
+fn run_page_script_with(script: &str, envs: &[(&str, &str)]) {
     let _turn = ONE_BROWSER_AT_A_TIME
         .lock()
         .unwrap_or_else(|e| e.into_inner());
@@ -185,11 +200,12 @@ fn run_page_script(script: &str) {
         );
         return;
     }
-    let (server, url) = start_server(script.trim_end_matches(".mjs"));
+    let (server, url) = start_server(script.trim_end_matches(".mjs"), envs);
     let status = Command::new("node")
         .arg(repo().join("tests/browser").join(script))
         .arg(&url)
         .env("CHROMIUM", &chromium)
+        .envs(envs.iter().copied())
         .stdin(Stdio::null())
         .status()
         .expect("run node");
@@ -243,4 +259,17 @@ fn windows_page_in_headless_chromium() {
 #[test]
 fn panels_page_in_headless_chromium() {
     run_page_script("panels_page.mjs");
+}
+
+#[test]
+fn live_page_in_headless_chromium() {
+    run_page_script("live_page.mjs");
+}
+
+#[test]
+fn live_page_with_api_tokens_in_headless_chromium() {
+    run_page_script_with(
+        "live_token_page.mjs",
+        &[("TETHERPLAN_API_TOKENS", "browser-test-token")],
+    );
 }

@@ -27,6 +27,9 @@ import shared from "./core.js";
       if (token) headers.authorization = `Bearer ${token}`;
       res = await fetch(path, { method, headers, body: body === undefined ? undefined : JSON.stringify(body) });
       if (res.status === 401 && !retried) {
+        // Another request was answered 401 too and its prompt got the token meanwhile.
+        const meanwhile = storedToken();
+        if (meanwhile && meanwhile !== token) return api(method, path, body, true);
         const entered = window.prompt(token ? "The API token was refused. API token:" : "This server needs an API token:");
         if (entered && entered.trim()) {
           try {
@@ -123,5 +126,5 @@ import shared from "./core.js";
     };
   }
 
-  Object.assign(shared, { api, unwrapJobError, needsJob, sleep, jobRunner, statusSetter });
+  Object.assign(shared, { api, apiToken: storedToken, unwrapJobError, needsJob, sleep, jobRunner, statusSetter });
 })(shared);

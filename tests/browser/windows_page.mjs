@@ -7,7 +7,7 @@
 // day's timeline shows its 24 hours, coloured by verdict, with GO and NO-GO
 // hours; choosing a NO-GO hour sets the plan's wind to that hour's (the
 // fitted power law) and the plan's verdict turns NO-GO; choosing a GO hour
-// turns it GO. Units chosen in the panel go to the URL. Screenshot:
+// turns it GO. The page's units (the header's) reach the timeline and the URL. Screenshot:
 // tests/artifacts/windows_page.png.
 
 import { readFileSync } from "node:fs";
@@ -64,7 +64,7 @@ try {
   await page.selectOption("#units-speed", "kn");
   await page.selectOption("#units-length", "ft");
   const q = new URL(page.url()).searchParams;
-  check(q.get("units_speed") === "kn" && q.get("units_length") === "ft", `units kept in the URL (${page.url()})`);
+  check(q.get("speed") === "kn" && q.get("length") === "ft", `the page's units kept in the URL (${page.url()})`);
   const title = await page.getAttribute(`#windows-timeline button[data-index="${go}"]`, "title");
   check(/ kn/.test(title) && / ft/.test(title), `the timeline speaks knots and feet (“${title.split("\n")[0]}”)`);
   await context.close();
