@@ -71,6 +71,22 @@ pub struct ServeArgs {
     pub jobs: JobArgs,
     #[command(flatten)]
     pub mqtt: MqttArgs,
+    #[command(flatten)]
+    pub forecast: ForecastArgs,
+}
+
+/// Where `GET /api/v1/forecast` fetches today's forecast (off by default:
+/// the server may have no network).
+#[derive(Clone, Debug, Default, clap::Args)]
+pub struct ForecastArgs {
+    /// URL of a forecast to fetch on request (`http://` or `https://`), e.g.
+    /// an Open-Meteo hourly forecast for the site:
+    /// `https://api.open-meteo.com/v1/forecast?latitude=…&longitude=…&hourly=wind_speed_10m,wind_speed_80m,wind_speed_120m,wind_speed_180m,wind_gusts_10m&wind_speed_unit=ms`.
+    #[arg(long, env = "TETHERPLAN_FORECAST_URL")]
+    pub forecast_url: Option<String>,
+    /// The format of what that URL answers: `open_meteo`, `metar`, `taf` or `csv`.
+    #[arg(long, env = "TETHERPLAN_FORECAST_FORMAT", default_value = "open_meteo")]
+    pub forecast_format: String,
 }
 
 /// The MQTT telemetry feed (`tetherplan serve`; off without `--mqtt-url`).
@@ -97,6 +113,46 @@ pub struct MqttArgs {
         default_value = "tetherplan-server"
     )]
     pub mqtt_client_id: String,
+}
+
+/// The forecast source, when configured.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ForecastSource {
+    pub url: String,
+    pub format: crate::contract::windows::dto::ForecastFormat,
+}
+
+impl ForecastArgs {
+    /// The source, `None` without a URL; an unusable URL or format is an
+    /// error in plain words.
+    pub fn settings(&self) -> Result<Option<ForecastSource>, String> {
+        let Some(url) = self
+            .forecast_url
+            .as_deref()
+            .map(str::trim)
+            .filter(|u| !u.is_empty())
+        else {
+            return Ok(None);
+        };
+        if !(url.starts_with("http://") || url.starts_with("https://")) {
+            return Err(format!(
+                "--forecast-url `{url}`: must start with http:// or https://"
+            ));
+        }
+        let format = serde_json::from_value(serde_json::Value::String(
+            self.forecast_format.trim().to_string(),
+        ))
+        .map_err(|_| {
+            format!(
+                "--forecast-format `{}`: must be open_meteo, metar, taf or csv",
+                self.forecast_format
+            )
+        })?;
+        Ok(Some(ForecastSource {
+            url: url.to_string(),
+            format,
+        }))
+    }
 }
 
 /// The MQTT feed's settings, when on.
@@ -249,6 +305,8 @@ pub struct Config {
     pub api_tokens: Vec<String>,
     /// The MQTT telemetry feed, as given (checked when the server starts).
     pub mqtt: MqttArgs,
+    /// The forecast source, as given (checked when the server starts).
+    pub forecast: ForecastArgs,
 }
 
 impl From<ServeArgs> for Config {
@@ -287,6 +345,7 @@ impl From<ServeArgs> for Config {
             },
             allowed_hosts: a.allowed_hosts,
             mqtt: a.mqtt,
+            forecast: a.forecast,
         }
     }
 }

@@ -46,7 +46,9 @@ import S from "./shared/index.js";
     <div class="field"><label for="windows-operation">Time aloft (h)</label><input id="windows-operation" inputmode="decimal" value="1"></div>
     <div class="field"><label for="windows-limit">Highest wind at the aerostat (m/s, blank: the plan's limits only)</label>
       <input id="windows-limit" inputmode="decimal" value=""></div>
-    <div class="actions"><button type="submit" id="windows-button">Show the day</button></div>
+    <div class="actions"><button type="submit" id="windows-button">Show the day</button>
+      <button type="button" id="windows-fetch" class="secondary" hidden>Fetch today's forecast</button></div>
+    <p id="windows-source" class="note" hidden></p>
     <p id="windows-error" class="error" role="alert" hidden></p>
   </form>
   <div id="windows-job" class="job" hidden>
@@ -214,6 +216,30 @@ import S from "./shared/index.js";
     e.preventDefault();
     const f = e.dataTransfer?.files?.[0];
     if (f) readFile(f);
+  });
+  // A server given a forecast source (--forecast-url) fetches it on request.
+  async function fetchForecast() {
+    const err = $("windows-error");
+    err.hidden = true;
+    $("windows-fetch").disabled = true;
+    const res = await S.api("GET", "api/v1/forecast");
+    $("windows-fetch").disabled = false;
+    if (!res.ok) {
+      err.textContent = res.body?.error ? res.body.error.message : `error ${res.status}`;
+      err.hidden = false;
+      return;
+    }
+    const f = res.body.forecast;
+    $("windows-data").value = typeof f.data === "string" ? f.data : JSON.stringify(f.data, null, 1);
+    const when = new Date(1000 * res.body.fetched_at_unix_s).toLocaleTimeString();
+    $("windows-source").textContent = `Fetched at ${when} from ${res.body.source_url}: ${res.body.period_count} periods` +
+      (res.body.member_count > 1 ? `, ${res.body.member_count} members` : "") + ".";
+    $("windows-source").hidden = false;
+    run();
+  }
+  $("windows-fetch").addEventListener("click", fetchForecast);
+  S.api("GET", "healthz").then((res) => {
+    if (res.ok && res.body.forecast_source) $("windows-fetch").hidden = false;
   });
   $("windows-form").addEventListener("submit", (e) => {
     e.preventDefault();

@@ -246,6 +246,12 @@ fn every_route_is_documented_with_its_statuses() {
             ],
         ),
         ("get", "/api/v1/presets", "list_presets", &["200", "401"]),
+        (
+            "get",
+            "/api/v1/forecast",
+            "get_forecast",
+            &["200", "401", "404", "502"],
+        ),
         ("get", "/healthz", "get_health", &["200"]),
         ("get", "/openapi.json", "get_openapi", &["200"]),
     ];

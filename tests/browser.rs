@@ -31,6 +31,9 @@
 //!   launch-windows panel: the day's timeline; a NO-GO hour turns the plan NO-GO.
 //! * `docs_page.mjs` runs every POST operation's "Try it out" in `/docs`
 //!   with the document's example (each must answer 2xx) under the CSP.
+//! * `windows_fetch_page.mjs` runs on a server given `--forecast-url` (the
+//!   recorded Open-Meteo file served by a thread here): "Fetch today's
+//!   forecast" fills the file's JSON and shows its day.
 //! * `live_page.mjs` starts a flight from the page and replays a log by
 //!   posting telemetry itself: the stoplight reads normal, caution, stop (the
 //!   flight's own thresholds), stays stop until Acknowledge, unavailable
@@ -56,6 +59,8 @@ use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+mod common;
 
 /// The server process, killed when the test ends (also on panic).
 struct Server {
@@ -259,6 +264,15 @@ fn windows_page_in_headless_chromium() {
 #[test]
 fn panels_page_in_headless_chromium() {
     run_page_script("panels_page.mjs");
+}
+
+#[test]
+fn windows_fetched_forecast_in_headless_chromium() {
+    let source = common::http::serve_recorded_forecast();
+    run_page_script_with(
+        "windows_fetch_page.mjs",
+        &[("TETHERPLAN_FORECAST_URL", source.as_str())],
+    );
 }
 
 #[test]

@@ -19,7 +19,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 mod common;
-use common::http::spawn_listening;
+use common::http::{serve_recorded_forecast, spawn_listening};
 
 fn schemathesis() -> Option<PathBuf> {
     if let Ok(p) = std::env::var("TETHERPLAN_SCHEMATHESIS") {
@@ -45,9 +45,19 @@ fn schemathesis_finds_no_server_error_and_no_schema_violation() {
     let dir = std::env::temp_dir().join(format!("tetherplan-st-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
+    // The forecast source (`GET /api/v1/forecast`): the recorded
+    // Open-Meteo file, served on loopback.
+    let forecast_url = serve_recorded_forecast();
     let (mut server, addr) = spawn_listening(
         Command::new(env!("CARGO_BIN_EXE_tetherplan"))
-            .args(["serve", "--addr", "127.0.0.1:0", "--db"])
+            .args([
+                "serve",
+                "--addr",
+                "127.0.0.1:0",
+                "--forecast-url",
+                &forecast_url,
+                "--db",
+            ])
             .arg(dir.join("jobs.db"))
             .current_dir(&dir)
             .env("RUST_LOG", "error")

@@ -21,6 +21,9 @@ pub struct Health {
     /// answer within a second.
     #[schema(minimum = 0)]
     pub live_workers: Option<usize>,
+    /// Whether `GET /api/v1/forecast` fetches a forecast (the server was
+    /// given `--forecast-url`).
+    pub forecast_source: bool,
 }
 
 /// Liveness, the job store and its live workers (the solver is not touched;
@@ -44,6 +47,7 @@ pub async fn get_health(axum::extract::State(app): axum::extract::State<AppState
         version: env!("CARGO_PKG_VERSION").into(),
         store: app.queue.store.store_kind().into(),
         live_workers,
+        forecast_source: app.forecast.is_some(),
     };
     (
         [(header::CONTENT_TYPE, "application/json")],

@@ -15,6 +15,7 @@ pub mod auth_doc;
 pub mod body;
 pub mod error;
 pub mod flights;
+pub mod forecast;
 pub mod guard;
 pub mod health;
 pub mod jobs;
@@ -78,6 +79,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
                 .delete(systems::delete_system),
         )
         .route("/api/v1/presets", get(systems::list_presets))
+        .route("/api/v1/forecast", get(forecast::get_forecast))
         .route("/api/v1/jobs", post(jobs::create_job).get(jobs::list_jobs))
         .route(
             "/api/v1/jobs/{id}",
@@ -108,6 +110,7 @@ pub fn app(state: AppState, static_dir: Option<&Path>) -> Router {
 /// running job back in the queue.
 pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
     let mqtt = config.mqtt.settings()?;
+    let forecast_source = config.forecast.settings()?;
     let store = config
         .store
         .open()
@@ -127,7 +130,8 @@ pub async fn serve(config: Config) -> Result<(), Box<dyn std::error::Error>> {
     })?;
     let state = AppState::new(queue.clone())
         .with_tokens(&config.api_tokens)
-        .with_flights(flights);
+        .with_flights(flights)
+        .with_forecast_source(forecast_source);
     if let Some(settings) = mqtt {
         flights::mqtt::spawn(state.flights.clone(), settings);
     }

@@ -43,6 +43,7 @@ macro_rules! api_doc {
             jobs::get_job,
             jobs::delete_job,
             crate::api::health::get_health,
+            crate::api::forecast::get_forecast,
             get_openapi,
         ),
         components(schemas(

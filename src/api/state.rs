@@ -1,5 +1,5 @@
 //! The handlers' shared state: the job queue, the limits, the permits of
-//! the synchronous solves and the priced work in flight, the API tokens and the live flights.
+//! the synchronous solves and the priced work in flight, the API tokens, the live flights and the forecast source.
 
 use std::sync::Arc;
 
@@ -7,7 +7,7 @@ use tokio::sync::Semaphore;
 
 use crate::api::auth;
 use crate::api::flights::hub::FlightHub;
-use crate::config::Limits;
+use crate::config::{ForecastSource, Limits};
 use crate::contract::price::InFlight;
 use crate::jobs::JobQueue;
 
@@ -23,6 +23,8 @@ pub struct AppState {
     pub tokens: Arc<auth::Tokens>,
     /// Live flights (in memory until [`Self::with_flights`]).
     pub flights: Arc<FlightHub>,
+    /// Where `GET /api/v1/forecast` fetches (none: not configured).
+    pub forecast: Option<Arc<ForecastSource>>,
 }
 
 impl AppState {
@@ -36,12 +38,19 @@ impl AppState {
             priced: Arc::new(InFlight::default()),
             tokens: Arc::new(auth::Tokens::default()),
             flights: Arc::new(FlightHub::in_memory()),
+            forecast: None,
         }
     }
 
     /// The same, keeping its flights in `hub`.
     pub fn with_flights(mut self, hub: FlightHub) -> Self {
         self.flights = Arc::new(hub);
+        self
+    }
+
+    /// The same, fetching today's forecast from `source`.
+    pub fn with_forecast_source(mut self, source: Option<ForecastSource>) -> Self {
+        self.forecast = source.map(Arc::new);
         self
     }
 

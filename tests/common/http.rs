@@ -134,3 +134,40 @@ pub fn dechunk(mut b: &[u8]) -> Vec<u8> {
         b = &b[eol + 4 + size..];
     }
 }
+
+/// A one-answer HTTP server on a loopback port, for the life of the test
+/// process: every request (its head read, its body ignored) gets `status`
+/// with `body` as JSON, then the connection closes. Its address.
+pub fn serve_fixed(status: u16, body: Vec<u8>) -> SocketAddr {
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = listener.local_addr().unwrap();
+    std::thread::spawn(move || {
+        for stream in listener.incoming() {
+            let Ok(mut s) = stream else { continue };
+            let mut r = BufReader::new(s.try_clone().unwrap());
+            let mut line = String::new();
+            while r.read_line(&mut line).is_ok_and(|n| n > 0) && line != "\r\n" {
+                line.clear();
+            }
+            let head = format!(
+                "HTTP/1.1 {status} X\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n",
+                body.len()
+            );
+            let _ = s.write_all(head.as_bytes());
+            let _ = s.write_all(&body);
+        }
+    });
+    addr
+}
+
+/// The recorded Open-Meteo forecast (`tests/forecasts/open_meteo_hourly.json`)
+/// served by [`serve_fixed`]; its URL.
+pub fn serve_recorded_forecast() -> String {
+    let body = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/forecasts/open_meteo_hourly.json"
+    ))
+    .unwrap();
+    let addr = serve_fixed(200, body);
+    format!("http://{addr}/v1/forecast?latitude=52.52&longitude=13.41")
+}
