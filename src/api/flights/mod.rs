@@ -1,11 +1,13 @@
 //! Live flights over HTTP (SPEC §13, issue 33): the routes
-//! ([`handlers`], [`events`]), the flights of a server ([`hub`]) and their
+//! ([`handlers`], [`events`], the report and the simulated flight in
+//! [`tools`]), the flights of a server ([`hub`]) and their
 //! part of the OpenAPI document ([`FlightsDoc`]). Wired into the router by
 //! [`routes`] and into the document by merging [`FlightsDoc`].
 
 pub mod events;
 pub mod handlers;
 pub mod hub;
+pub mod tools;
 
 use axum::Router;
 use axum::routing::{get, post};
@@ -20,7 +22,9 @@ pub fn routes() -> Router<AppState> {
             "/api/v1/flights",
             post(handlers::create_flight).get(handlers::list_flights),
         )
+        .route("/api/v1/flights/simulate", post(tools::simulate_flight))
         .route("/api/v1/flights/{id}", get(handlers::get_flight))
+        .route("/api/v1/flights/{id}/report", get(tools::flight_report))
         .route("/api/v1/flights/{id}/end", post(handlers::end_flight))
         .route(
             "/api/v1/flights/{id}/telemetry",
@@ -45,6 +49,8 @@ pub fn routes() -> Router<AppState> {
         handlers::acknowledge_alarms,
         handlers::replan_flight,
         events::flight_events,
+        tools::flight_report,
+        tools::simulate_flight,
     ),
     tags((name = "flights", description = "Live flights: a committed plan against its telemetry, with alarms (SPEC §13)"))
 )]
