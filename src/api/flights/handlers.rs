@@ -14,13 +14,13 @@ use crate::api::error::{ApiError, JsonBody};
 use crate::api::flights::hub::{LiveFlight, now_ms};
 use crate::api::jobs::{blocking, json_response};
 use crate::api::solve::{Deadline, SolveCtx};
-use std::sync::{Arc, Mutex};
 use crate::contract::error::ErrorBody;
 use crate::contract::flight::dto::*;
 use crate::contract::flight::model::{PreparedFlight, prepare_with};
 use crate::contract::flight::replan::{ReplanOutput, replan};
 use crate::contract::flight::telemetry::{Format, TelemetrySampleInput, parse_batch};
 use crate::jobs::flights::{MAX_FLIGHTS_PER_OWNER, NewFlight};
+use std::sync::{Arc, Mutex};
 
 /// Most refused samples listed in an answer.
 const MAX_LISTED_ERRORS: usize = 100;

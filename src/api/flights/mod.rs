@@ -1,10 +1,11 @@
 //! Live flights over HTTP (SPEC §13, issue 33): the routes
 //! ([`handlers`], [`events`], the report and the simulated flight in
-//! [`tools`]), the flights of a server ([`hub`]) and their
+//! [`tools`]), the client that replays a log against them ([`feed`]), the flights of a server ([`hub`]) and their
 //! part of the OpenAPI document ([`FlightsDoc`]). Wired into the router by
 //! [`routes`] and into the document by merging [`FlightsDoc`].
 
 pub mod events;
+pub mod feed;
 pub mod handlers;
 pub mod hub;
 pub mod tools;

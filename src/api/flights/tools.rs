@@ -67,12 +67,7 @@ fn not_acceptable(what: &str) -> ApiError {
 }
 
 fn typed(content_type: &'static str, body: String) -> Response {
-    (
-        StatusCode::OK,
-        [(header::CONTENT_TYPE, content_type)],
-        body,
-    )
-        .into_response()
+    (StatusCode::OK, [(header::CONTENT_TYPE, content_type)], body).into_response()
 }
 
 /// A flight's report.
@@ -157,8 +152,8 @@ pub async fn simulate_flight(
     headers: HeaderMap,
     JsonBody(body): JsonBody,
 ) -> Result<Response, ApiError> {
-    let want = wanted(&headers, false)
-        .ok_or_else(|| not_acceptable("application/json or text/csv"))?;
+    let want =
+        wanted(&headers, false).ok_or_else(|| not_acceptable("application/json or text/csv"))?;
     let response = app
         .solve(move |ctx: &SolveCtx| {
             let req = SimulateFlightRequest::parse(&body)?;

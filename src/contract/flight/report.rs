@@ -102,7 +102,10 @@ fn better(best: &mut Option<PeakOutput>, v: f64, t: f64, larger: bool) {
         }
     };
     if take && v.is_finite() {
-        *best = Some(PeakOutput { value: v, time_s: t });
+        *best = Some(PeakOutput {
+            value: v,
+            time_s: t,
+        });
     }
 }
 

@@ -7,8 +7,8 @@
 //! sample rate and a hold time. The flight's plan is committed exactly as
 //! the flight route commits it ([`prepare_with`]); the dynamics model of
 //! SPEC §11 then flies its schedule (the schedule's `(time_s, rate_m_s)` as
-//! a `piecewise_linear_rate` profile from `initial_length_m`, stopping at
-//! the schedule's last length) and holds at the target for `hold_s`, in
+//! a `piecewise_linear_rate` profile from `initial_length_m`, its last
+//! rate, zero, held) and holds at the target for `hold_s`, in
 //! the plan's steady flow plus the event. The answer is the telemetry a
 //! flight would record: the unstretched length, the winch rate of the
 //! profile, the winch tension, the wind at the anemometer (the model's
@@ -210,7 +210,6 @@ impl SimulateFlightRequest {
                 ),
             ));
         }
-        let target = schedule.last().map_or(req.initial_length_m, |s| s.length_m);
         // a whole number of samples: sample k at k / rate
         let intervals = ((plan_duration_s + self.hold_s) * rate).ceil().max(1.0);
         if intervals + 1.0 > MAX_SIMULATED_SAMPLES as f64 {
@@ -236,7 +235,9 @@ impl SimulateFlightRequest {
             tether_length_m: None,
             profile: Some(ProfileInput::PiecewiseLinearRate {
                 points,
-                target_length_m: Some(target),
+                // the table decides: its integral is the schedule's within the
+                // interpolation (a target it fell short of would be refused)
+                target_length_m: None,
             }),
             initial_length_m: Some(req.initial_length_m),
             duration_s,
