@@ -128,6 +128,24 @@ impl Server {
         (r.status, r.body)
     }
 
+    fn post_as(&self, path: &str, accept: &str, body: &[u8]) -> (u16, String) {
+        use std::io::{Read, Write};
+        let mut s = connect(self.addr, Duration::from_secs(120));
+        write!(
+            s,
+            "POST {path} HTTP/1.1\r\nHost: {}\r\nAccept: {accept}\r\nContent-Type: application/json\r\n\
+             Content-Length: {}\r\nConnection: close\r\n\r\n",
+            self.addr,
+            body.len()
+        )
+        .unwrap();
+        s.write_all(body).unwrap();
+        let mut raw = Vec::new();
+        s.read_to_end(&mut raw).unwrap();
+        let r = common::http::Reply::parse(&raw);
+        (r.status, r.body)
+    }
+
     fn create(&self, limits: Value) -> i64 {
         let (s, body) = self.send(
             "POST",
@@ -435,6 +453,84 @@ fn a_simulated_gust_fed_to_a_server_raises_and_clears_the_caution_and_the_report
         err.contains("HTTP 404") && err.contains("no flight"),
         "{err}"
     );
+
+    // the API answers the CLI's log byte for byte (Accept: text/csv), and
+    // names this request's fields
+    let req = std::fs::read(dir.join("gust.json")).unwrap();
+    let (s, csv) = server.post_as("/api/v1/flights/simulate", "text/csv", &req);
+    assert_eq!(s, 200, "{csv}");
+    assert_eq!(csv, std::fs::read_to_string(&gust_log).unwrap());
+    let mut too_fast: Value = serde_json::from_slice(&req).unwrap();
+    too_fast["sample_rate_hz"] = json!(100.0);
+    let (s, e) = server.post_as(
+        "/api/v1/flights/simulate",
+        "application/json",
+        too_fast.to_string().as_bytes(),
+    );
+    assert_eq!(s, 422, "{e}");
+    assert_eq!(
+        serde_json::from_str::<Value>(&e).unwrap()["error"]["field"],
+        "sample_rate_hz"
+    );
+    let mut no_ea: Value = serde_json::from_slice(&req).unwrap();
+    no_ea["flight"]["cable"] = json!({"mass_per_length_kg_m": 0.02, "diameter_m": 0.006});
+    let (s, e) = server.post_as(
+        "/api/v1/flights/simulate",
+        "application/json",
+        no_ea.to_string().as_bytes(),
+    );
+    assert_eq!(s, 422, "{e}");
+    assert_eq!(
+        serde_json::from_str::<Value>(&e).unwrap()["error"]["field"],
+        "flight.cable.axial_stiffness_n"
+    );
     drop(server);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The log's batches: NMEA told by content, lines with and without a
+/// time, batches of at most a second of sample time, and the server's
+/// batch lines mapped back to the file's.
+#[test]
+fn a_log_is_cut_into_batches_that_know_their_file_lines() {
+    use tetherplan::contract::flight::feed::{LogError, read_log};
+    use tetherplan::contract::flight::telemetry::Format;
+    let nmea = "\n0.0,$WIMWV,270.0,R,8.0,N,A*2E\n0.5,$WIMWV,270.0,R,8.0,N,A*2E\n1.2,$WIMWV,270.0,R,8.0,N,A*2E\n$WIMWV,270.0,R,8.0,N,A*2E\n";
+    let log = read_log(Path::new("wind.log"), nmea).unwrap();
+    assert_eq!(log.format, Format::Nmea);
+    assert_eq!(
+        log.lines
+            .iter()
+            .map(|l| (l.line, l.time_s))
+            .collect::<Vec<_>>(),
+        vec![(2, Some(0.0)), (3, Some(0.5)), (4, Some(1.2)), (5, None)]
+    );
+    let b = log.batches(100, Some(1.0));
+    assert_eq!(b.len(), 2);
+    assert_eq!((b[0].lines.clone(), b[0].due_s), (vec![2, 3], Some(0.5)));
+    assert_eq!((b[1].lines.clone(), b[1].due_s), (vec![4, 5], Some(1.2)));
+    assert_eq!(b[1].file_line(Format::Nmea, 2), Some(5));
+
+    let csv = "time_s,tether_length_m\n0,1\n0.1,1.1\n0.2,1.2\n";
+    let log = read_log(Path::new("x.txt"), csv).unwrap();
+    assert_eq!(log.format, Format::Csv);
+    let b = log.batches(2, None);
+    assert_eq!(b.len(), 2);
+    assert_eq!(b[1].body, "time_s,tether_length_m\n0.2,1.2\n");
+    // the server's line 2 of the second body (its header is line 1) is the file's line 4
+    assert_eq!(b[1].file_line(Format::Csv, 2), Some(4));
+
+    match read_log(Path::new("x.csv"), "time_s,tether_length_m\n0,1\n0.1,-3\n") {
+        Err(LogError::Lines(r)) => {
+            assert_eq!(
+                (r.len(), r[0].line, r[0].field.as_str()),
+                (1, 3, "tether_length_m")
+            )
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(matches!(
+        read_log(Path::new("x.csv"), "time_s,speed\n0,1\n"),
+        Err(LogError::Whole(_))
+    ));
 }

@@ -168,6 +168,16 @@ impl SimulateFlightRequest {
                 format!("must be above 0 and at most 10000 Hz, got {rate}"),
             ));
         }
+        let step = self.numerics.time_step_s;
+        if step.is_finite() && step > 0.0 && rate * step > 1.0 + 1e-9 {
+            return Err(invalid(
+                "sample_rate_hz",
+                format!(
+                    "at most one sample per time step: at most {} Hz with numerics.time_step_s = {step} s, got {rate}",
+                    1.0 / step
+                ),
+            ));
+        }
         if !(self.hold_s.is_finite() && (0.0..=MAX_HOLD_S).contains(&self.hold_s)) {
             return Err(invalid(
                 "hold_s",
@@ -298,8 +308,14 @@ impl Setup {
             .samples
             .iter()
             .map(|s| {
-                // the nominal sample time k / rate (the model's differs by rounding)
-                let t = (s.time_s * rate).round() / rate;
+                // the nominal sample time k / rate when the model's is it but
+                // for rounding; else the model's step time (to 1 ns)
+                let k = (s.time_s * rate).round();
+                let t = if (k / rate - s.time_s).abs() < 1e-9 {
+                    k / rate
+                } else {
+                    (s.time_s * 1e9).round() / 1e9
+                };
                 TelemetrySampleInput {
                     time_s: t,
                     tether_length_m: Some(s.length_m),
