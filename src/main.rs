@@ -95,6 +95,47 @@ enum Command {
     /// Run jobs only, from the same job store as `serve` (SQLite on this
     /// host, or `--database-url postgres://…` on any host), until SIGTERM.
     Worker(tetherplan::config::WorkerArgs),
+    /// Fly a flight in the dynamics model through a wind event and write
+    /// its telemetry log (the flight's CSV format; `--format json`: the
+    /// answer of `POST /api/v1/flights/simulate`). The request: `{"flight":
+    /// <a POST /api/v1/flights body>, "wind_event": {...}, "sample_rate_hz",
+    /// "hold_s", "numerics"}`.
+    SimulateFlight(SimulateArgs),
+    /// Replay a recorded telemetry log (the flight's CSV, or NMEA `$--MWV`
+    /// lines) against a running server, paced by its time_s.
+    Feed(FeedArgs),
+}
+
+#[derive(clap::Args)]
+struct SimulateArgs {
+    /// Request JSON file; `-` or absent reads standard input.
+    #[arg(long, short)]
+    input: Option<PathBuf>,
+    /// Where to write the log (absent: standard output).
+    #[arg(long, short)]
+    output: Option<PathBuf>,
+    /// `csv` (the telemetry log) or `json`.
+    #[arg(long, default_value = "csv", value_parser = ["csv", "json"])]
+    format: String,
+}
+
+#[derive(clap::Args)]
+struct FeedArgs {
+    /// The flight's id.
+    #[arg(long)]
+    flight: i64,
+    /// The log: `.csv` (a header of the sample's field names) or NMEA
+    /// (`.nmea`, or told by its content).
+    file: PathBuf,
+    /// Sample seconds per wall second; `0` or `max`: as fast as possible.
+    #[arg(long, default_value = "1")]
+    speed: String,
+    /// The server's URL.
+    #[arg(long, default_value = "http://127.0.0.1:8080")]
+    server: String,
+    /// The API token.
+    #[arg(long, env = "TETHERPLAN_TOKEN")]
+    token: Option<String>,
 }
 
 /// A progress bar on standard error for `total` units of `what`.
@@ -245,6 +286,165 @@ fn worker(args: tetherplan::config::WorkerArgs) -> ExitCode {
     }
 }
 
+/// Prints an error body and returns `code`.
+fn fail(body: &dto::ErrorBody, code: u8) -> ExitCode {
+    eprintln!(
+        "{}",
+        serde_json::to_string_pretty(body).expect("errors serialise")
+    );
+    ExitCode::from(code)
+}
+
+/// `tetherplan simulate-flight`.
+fn simulate_flight(args: &SimulateArgs) -> ExitCode {
+    use tetherplan::contract::flight::simulate::{SimulateFlightRequest, to_csv};
+    let input = InputArg {
+        input: args.input.clone(),
+        db: None,
+        database_url: None,
+        token: None,
+    };
+    let body = match read_input(&input) {
+        Ok(b) => b,
+        Err(msg) => return fail(&dto::ErrorBody::new("io", None, msg), 2),
+    };
+    let bar = progress_bar(0, "simulate-flight");
+    let out = SimulateFlightRequest::parse(&body).and_then(|r| {
+        let setup = r.setup(&bar)?;
+        setup.run(&bar)
+    });
+    bar.0.finish_and_clear();
+    let out = match out {
+        Ok(o) => o,
+        Err(e) => {
+            let code = if matches!(e, RequestError::Invalid(_) | RequestError::Malformed(_)) {
+                2
+            } else {
+                1
+            };
+            return fail(&e.body(), code);
+        }
+    };
+    let text = if args.format == "json" {
+        serde_json::to_string_pretty(&out).expect("responses serialise")
+    } else {
+        to_csv(&out.samples)
+    };
+    match &args.output {
+        Some(path) => {
+            if let Err(e) = std::fs::write(path, text) {
+                let msg = format!("cannot write {}: {e}", path.display());
+                return fail(&dto::ErrorBody::new("io", None, msg), 1);
+            }
+        }
+        None => print_text(text.trim_end()),
+    }
+    eprintln!(
+        "simulate-flight: {} samples over {} s ({:?})",
+        out.samples.len(),
+        out.duration_s,
+        out.outcome
+    );
+    ExitCode::SUCCESS
+}
+
+/// `tetherplan feed`.
+fn feed(args: &FeedArgs) -> ExitCode {
+    use tetherplan::api::flights::feed::{FeedError, Target, feed};
+    use tetherplan::contract::flight::feed::{LogError, read_log};
+    let speed = match args.speed.trim() {
+        "max" | "0" => None,
+        s => match s.parse::<f64>() {
+            Ok(v) if v.is_finite() && v > 0.0 => Some(v),
+            Ok(0.0) => None,
+            _ => {
+                eprintln!(
+                    "tetherplan feed: --speed must be a positive number, 0 or max, got `{s}`"
+                );
+                return ExitCode::from(2);
+            }
+        },
+    };
+    let text = match std::fs::read_to_string(&args.file) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("tetherplan feed: cannot read {}: {e}", args.file.display());
+            return ExitCode::from(2);
+        }
+    };
+    let log = match read_log(&args.file, &text) {
+        Ok(l) => l,
+        Err(LogError::Whole(e)) => {
+            eprintln!("tetherplan feed: {}: {e}", args.file.display());
+            return ExitCode::from(2);
+        }
+        Err(LogError::Lines(rejected)) => {
+            for r in rejected.iter().take(20) {
+                eprintln!(
+                    "tetherplan feed: {} line {}: {} {}",
+                    args.file.display(),
+                    r.line,
+                    r.field,
+                    r.reason
+                );
+            }
+            eprintln!(
+                "tetherplan feed: {} line(s) refused; nothing was sent",
+                rejected.len()
+            );
+            return ExitCode::from(2);
+        }
+    };
+    let target = match Target::new(&args.server, args.token.clone(), args.flight) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("tetherplan feed: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let runtime = match tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+    {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("tetherplan feed: cannot start the async runtime: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let bar = progress_bar(log.lines.len() as u64, "feed");
+    let result = runtime.block_on(feed(&target, &log, speed, |sent| {
+        bar.0.set_position(sent as u64)
+    }));
+    bar.0.finish_and_clear();
+    match result {
+        Ok(s) => {
+            println!(
+                "accepted {}, duplicates {}, refused {} ({} batches, {} retries); state {}",
+                s.accepted,
+                s.duplicates,
+                s.refused.len(),
+                s.batches,
+                s.retries,
+                s.state.as_deref().unwrap_or("unknown")
+            );
+            for r in &s.refused {
+                let line = r.line.map_or("?".into(), |l| l.to_string());
+                println!("refused line {line}: {} {}", r.field, r.reason);
+            }
+            ExitCode::SUCCESS
+        }
+        Err(FeedError::Refused { status, body }) => {
+            eprintln!("tetherplan feed: the server refused a batch (HTTP {status}): {body}");
+            ExitCode::from(3)
+        }
+        Err(FeedError::Unreachable(e)) => {
+            eprintln!("tetherplan feed: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let kinds: Vec<(&'static str, &'static Kind)> =
         KINDS.iter().map(|k| (subcommand_name(k), k)).collect();
@@ -268,5 +468,7 @@ fn main() -> ExitCode {
         None => serve(cli.serve),
         Some(Command::Serve(args)) => serve(args),
         Some(Command::Worker(args)) => worker(args),
+        Some(Command::SimulateFlight(args)) => simulate_flight(&args),
+        Some(Command::Feed(args)) => feed(&args),
     }
 }

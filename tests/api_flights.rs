@@ -569,3 +569,38 @@ fn a_server_killed_with_sigkill_keeps_every_acknowledged_sample_and_its_state() 
     drop(server);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Creating a flight solves its plan like the solve routes: past the
+/// server's solve timeout (zero here: no solve can start in time) it is
+/// the plan route's own 504 `timeout`, word for word, and nothing is
+/// stored; within it (the default) the same body is created.
+#[tokio::test]
+async fn a_flight_whose_plan_is_not_solved_in_time_is_the_solve_routes_timeout() {
+    let limits = tetherplan::config::Limits {
+        solve_timeout: Duration::ZERO,
+        ..Default::default()
+    };
+    let (app, _) = common::app_with(2, limits);
+    let body = flight_body("late");
+    let (s, flight) = send_as(&app, "", "POST", "/api/v1/flights", Some(&body)).await;
+    assert_eq!(s, StatusCode::GATEWAY_TIMEOUT, "{flight}");
+    let mut plan = body.clone();
+    plan.as_object_mut().unwrap().remove("name");
+    plan.as_object_mut().unwrap().remove("limits");
+    let (s, planned) = send_as(&app, "", "POST", "/api/v1/plan", Some(&plan)).await;
+    assert_eq!(s, StatusCode::GATEWAY_TIMEOUT, "{planned}");
+    let flight: Value = serde_json::from_str(&flight).unwrap();
+    let planned: Value = serde_json::from_str(&planned).unwrap();
+    assert_eq!(flight["error"]["code"], "timeout");
+    assert_eq!(flight, planned);
+    let (s, list) = send_as(&app, "", "GET", "/api/v1/flights", None).await;
+    assert_eq!(s, StatusCode::OK);
+    assert_eq!(
+        serde_json::from_str::<Value>(&list).unwrap()["flights"],
+        json!([])
+    );
+
+    let (app, _) = common::app();
+    let (s, created) = send_as(&app, "", "POST", "/api/v1/flights", Some(&body)).await;
+    assert_eq!(s, StatusCode::CREATED, "{created}");
+}

@@ -191,7 +191,23 @@ fn every_route_is_documented_with_its_statuses() {
             "post",
             "/api/v1/flights",
             "create_flight",
-            &["201", "400", "401", "413", "415", "422", "500"],
+            &[
+                "201", "400", "401", "413", "415", "422", "500", "503", "504",
+            ],
+        ),
+        (
+            "post",
+            "/api/v1/flights/simulate",
+            "simulate_flight",
+            &[
+                "200", "400", "401", "406", "413", "415", "422", "503", "504",
+            ],
+        ),
+        (
+            "get",
+            "/api/v1/flights/{id}/report",
+            "flight_report",
+            &["200", "401", "404", "406", "500"],
         ),
         (
             "get",

@@ -13,12 +13,14 @@ use crate::api::auth::Caller;
 use crate::api::error::{ApiError, JsonBody};
 use crate::api::flights::hub::{LiveFlight, now_ms};
 use crate::api::jobs::{blocking, json_response};
+use crate::api::solve::{Deadline, SolveCtx};
 use crate::contract::error::ErrorBody;
 use crate::contract::flight::dto::*;
-use crate::contract::flight::model::prepare;
+use crate::contract::flight::model::{PreparedFlight, prepare_with};
 use crate::contract::flight::replan::{ReplanOutput, replan};
 use crate::contract::flight::telemetry::{Format, TelemetrySampleInput, parse_batch};
 use crate::jobs::flights::{MAX_FLIGHTS_PER_OWNER, NewFlight};
+use std::sync::{Arc, Mutex};
 
 /// Most refused samples listed in an answer.
 const MAX_LISTED_ERRORS: usize = 100;
@@ -57,6 +59,9 @@ pub(super) async fn flight_of(
         (status = 415, description = "Content type is not JSON", body = ErrorBody),
         (status = 422, description = "Invalid request, an infeasible plan (no schedule to fly) or 1000 flights kept by this token", body = ErrorBody),
         (status = 500, description = "Store failure", body = ErrorBody),
+        (status = 503, description = "Too many solves in flight", body = ErrorBody,
+            headers(("Retry-After" = u32, description = "Seconds to wait before retrying"))),
+        (status = 504, description = "The plan was not solved within the solve timeout", body = ErrorBody),
     )
 )]
 pub async fn create_flight(
@@ -64,7 +69,7 @@ pub async fn create_flight(
     Extension(caller): Extension<Caller>,
     JsonBody(body): JsonBody,
 ) -> Result<Response, ApiError> {
-    let prepared = blocking(move || prepare(&body).map_err(ApiError::from)).await?;
+    let prepared = solve_prepare(&app, body).await?;
     let hub = app.flights.clone();
     let owner = owner(&caller);
     let request = text(&prepared.request);
@@ -100,6 +105,22 @@ pub async fn create_flight(
             limits: prepared.limits,
         },
     ))
+}
+
+/// Commits a flight's plan as the solve routes solve: on the rayon pool,
+/// within the server's solve timeout (504 `timeout` past it, the solve
+/// stopped), at most `max_in_flight` at once (503).
+async fn solve_prepare(app: &AppState, body: Bytes) -> Result<PreparedFlight, ApiError> {
+    let slot = Arc::new(Mutex::new(None));
+    let out = slot.clone();
+    app.solve(move |ctx: &SolveCtx| {
+        let prepared = prepare_with(&body, &Deadline::after(ctx))?;
+        *out.lock().expect("not poisoned") = Some(prepared);
+        Ok(Vec::new())
+    })
+    .await?;
+    let prepared = slot.lock().expect("not poisoned").take();
+    prepared.ok_or_else(|| ApiError::internal("the flight's plan was solved but not kept"))
 }
 
 /// JSON text of a stored part.

@@ -13,7 +13,7 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 
 use crate::contract::RequestError;
-use crate::contract::error::NoProgress;
+use crate::contract::error::{NoProgress, Progress};
 use crate::contract::flight::dto::*;
 use crate::contract::flight::wind::measured_wind;
 use crate::contract::json::parse_value;
@@ -187,6 +187,12 @@ pub fn resolve_limits(
 
 /// Parses and commits a flight.
 pub fn prepare(body: &[u8]) -> Result<PreparedFlight, RequestError> {
+    prepare_with(body, &NoProgress)
+}
+
+/// Parses and commits a flight; `progress` may stop the plan's solve and
+/// the ceiling table between its winds ([`RequestError::Cancelled`]).
+pub fn prepare_with(body: &[u8], progress: &dyn Progress) -> Result<PreparedFlight, RequestError> {
     crate::contract::json_keys::reject_duplicate_keys(body)?;
     let mut value: serde_json::Value =
         serde_json::from_slice(body).map_err(|e| RequestError::Malformed(e.to_string()))?;
@@ -216,7 +222,7 @@ pub fn prepare(body: &[u8]) -> Result<PreparedFlight, RequestError> {
         })?,
     };
     let req: PlanRequest = parse_value(&value)?;
-    let plan = plan(&req, &NoProgress)?;
+    let plan = plan(&req, progress)?;
     if !plan.feasible {
         return Err(invalid(
             plan.binding_limit
@@ -229,7 +235,10 @@ pub fn prepare(body: &[u8]) -> Result<PreparedFlight, RequestError> {
         ));
     }
     let mut limits = resolve_limits(&limits, &req, &plan)?;
-    let (table, note) = ceiling_table(&req, &plan, &limits)?;
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    let (table, note) = ceiling_table(&req, &plan, &limits, progress)?;
     limits.payout_ceiling = note;
     Ok(PreparedFlight {
         name,
@@ -255,6 +264,7 @@ pub fn ceiling_table(
     req: &PlanRequest,
     plan: &PlanResponse,
     limits: &FlightLimitsOutput,
+    progress: &dyn Progress,
 ) -> Result<(StoredTable, String), RequestError> {
     let longest = plan
         .schedule
@@ -277,6 +287,9 @@ pub fn ceiling_table(
     let mut columns = Vec::with_capacity(winds.len());
     let mut calm_only = false;
     for &w in &winds {
+        if progress.cancelled() {
+            return Err(RequestError::Cancelled);
+        }
         let mut r = req.clone();
         r.haul_down = None;
         r.wind = Some(measured_wind(

@@ -190,6 +190,11 @@ impl PlanTrace {
         })
     }
 
+    /// The schedule's last time (s).
+    pub fn end_time_s(&self) -> f64 {
+        self.times_s[self.times_s.len() - 1]
+    }
+
     /// Planned length at `t` (m).
     pub fn length_at_m(&self, t: f64) -> f64 {
         let n = self.times_s.len();
