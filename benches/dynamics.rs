@@ -47,6 +47,8 @@ use std::time::{Duration, Instant};
 
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, criterion_group};
+use tetherplan::contract::dynamics::{DynamicsRequest, DynamicsResponse, parse_dynamics};
+use tetherplan::contract::run::NoProgress;
 use tetherplan::numerics::dynamics::{self, DynamicsConfig, DynamicsProblem, reference};
 
 #[path = "../tests/peers/moordyn_case.rs"]
@@ -92,10 +94,54 @@ fn timed(
     });
 }
 
+/// The turbulence case of [`reference::turbulence_case`] as a
+/// `/dynamics` request for one hour at the converged default (no
+/// `numerics`): the default ladder, the segment check and the
+/// quasi-static comparison, as the route answers it.
+fn converged_hour_request() -> DynamicsRequest {
+    let v = serde_json::json!({
+        "cable": {"mass_per_length_kg_m": 0.078, "diameter_m": 0.005,
+                  "normal_drag_coefficient_nondim": 1.2, "axial_stiffness_n": 1.0e6},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.3,
+                     "reference_area_m2": 20.0, "added_mass_coefficient_nondim": 0.5},
+        "wind": {"flow": {"kind": "uniform", "speed_m_s": 8.0},
+                 "time_history": {"kind": "turbulence", "model": "von_karman",
+                                  "turbulence_intensity_nondim": 0.15, "length_scale_m": 150.0,
+                                  "seed": 7}},
+        "internal_damping_n_s": 1.0e4,
+        "tether_length_m": 1000.0,
+        "duration_s": 3600.0,
+        "sample_count": 3601,
+        "shape_count": 0
+    });
+    parse_dynamics(v.to_string().as_bytes()).unwrap()
+}
+
+fn converged_hour(req: &DynamicsRequest) -> DynamicsResponse {
+    tetherplan::contract::dynamics::dynamics(req, &NoProgress).unwrap()
+}
+
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("dynamics");
     g.sample_size(10);
     g.sampling_mode(SamplingMode::Flat);
+    let req = converged_hour_request();
+    g.bench_function("converged_hour_of_turbulence", |b| {
+        b.iter(|| converged_hour(&req))
+    });
+    g.bench_function("converged_hour_of_turbulence_cpu", |b| {
+        b.iter_custom(|iters| {
+            let start = thread_cpu();
+            for _ in 0..iters {
+                std::hint::black_box(converged_hour(&req));
+            }
+            thread_cpu() - start
+        })
+    });
+    if std::env::var("TETHERPLAN_DYNAMICS_CONVERGED_ONLY").is_ok() {
+        g.finish();
+        return;
+    }
     let hour = hour();
     timed(
         &mut g,
@@ -183,6 +229,19 @@ fn step_study() {
 fn main() {
     if std::env::var("TETHERPLAN_DYNAMICS_ONCE").as_deref() == Ok("step_study") {
         step_study();
+        return;
+    }
+    if std::env::var("TETHERPLAN_DYNAMICS_ONCE").as_deref() == Ok("converged_hour") {
+        let req = converged_hour_request();
+        let clock = Instant::now();
+        let cpu = thread_cpu();
+        let a = converged_hour(&req);
+        println!(
+            "converged_hour: {} s CPU, {:.3} s wall; {}",
+            (thread_cpu() - cpu).as_secs_f64(),
+            clock.elapsed().as_secs_f64(),
+            serde_json::to_string(&a.converged).unwrap()
+        );
         return;
     }
     if let Ok(case) = std::env::var("TETHERPLAN_DYNAMICS_ONCE") {
