@@ -11,6 +11,18 @@
 //!   histories agree within the tolerance of `tests/peer_moordyn.rs`
 //!   (winch and top tension within 2 % of their peaks, the aerostat within
 //!   5 m) at the same configuration (`reference::gust_case_config`);
+//! * `converged_hour_of_turbulence`: the same hour as a `/dynamics`
+//!   request at the converged default (issue 31 item 2: no `numerics`;
+//!   the ladder stops at 0.1 s, the figures within 0.35 % of the 0.2 s
+//!   run's, then the segment check at 0.1 s on 25 segments: three runs,
+//!   three turbulence fields, the quasi-static comparison).
+//!   Measured 2026-12-04 (10 flat samples, load average 5.5 on 2 cores,
+//!   a release build of the tests beside it): median 0.928 s CPU, 1.98 s
+//!   wall (the wall clock measures the load); `TETHERPLAN_DYNAMICS_ONCE=
+//!   converged_hour` once: 0.922 s CPU. Figures: peak winch tension
+//!   523.7 ± 3.5 N, minimum 344.6 ± 2.4 N, peak tension 1106.7 ± 7.8 N,
+//!   lowest altitude 748.45 ± 0.03 m. `TETHERPLAN_DYNAMICS_CONVERGED_ONLY=1`
+//!   runs only this bench;
 //! * `seeds_4_hours_2_threads`: four seeds of the hour on a rayon pool of
 //!   two threads (100 seeds take 25 times as long).
 //!

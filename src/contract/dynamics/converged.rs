@@ -23,7 +23,7 @@
 //! give the estimate, and `tolerance_enforced` is false.
 
 use super::dto::*;
-use super::run::{Ran, run_with};
+use super::run::{Ran, response, run_with};
 use super::validate::Prepared;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::dynamics::converged::{
@@ -67,6 +67,21 @@ fn ladder_words(runs: &[(f64, usize, Figures)]) -> String {
     s.trim_end_matches("; ").to_string()
 }
 
+/// Answers one dynamics request: its converged figures and the answer's
+/// run, the account of both in its explanation.
+pub fn dynamics(
+    req: &DynamicsRequest,
+    progress: &dyn Progress,
+) -> Result<DynamicsResponse, RequestError> {
+    let prepared = req.prepare()?;
+    let (ran, converged) = run_converged(&prepared, progress)?;
+    let words = explain(&converged);
+    let mut answer = response(req, &prepared, &ran, converged);
+    answer.explanation.push(' ');
+    answer.explanation.push_str(&words);
+    Ok(answer)
+}
+
 /// Runs the ladder of `prepared` and gives the answer's run with its
 /// converged figures, or refuses naming `numerics`.
 pub fn run_converged(
@@ -108,10 +123,18 @@ pub fn run_converged(
     let fine = figures.last().expect("a run").2;
     let coarse = figures[figures.len() - 2].2;
     if ladder.enforced && !met {
+        let unfinished = refinements.iter().filter(|r| !r.completed).count();
+        let why = if unfinished > 0 {
+            format!(
+                "{unfinished} of the runs did not reach the end (see `outcome` at a fixed discretisation)"
+            )
+        } else {
+            "a slack tether snapping taut (an abrupt winch stop) is not converged at any affordable step".to_string()
+        };
         return Err(InvalidInput::new(
             "numerics",
             format!(
-                "the figures did not converge to {} of their scale by the finest default step ({} s): {}. A slack tether snapping taut (an abrupt winch stop) is not converged at any affordable step; give numerics.time_step_s (and numerics.segments) to have the answer at that discretisation with its error estimate, or a larger numerics.tolerance_nondim",
+                "the figures did not converge to {} of their scale by the finest default step ({} s): {}. Likely cause: {why}. Give numerics.time_step_s (and numerics.segments) to have the answer at that discretisation with its error estimate, or a larger numerics.tolerance_nondim",
                 ladder.tolerance,
                 figures.last().expect("a run").0,
                 ladder_words(&figures)

@@ -24,9 +24,9 @@ pub mod price;
 pub mod run;
 pub mod validate;
 
+pub use converged::dynamics;
 pub use dto::{DynamicsRequest, DynamicsResponse};
 pub use peaks::{DynamicsPeaksRequest, DynamicsPeaksResponse};
-pub use run::dynamics;
 
 use crate::contract::RequestError;
 

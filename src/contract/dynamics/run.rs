@@ -157,16 +157,6 @@ fn wind_change_range(problem: &DynamicsProblem, run: &Run, duration_s: f64) -> (
     (hi, lo)
 }
 
-/// Answers one dynamics request.
-pub fn dynamics(
-    req: &DynamicsRequest,
-    progress: &dyn Progress,
-) -> Result<DynamicsResponse, RequestError> {
-    let prepared = req.prepare()?;
-    let (ran, converged) = super::converged::run_converged(&prepared, progress)?;
-    Ok(response(req, &prepared, &ran, converged))
-}
-
 /// The answer of a run, with its converged figures.
 pub fn response(
     req: &DynamicsRequest,
@@ -233,9 +223,7 @@ pub fn response(
         winch_tension_at_min_wind_n: at_min.as_ref().map(|e| e.winch_tension_n),
         slack_at_min_wind: at_min.as_ref().map(|e| e.slack),
     };
-    let mut explanation = explain(run, &quasi_static, dynamic_factor, outcome, stopped_at_s);
-    explanation.push(' ');
-    explanation.push_str(&super::converged::explain(&converged));
+    let explanation = explain(run, &quasi_static, dynamic_factor, outcome, stopped_at_s);
     DynamicsResponse {
         outcome,
         stopped_at_s,
