@@ -11,6 +11,18 @@
 //!   histories agree within the tolerance of `tests/peer_moordyn.rs`
 //!   (winch and top tension within 2 % of their peaks, the aerostat within
 //!   5 m) at the same configuration (`reference::gust_case_config`);
+//! * `converged_hour_of_turbulence`: the same hour as a `/dynamics`
+//!   request at the converged default (issue 31 item 2: no `numerics`;
+//!   the ladder stops at 0.1 s, the figures within 0.35 % of the 0.2 s
+//!   run's, then the segment check at 0.1 s on 25 segments: three runs,
+//!   three turbulence fields, the quasi-static comparison).
+//!   Measured 2026-12-04 (10 flat samples, load average 5.5 on 2 cores,
+//!   a release build of the tests beside it): median 0.928 s CPU, 1.98 s
+//!   wall (the wall clock measures the load); `TETHERPLAN_DYNAMICS_ONCE=
+//!   converged_hour` once: 0.922 s CPU. Figures: peak winch tension
+//!   523.7 ± 3.5 N, minimum 344.6 ± 2.4 N, peak tension 1106.7 ± 7.8 N,
+//!   lowest altitude 748.45 ± 0.03 m. `TETHERPLAN_DYNAMICS_CONVERGED_ONLY=1`
+//!   runs only this bench;
 //! * `seeds_4_hours_2_threads`: four seeds of the hour on a rayon pool of
 //!   two threads (100 seeds take 25 times as long).
 //!
@@ -47,6 +59,8 @@ use std::time::{Duration, Instant};
 
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, criterion_group};
+use tetherplan::contract::dynamics::{DynamicsRequest, DynamicsResponse, parse_dynamics};
+use tetherplan::contract::run::NoProgress;
 use tetherplan::numerics::dynamics::{self, DynamicsConfig, DynamicsProblem, reference};
 
 #[path = "../tests/peers/moordyn_case.rs"]
@@ -92,10 +106,54 @@ fn timed(
     });
 }
 
+/// The turbulence case of [`reference::turbulence_case`] as a
+/// `/dynamics` request for one hour at the converged default (no
+/// `numerics`): the default ladder, the segment check and the
+/// quasi-static comparison, as the route answers it.
+fn converged_hour_request() -> DynamicsRequest {
+    let v = serde_json::json!({
+        "cable": {"mass_per_length_kg_m": 0.078, "diameter_m": 0.005,
+                  "normal_drag_coefficient_nondim": 1.2, "axial_stiffness_n": 1.0e6},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.3,
+                     "reference_area_m2": 20.0, "added_mass_coefficient_nondim": 0.5},
+        "wind": {"flow": {"kind": "uniform", "speed_m_s": 8.0},
+                 "time_history": {"kind": "turbulence", "model": "von_karman",
+                                  "turbulence_intensity_nondim": 0.15, "length_scale_m": 150.0,
+                                  "seed": 7}},
+        "internal_damping_n_s": 1.0e4,
+        "tether_length_m": 1000.0,
+        "duration_s": 3600.0,
+        "sample_count": 3601,
+        "shape_count": 0
+    });
+    parse_dynamics(v.to_string().as_bytes()).unwrap()
+}
+
+fn converged_hour(req: &DynamicsRequest) -> DynamicsResponse {
+    tetherplan::contract::dynamics::dynamics(req, &NoProgress).unwrap()
+}
+
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("dynamics");
     g.sample_size(10);
     g.sampling_mode(SamplingMode::Flat);
+    let req = converged_hour_request();
+    g.bench_function("converged_hour_of_turbulence", |b| {
+        b.iter(|| converged_hour(&req))
+    });
+    g.bench_function("converged_hour_of_turbulence_cpu", |b| {
+        b.iter_custom(|iters| {
+            let start = thread_cpu();
+            for _ in 0..iters {
+                std::hint::black_box(converged_hour(&req));
+            }
+            thread_cpu() - start
+        })
+    });
+    if std::env::var("TETHERPLAN_DYNAMICS_CONVERGED_ONLY").is_ok() {
+        g.finish();
+        return;
+    }
     let hour = hour();
     timed(
         &mut g,
@@ -183,6 +241,19 @@ fn step_study() {
 fn main() {
     if std::env::var("TETHERPLAN_DYNAMICS_ONCE").as_deref() == Ok("step_study") {
         step_study();
+        return;
+    }
+    if std::env::var("TETHERPLAN_DYNAMICS_ONCE").as_deref() == Ok("converged_hour") {
+        let req = converged_hour_request();
+        let clock = Instant::now();
+        let cpu = thread_cpu();
+        let a = converged_hour(&req);
+        println!(
+            "converged_hour: {} s CPU, {:.3} s wall; {}",
+            (thread_cpu() - cpu).as_secs_f64(),
+            clock.elapsed().as_secs_f64(),
+            serde_json::to_string(&a.converged).unwrap()
+        );
         return;
     }
     if let Ok(case) = std::env::var("TETHERPLAN_DYNAMICS_ONCE") {

@@ -372,6 +372,11 @@ fn numeric_fields_name_their_unit() {
         "samples_received",
         "acknowledged",
         "seq",
+        // A dynamics answer's converged figure (issue 31 item 2): its
+        // unit is the one its key ends in (`converged.peak_tension_n`:
+        // `value`, `error_estimate`, `safe_value` in N).
+        "error_estimate",
+        "safe_value",
     ];
     // Dimensionless by name: ratios (E*, γ̃ as the issues name them), step
     // and sample counts, Newton iteration counts, relative tolerances,

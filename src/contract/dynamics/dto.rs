@@ -17,12 +17,6 @@ pub(crate) fn default_gravity() -> f64 {
 fn default_air_density() -> f64 {
     1.225
 }
-fn default_segments() -> usize {
-    50
-}
-fn default_time_step() -> f64 {
-    0.05
-}
 fn default_spectral_radius() -> f64 {
     0.8
 }
@@ -122,32 +116,48 @@ pub struct DynamicsWindInput {
     pub time_history: Option<TimeHistoryInput>,
 }
 
-/// Discretisation and integrator.
+/// Discretisation and integrator. Leave `segments` and `time_step_s`
+/// out (the default) for converged figures: the run is repeated at halved
+/// steps until its figures (`converged` in the answer) change by at most
+/// `tolerance_nondim`, or refused naming `numerics` when the finest
+/// default step does not get there. Give them to run that discretisation
+/// as it is: the answer still carries the error estimate from the run at
+/// twice the step and half the segments, and says the tolerance was not
+/// enforced.
 #[derive(Clone, Debug, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DynamicsNumericsInput {
-    /// Equal segments of the tether (lumped masses at their ends).
-    #[serde(default = "default_segments")]
+    /// Equal segments of the tether (lumped masses at their ends); default 50.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(example = 50, minimum = 2, maximum = 1000)]
-    pub segments: usize,
+    pub segments: Option<usize>,
     /// Time step (s); the generalized-α step is unconditionally stable, so
-    /// it is set by the accuracy wanted (0.05 s resolves gusts of a few seconds).
-    #[serde(default = "default_time_step")]
+    /// it is set by the accuracy wanted. Default: chosen (0.2, 0.1 or
+    /// 0.05 s, at most a quarter of the shortest gust or sinusoid period)
+    /// so that the figures meet `tolerance_nondim`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(example = 0.05, minimum = 0.0001, maximum = 10.0)]
-    pub time_step_s: f64,
+    pub time_step_s: Option<f64>,
     /// Spectral radius ρ∞ at infinite frequency: 1 keeps every mode
     /// (trapezoidal rule), smaller damps the unresolved axial waves.
     #[serde(default = "default_spectral_radius")]
     #[schema(example = 0.8, minimum = 0.0, maximum = 1.0)]
     pub spectral_radius_nondim: f64,
+    /// Relative tolerance of the converged figures (of their scale: the
+    /// largest tension figure for tensions, the altitude itself), default
+    /// 0.01; enforced only when `segments` and `time_step_s` are left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(example = 0.01, minimum = 0.0001, maximum = 0.1)]
+    pub tolerance_nondim: Option<f64>,
 }
 
 impl Default for DynamicsNumericsInput {
     fn default() -> Self {
         Self {
-            segments: default_segments(),
-            time_step_s: default_time_step(),
+            segments: None,
+            time_step_s: None,
             spectral_radius_nondim: default_spectral_radius(),
+            tolerance_nondim: None,
         }
     }
 }
@@ -380,18 +390,23 @@ pub struct DynamicsResponse {
     /// Largest tension anywhere along the tether and when (N, s).
     pub peak_tension_n: f64,
     pub peak_tension_time_s: f64,
-    /// Lowest aerostat altitude among the samples (m).
+    /// Lowest aerostat altitude at any step and when (m, s).
     pub min_aerostat_altitude_m: f64,
     /// The fixed point where `probe_wind_m_s` is read: height above the
     /// winch and distance downwind of it (m).
     pub wind_probe_height_m: f64,
     pub wind_probe_downwind_m: f64,
     pub quasi_static: QuasiStaticOutput,
-    /// Peak winch tension / static winch tension at the largest wind; null
-    /// without it, or when the run did not complete (`figures_partial`).
+    /// The four figures above with their error estimates and safe sides,
+    /// and how the step and segments were chosen (SPEC §5).
+    pub converged: DynamicsConvergedOutput,
+    /// Peak winch tension (its safe value, `converged`) / static winch
+    /// tension at the largest wind; null without it, or when the run did
+    /// not complete (`figures_partial`).
     pub dynamic_factor_nondim: Option<f64>,
-    /// Breaking strength / peak tension; null without a breaking strength,
-    /// or when the run did not complete.
+    /// Breaking strength / peak tension anywhere (its safe value,
+    /// `converged.peak_tension_n.safe_value`); null without a breaking
+    /// strength, or when the run did not complete.
     pub safety_factor_nondim: Option<f64>,
     pub required_safety_factor_nondim: f64,
     /// Whether the safety factor meets the required one; null without a breaking strength.
@@ -399,4 +414,75 @@ pub struct DynamicsResponse {
     /// Plain-language account of the run.
     pub explanation: String,
     pub numerics: DynamicsNumericsOutput,
+}
+
+/// One figure an operator acts on, with its discretisation error (SPEC §5);
+/// its unit is the one its field's name ends in.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct EstimatedFigureOutput {
+    /// The figure of the answer's run (the one whose samples are returned).
+    pub value: f64,
+    /// Estimated discretisation error (≥ 0): its change from the run at
+    /// twice the step plus its change from the run at half the segments
+    /// (a bound when the method converges at order ≥ 1 in the step and
+    /// ≥ 1 in the segments).
+    pub error_estimate: f64,
+    /// `value + error_estimate` for a peak, `value − error_estimate` for a
+    /// minimum: the side to act on.
+    pub safe_value: f64,
+    /// When it happened in the answer's run (s).
+    pub time_s: f64,
+}
+
+/// The observed order of convergence in the time step of each figure,
+/// `log₂(|q(4h) − q(2h)| / |q(2h) − q(h)|)` over the last three default
+/// steps; null when fewer than three steps were run, when a change is at
+/// roundoff, or when the changes did not decrease.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct ObservedOrdersOutput {
+    pub peak_winch_tension_nondim: Option<f64>,
+    pub min_winch_tension_nondim: Option<f64>,
+    pub peak_tension_nondim: Option<f64>,
+    pub min_aerostat_altitude_nondim: Option<f64>,
+}
+
+/// One run of the refinement, with its figures.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct RefinementOutput {
+    /// Its time step (s).
+    pub time_step_s: f64,
+    pub segments: usize,
+    /// Whether it ran to the end.
+    pub completed: bool,
+    /// Its figures (N, N, N, m).
+    pub peak_winch_tension_n: f64,
+    pub min_winch_tension_n: f64,
+    pub peak_tension_n: f64,
+    pub min_aerostat_altitude_m: f64,
+}
+
+/// The converged figures (issue 31 item 2): what an operator acts on,
+/// each with its error estimate and safe side.
+#[derive(Clone, Debug, Deserialize, Serialize, ToSchema, PartialEq)]
+pub struct DynamicsConvergedOutput {
+    pub peak_winch_tension_n: EstimatedFigureOutput,
+    pub min_winch_tension_n: EstimatedFigureOutput,
+    /// Largest segment tension anywhere along the tether.
+    pub peak_tension_n: EstimatedFigureOutput,
+    pub min_aerostat_altitude_m: EstimatedFigureOutput,
+    /// The relative tolerance (of the largest tension figure for the
+    /// tensions, of the altitude for the altitude).
+    pub tolerance_nondim: f64,
+    /// True when the step was chosen to meet the tolerance (numerics
+    /// `segments` and `time_step_s` left out); false when the request
+    /// fixed them: the estimate is then given, the tolerance not enforced.
+    pub tolerance_enforced: bool,
+    /// Whether every figure's change from the coarser runs is within the tolerance.
+    pub tolerance_met: bool,
+    /// The answer's time step (s) and segments.
+    pub time_step_s: f64,
+    pub segments: usize,
+    pub observed_orders: ObservedOrdersOutput,
+    /// Every run made, the answer's included, in the order run.
+    pub refinements: Vec<RefinementOutput>,
 }

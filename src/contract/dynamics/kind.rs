@@ -18,6 +18,8 @@ use crate::numerics::parallel::Parallelism;
 
 /// One kept sample: 7 numbers and their keys.
 pub const PER_DYNAMICS_SAMPLE: u64 = 7 * est::PER_NUMBER + 140;
+/// One run of the converged figures' refinement: 6 numbers and their keys.
+pub const PER_REFINEMENT: u64 = 6 * est::PER_NUMBER + 200;
 /// One shape node: 4 numbers and their keys.
 pub const PER_SHAPE_NODE: u64 = 4 * est::PER_NUMBER + 40;
 /// One Monte-Carlo sample's extremes: 9 values and their keys.
@@ -39,8 +41,11 @@ impl Analysis for DynamicsRequest {
         winch and top tensions and the aerostat's position, tether `shapes`\n\
         at evenly spaced times, `slack_events`, and the peak and minimum\n\
         tensions beside the quasi-static ones at the same wind.\n\
-        Synchronously at most 3 000 000 segment-steps (`duration_s /\n\
-        numerics.time_step_s × numerics.segments`), 20 000 samples and\n\
+        Its `converged` figures carry error estimates from runs at twice\n\
+        the step and half the segments; by default the step is chosen to\n\
+        meet `numerics.tolerance_nondim` (issue 31 item 2).\n\
+        Synchronously at most 3 000 000 segment-steps over every run\n\
+        (`duration_s / time step × segments`), 20 000 samples and\n\
         2 CPU-seconds as priced from the steps, segments and turbulence\n\
         field (`contract::price`); larger runs: a job with `\"kind\": \"dynamics\"`.";
     const ABOUT: &'static str = "The tether in time through a gust or turbulence, from rest in the static equilibrium of `wind.flow` (progress bar in time steps).";
@@ -53,12 +58,12 @@ impl Analysis for DynamicsRequest {
     }
     fn check_sync(&self, _: &Limits) -> Result<(), RequestError> {
         let prepared = DynamicsRequest::prepare(self)?;
-        if prepared.work() > MAX_SYNC_WORK {
+        if prepared.total_work() > MAX_SYNC_WORK {
             return Err(too_large(
                 "duration_s",
                 format!(
-                    "{:.0} segment-steps take too long to answer synchronously (at most {MAX_SYNC_WORK:e}): submit a job with \"kind\": \"dynamics\"",
-                    prepared.work()
+                    "{:.0} segment-steps (every run of the converged figures) take too long to answer synchronously (at most {MAX_SYNC_WORK:e}): submit a job with \"kind\": \"dynamics\"",
+                    prepared.total_work()
                 ),
             ));
         }
@@ -85,10 +90,15 @@ impl Analysis for DynamicsRequest {
                 .unwrap_or(crate::contract::dynamics::dto::DEFAULT_SHAPE_COUNT),
             Vec::len,
         ) as u64;
-        let nodes = shapes.saturating_mul(self.numerics.segments as u64 + 1);
+        let segments = self
+            .numerics
+            .segments
+            .unwrap_or(crate::contract::dynamics::validate::DEFAULT_SEGMENTS);
+        let nodes = shapes.saturating_mul(segments as u64 + 1);
         Estimate::new(
             "sample_count",
             est::SIMULATE_BASE
+                + PER_REFINEMENT * 8
                 + (self.sample_count as u64).saturating_mul(PER_DYNAMICS_SAMPLE)
                 + nodes.saturating_mul(PER_SHAPE_NODE)
                 + shapes * 64,

@@ -9,11 +9,14 @@
 //!   peaks beside the quasi-static tensions at the same wind);
 //! * [`validate`]: the checks (the schema's bounds) and the numerical
 //!   problem ([`crate::numerics::dynamics`]);
+//! * [`converged`]: the figures an operator acts on with their error
+//!   estimates, the step chosen to meet a tolerance (issue 31 item 2);
 //! * [`run`]: the run with progress and cancellation, the quasi-static
 //!   comparison (the §6 equilibrium with the flow changed by the run's
 //!   largest and smallest wind change);
 //! * [`peaks`]: the Monte Carlo, chunked by sample for the job queue.
 
+pub mod converged;
 pub mod dto;
 pub mod kind;
 pub mod peaks;
@@ -21,9 +24,9 @@ pub mod price;
 pub mod run;
 pub mod validate;
 
+pub use converged::dynamics;
 pub use dto::{DynamicsRequest, DynamicsResponse};
 pub use peaks::{DynamicsPeaksRequest, DynamicsPeaksResponse};
-pub use run::dynamics;
 
 use crate::contract::RequestError;
 

@@ -221,6 +221,15 @@ impl DynamicsPeaksRequest {
             *seed = seed.wrapping_add(i as u64);
         }
         let count = ((self.exposure_s * SAMPLES_PER_SECOND).ceil() as usize + 1).clamp(2, 100_001);
+        // One run per sample at a fixed discretisation (the answer is a
+        // distribution over seeds, not one converged history).
+        let mut numerics = self.numerics.clone();
+        numerics
+            .segments
+            .get_or_insert(super::validate::DEFAULT_SEGMENTS);
+        numerics
+            .time_step_s
+            .get_or_insert(super::validate::PEAKS_TIME_STEP_S);
         DynamicsRequest {
             cable: self.cable.clone(),
             aerostat: self.aerostat.clone(),
@@ -235,7 +244,7 @@ impl DynamicsPeaksRequest {
             wind_probe_height_m: None,
             internal_damping_n_s: self.internal_damping_n_s,
             tangential_drag_coefficient_nondim: self.tangential_drag_coefficient_nondim,
-            numerics: self.numerics.clone(),
+            numerics,
             gravity_m_s2: self.gravity_m_s2,
             required_safety_factor_nondim: self.required_safety_factor_nondim,
             winch: self.winch.clone(),

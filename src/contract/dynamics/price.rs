@@ -62,10 +62,11 @@ pub fn turbulence_field(p: &Prepared) -> (f64, f64) {
     (levels, samples)
 }
 
-/// CPU seconds of one dynamics run.
-pub fn dynamics_run_s(p: &Prepared) -> f64 {
-    let steps = p.steps as f64;
-    let segments = p.config.segments as f64;
+/// CPU seconds of one run of `steps` × `segments` (each run synthesises
+/// its turbulence field).
+fn one_run_s(p: &Prepared, steps: usize, segments: usize) -> f64 {
+    let steps = steps as f64;
+    let segments = segments as f64;
     let (levels, samples) = turbulence_field(p);
     let field = if samples > 0.0 {
         levels * samples * samples.log2().max(1.0) * DYNAMICS_FIELD_SAMPLE_S
@@ -75,15 +76,38 @@ pub fn dynamics_run_s(p: &Prepared) -> f64 {
     DYNAMICS_RUN_S + steps * DYNAMICS_STEP_S + steps * segments * DYNAMICS_SEGMENT_STEP_S + field
 }
 
+/// CPU seconds of one dynamics run at the prepared configuration (a
+/// `/dynamics/peaks` sample).
+pub fn dynamics_run_s(p: &Prepared) -> f64 {
+    one_run_s(p, p.steps, p.config.segments)
+}
+
+/// CPU seconds of a `/dynamics` request: every run it may make (issue 31
+/// item 2: the default ladder's 0.2, 0.1 and 0.05 s runs and the segment
+/// check, priced in full although it stops early when the figures agree;
+/// a fixed discretisation's run, the run at twice its step and the one at
+/// half its segments).
+pub fn dynamics_request_s(p: &Prepared) -> f64 {
+    p.planned_runs()
+        .iter()
+        .map(|&(steps, segments)| one_run_s(p, steps, segments))
+        .sum()
+}
+
 /// `POST /api/v1/dynamics`.
 pub fn dynamics(p: &Prepared) -> Price {
+    let runs = p.planned_runs();
+    let words: Vec<String> = runs
+        .iter()
+        .map(|(steps, segments)| format!("{steps} × {segments}"))
+        .collect();
     Price {
-        cpu_s: dynamics_run_s(p),
+        cpu_s: dynamics_request_s(p),
         field: "duration_s".into(),
         counts: format!(
-            "{} steps of {} segments{}",
-            p.steps,
-            p.config.segments,
+            "{} runs of steps × segments ({}){}",
+            runs.len(),
+            words.join(", "),
             field_words(p)
         ),
     }

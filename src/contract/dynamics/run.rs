@@ -6,8 +6,10 @@ use super::dto::*;
 use super::validate::Prepared;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::aero::SteadyFlow;
+use crate::numerics::dynamics::limits::step_count;
 use crate::numerics::dynamics::{
-    DynamicsError, DynamicsProblem, Outcome, Run, StepView, simulate_from, static_start,
+    DynamicsConfig, DynamicsError, DynamicsProblem, Outcome, Run, StepView, simulate_from,
+    static_start,
 };
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::{Equilibrium, EquilibriumConfig, WindProfile};
@@ -80,38 +82,59 @@ pub fn equilibrium_at(
     .ok()
 }
 
-/// A run and the force its static start left (N).
+/// A run, its configuration and steps, and the force its static start left (N).
 pub struct Ran {
     pub run: Run,
+    pub config: DynamicsConfig,
+    pub steps: usize,
     pub start_residual_n: f64,
 }
 
 /// Runs a prepared problem from its static start, reporting steps done.
 pub fn run_prepared(prepared: &Prepared, progress: &dyn Progress) -> Result<Ran, RequestError> {
+    run_with(
+        prepared,
+        prepared.config.clone(),
+        progress,
+        0,
+        prepared.steps,
+    )
+}
+
+/// Runs `config` on the prepared problem from its static start; progress
+/// counts `done_before` steps already made of `total`.
+pub fn run_with(
+    prepared: &Prepared,
+    config: DynamicsConfig,
+    progress: &dyn Progress,
+    done_before: usize,
+    total: usize,
+) -> Result<Ran, RequestError> {
     let p = &prepared.problem;
-    let c = &prepared.config;
     if progress.cancelled() {
         return Err(RequestError::Cancelled);
     }
-    let start = static_start(p, c.segments)?;
+    let start = static_start(p, config.segments)?;
     let start_residual_n = start.residual_n;
-    let total = prepared.steps;
+    let steps = step_count(config.duration_s, config.time_step_s) as usize;
     let mut done = 0usize;
     let mut observer = |_: &StepView| {
         done += 1;
         if done.is_multiple_of(REPORT_EVERY) {
-            progress.report(done.min(total), total);
+            progress.report((done_before + done).min(total), total);
             return !progress.cancelled();
         }
         true
     };
-    let run = simulate_from(p, c, start.state, start.equilibrium, &mut observer)?;
+    let run = simulate_from(p, &config, start.state, start.equilibrium, &mut observer)?;
     if let Outcome::Stopped { .. } = run.outcome {
         return Err(RequestError::Cancelled);
     }
-    progress.report(total, total);
+    progress.report((done_before + steps).min(total), total);
     Ok(Ran {
         run,
+        config,
+        steps,
         start_residual_n,
     })
 }
@@ -134,21 +157,16 @@ fn wind_change_range(problem: &DynamicsProblem, run: &Run, duration_s: f64) -> (
     (hi, lo)
 }
 
-/// Answers one dynamics request.
-pub fn dynamics(
+/// The answer of a run, with its converged figures.
+pub fn response(
     req: &DynamicsRequest,
-    progress: &dyn Progress,
-) -> Result<DynamicsResponse, RequestError> {
-    let prepared = req.prepare()?;
-    let ran = run_prepared(&prepared, progress)?;
-    Ok(response(req, &prepared, &ran))
-}
-
-/// The answer of a run.
-pub fn response(req: &DynamicsRequest, prepared: &Prepared, ran: &Ran) -> DynamicsResponse {
+    prepared: &Prepared,
+    ran: &Ran,
+    converged: DynamicsConvergedOutput,
+) -> DynamicsResponse {
     let run = &ran.run;
     let p = &prepared.problem;
-    let c = &prepared.config;
+    let c = &ran.config;
     let (max_change, min_change) = wind_change_range(p, run, c.duration_s);
     let at_max = equilibrium_at(
         p,
@@ -175,19 +193,17 @@ pub fn response(req: &DynamicsRequest, prepared: &Prepared, ran: &Ran) -> Dynami
     // A run that did not complete gives no final figure.
     let partial = outcome != DynamicsOutcomeOutput::Completed;
     let peak = run.peak_winch_tension.value;
+    // The factors an operator acts on: from the safe side of the peaks.
+    let safe_peak = converged.peak_winch_tension_n.safe_value;
     let dynamic_factor = at_max
         .as_ref()
         .filter(|e| e.winch_tension_n > 0.0 && !partial)
-        .map(|e| peak / e.winch_tension_n);
+        .map(|e| safe_peak / e.winch_tension_n);
     let safety = prepared
         .breaking_strength_n
         .filter(|_| !partial)
-        .map(|b| b / run.peak_tension.value);
-    let min_altitude = run
-        .samples
-        .iter()
-        .map(|s| s.aerostat_altitude_m)
-        .fold(f64::INFINITY, f64::min);
+        .map(|b| b / converged.peak_tension_n.safe_value);
+    let min_altitude = run.min_aerostat_altitude.value;
     let params = p.parameters(c.segments);
     let quasi_static = QuasiStaticOutput {
         start_winch_tension_n: run
@@ -262,6 +278,7 @@ pub fn response(req: &DynamicsRequest, prepared: &Prepared, ran: &Ran) -> Dynami
         wind_probe_height_m: run.wind_probe[1],
         wind_probe_downwind_m: run.wind_probe[0],
         quasi_static,
+        converged,
         dynamic_factor_nondim: dynamic_factor,
         safety_factor_nondim: safety,
         required_safety_factor_nondim: req.required_safety_factor_nondim,
@@ -269,7 +286,7 @@ pub fn response(req: &DynamicsRequest, prepared: &Prepared, ran: &Ran) -> Dynami
         explanation,
         numerics: DynamicsNumericsOutput {
             segments: c.segments,
-            time_step_s: c.duration_s / prepared.steps as f64,
+            time_step_s: c.duration_s / ran.steps as f64,
             spectral_radius_nondim: c.spectral_radius,
             steps: run.statistics.steps,
             newton_iterations: run.statistics.newton_iterations,

@@ -10,9 +10,11 @@ use super::dto::*;
 use crate::contract::system::WindFlowInput;
 use crate::contract::system::bounds;
 use crate::contract::system::validate::{check_rest, require_range};
+use crate::numerics::dynamics::converged;
+use crate::numerics::dynamics::limits::MIN_SEGMENTS;
 use crate::numerics::dynamics::limits::{
     check_sample_count, check_segments, check_shape_count, check_shape_times,
-    check_spectral_radius, check_steps,
+    check_spectral_radius, check_steps, step_count,
 };
 use crate::numerics::dynamics::{
     Aerostat, DynamicsConfig, DynamicsProblem, GustHistory, LengthSchedule, SpectrumModel, Tether,
@@ -30,21 +32,79 @@ pub const MIN_LENGTH_M: f64 = 1.0;
 /// Largest seed (2^53 − 1: exact in every JSON reader).
 pub const MAX_SEED: u64 = (1 << 53) - 1;
 
+/// Segments when the request leaves them out.
+pub const DEFAULT_SEGMENTS: usize = 50;
+/// The coarsest default step (s): the ladder starts here.
+pub const BASE_TIME_STEP_S: f64 = 0.2;
+/// Steps of the default ladder: the base, halved, halved again (0.2, 0.1,
+/// 0.05 s): its finest is the former fixed default, so a default answer
+/// costs at most 2.25 times what the former default run did (its runs
+/// at 0.2 + 0.1 + 0.05 s and the segment check at 0.05 s on half the
+/// segments: 1 + 2 + 4 + 2 units of the 0.2 s run, against 4).
+pub const DEFAULT_LEVELS: usize = 3;
+/// The step of `/dynamics/peaks` samples without a `numerics.time_step_s` (s).
+pub const PEAKS_TIME_STEP_S: f64 = 0.05;
+
+/// How the step and segments are chosen ([`super::converged`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ladder {
+    /// Steps of the runs, coarse to fine, each half the one before
+    /// (default: from [`BASE_TIME_STEP_S`], stopping at the first that
+    /// agrees with the one before; fixed: twice the request's, the
+    /// request's).
+    pub time_steps_s: Vec<f64>,
+    /// Segments of every run but the segment check.
+    pub segments: usize,
+    /// Segments of the segment check at the answer's step (half, at least
+    /// 2; equal to `segments`: no check).
+    pub check_segments: usize,
+    pub tolerance: f64,
+    /// Whether the tolerance chooses the step (the request fixed neither
+    /// `numerics.segments` nor `numerics.time_step_s`).
+    pub enforced: bool,
+}
+
 /// A validated request: the problem, the configuration, and what the
 /// answer needs beside them.
 #[derive(Clone, Debug)]
 pub struct Prepared {
     pub problem: DynamicsProblem,
+    /// The configuration of the finest run (the answer's when fixed).
     pub config: DynamicsConfig,
     pub breaking_strength_n: Option<f64>,
-    /// Steps of the run.
+    /// Steps of the finest run.
     pub steps: usize,
+    pub ladder: Ladder,
 }
 
 impl Prepared {
-    /// Segment-steps of the run (its cost).
+    /// Segment-steps of the finest run.
     pub fn work(&self) -> f64 {
         self.steps as f64 * self.config.segments as f64
+    }
+
+    /// Every run the request may make, `(steps, segments)`: the ladder's
+    /// steps and the segment check at the finest.
+    pub fn planned_runs(&self) -> Vec<(usize, usize)> {
+        let d = self.config.duration_s;
+        let mut runs: Vec<(usize, usize)> = self
+            .ladder
+            .time_steps_s
+            .iter()
+            .map(|&h| (step_count(d, h) as usize, self.ladder.segments))
+            .collect();
+        if self.ladder.check_segments != self.ladder.segments {
+            runs.push((self.steps, self.ladder.check_segments));
+        }
+        runs
+    }
+
+    /// Segment-steps of every run the request may make.
+    pub fn total_work(&self) -> f64 {
+        self.planned_runs()
+            .iter()
+            .map(|&(s, n)| s as f64 * n as f64)
+            .sum()
     }
 }
 
@@ -240,6 +300,18 @@ impl DynamicsRequest {
         Ok(())
     }
 
+    /// The coarsest default step (s): [`BASE_TIME_STEP_S`], or a quarter
+    /// of the shortest gust or sinusoid period when that is shorter (each
+    /// step of the ladder then resolves it with at least four steps).
+    fn base_time_step(&self) -> f64 {
+        let feature = match self.wind.time_history {
+            Some(TimeHistoryInput::OneMinusCosine { duration_s, .. }) => duration_s,
+            Some(TimeHistoryInput::Sinusoid { period_s, .. }) => period_s,
+            _ => f64::INFINITY,
+        };
+        BASE_TIME_STEP_S.min(0.25 * feature).max(1e-4)
+    }
+
     /// The gusts and turbulence of the time history over `flow`;
     /// `start_altitude_m` is where a tabulated flow's speed is read.
     fn wind_in_time(
@@ -325,11 +397,44 @@ impl DynamicsRequest {
         check_rest(self.winch.as_ref(), None, self.lift_reserve_nondim)?;
         let duration = require_range("duration_s", self.duration_s, 0.0, true, MAX_DURATION_S)?;
         let n = &self.numerics;
-        let segments = check_segments("numerics.segments", n.segments)?;
-        let dt = require_range("numerics.time_step_s", n.time_step_s, 1e-4, false, 10.0)?;
+        let segments = check_segments("numerics.segments", n.segments.unwrap_or(DEFAULT_SEGMENTS))?;
+        let tolerance = require_range(
+            "numerics.tolerance_nondim",
+            n.tolerance_nondim.unwrap_or(converged::DEFAULT_TOLERANCE),
+            converged::MIN_TOLERANCE,
+            false,
+            converged::MAX_TOLERANCE,
+        )?;
+        let enforced = n.segments.is_none() && n.time_step_s.is_none();
+        let time_steps_s = match n.time_step_s {
+            Some(dt) => {
+                let dt = require_range("numerics.time_step_s", dt, 1e-4, false, 10.0)?;
+                vec![2.0 * dt, dt]
+            }
+            None => {
+                let h0 = self.base_time_step();
+                if enforced {
+                    (0..DEFAULT_LEVELS)
+                        .map(|k| h0 * 0.5f64.powi(k as i32))
+                        .collect()
+                } else {
+                    // Segments fixed, the step not: the finest default step.
+                    let h = h0 * 0.5f64.powi(DEFAULT_LEVELS as i32 - 1);
+                    vec![2.0 * h, h]
+                }
+            }
+        };
+        let dt = *time_steps_s.last().expect("a step");
         let rho_inf =
             check_spectral_radius("numerics.spectral_radius_nondim", n.spectral_radius_nondim)?;
         let steps = check_steps("duration_s", "numerics.time_step_s", duration, dt, segments)?;
+        let ladder = Ladder {
+            time_steps_s,
+            segments,
+            check_segments: (segments / 2).max(MIN_SEGMENTS),
+            tolerance,
+            enforced,
+        };
         let count = check_sample_count("sample_count", self.sample_count)?;
         let sample_interval = duration / (count - 1) as f64;
         let shape_times = match &self.shape_times_s {
@@ -425,6 +530,7 @@ impl DynamicsRequest {
             config,
             breaking_strength_n,
             steps,
+            ladder,
         })
     }
 }

@@ -10,6 +10,8 @@
 //! * [`wind`]: discrete gusts, the sinusoid, seeded turbulence;
 //! * `start`: the static start; `integrator`: the step; `outputs`:
 //!   samples, shapes, slack, extremes; `run`: the loop;
+//! * [`converged`]: the figures an operator acts on, compared between
+//!   steps: their changes, error estimates, safe sides and observed order;
 //! * [`reference`]: the issue-23 reference tether and its gust and
 //!   turbulence cases (shared by the tests, the MoorDyn peer and the bench).
 //!
@@ -44,6 +46,7 @@
 //! not start with a spurious transient.
 
 pub mod blocks;
+pub mod converged;
 mod integrator;
 pub mod limits;
 pub mod model;

@@ -68,6 +68,8 @@ pub(super) struct Recorder {
     pub peak_winch: Extreme,
     pub min_winch: Extreme,
     pub peak: Extreme,
+    /// Lowest aerostat altitude at any step (m).
+    pub min_altitude: Extreme,
     sample_interval_s: f64,
     next_sample: f64,
     shape_times: Vec<f64>,
@@ -96,6 +98,7 @@ impl Recorder {
             peak_winch: start(f64::NEG_INFINITY),
             min_winch: start(f64::INFINITY),
             peak: start(f64::NEG_INFINITY),
+            min_altitude: start(f64::INFINITY),
             sample_interval_s,
             next_sample: t0,
             shape_times,
@@ -157,6 +160,12 @@ impl Recorder {
             _ => {}
         }
         let top = x[n - 1];
+        if top[1] < self.min_altitude.value {
+            self.min_altitude = Extreme {
+                value: top[1],
+                time_s: t,
+            };
+        }
         let eps = 1e-9 * self.sample_interval_s;
         if force_sample || t >= self.next_sample - eps {
             self.samples.push(Sample {

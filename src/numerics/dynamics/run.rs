@@ -27,6 +27,8 @@ pub struct Run {
     pub min_winch_tension: Extreme,
     /// Largest segment tension anywhere (N).
     pub peak_tension: Extreme,
+    /// Lowest aerostat altitude at any step (m).
+    pub min_aerostat_altitude: Extreme,
     pub final_state: State,
     pub statistics: Statistics,
     /// The fixed point `(x, z)` where [`Sample::probe_wind_m_s`] is read (m).
@@ -203,6 +205,7 @@ pub fn simulate_from(
         peak_winch_tension: rec.peak_winch,
         min_winch_tension: rec.min_winch,
         peak_tension: rec.peak,
+        min_aerostat_altitude: rec.min_altitude,
         statistics: st.stats,
         wind_probe,
         final_state: State {
