@@ -26,6 +26,7 @@ use crate::contract::dynamics::dto::{
 };
 use crate::contract::dynamics::run::run_prepared;
 use crate::contract::dynamics::validate::Prepared as DynamicsPrepared;
+use crate::contract::dynamics::validate::{DEFAULT_SEGMENTS, PEAKS_TIME_STEP_S};
 use crate::contract::error::Progress;
 use crate::contract::flight::dto::{CreateFlightRequest, FlightLimitsOutput};
 use crate::contract::flight::model::{PreparedFlight, prepare_with};
@@ -168,7 +169,10 @@ impl SimulateFlightRequest {
                 format!("must be above 0 and at most 10000 Hz, got {rate}"),
             ));
         }
-        let step = self.numerics.time_step_s;
+        // one run at the fixed step (a telemetry log, not a converged figure)
+        let mut numerics = self.numerics.clone();
+        let step = *numerics.time_step_s.get_or_insert(PEAKS_TIME_STEP_S);
+        numerics.segments.get_or_insert(DEFAULT_SEGMENTS);
         if step.is_finite() && step > 0.0 && rate * step > 1.0 + 1e-9 {
             return Err(invalid(
                 "sample_rate_hz",
@@ -257,7 +261,7 @@ impl SimulateFlightRequest {
             internal_damping_n_s: 0.0,
             wind_probe_height_m: Some(flight.limits.anemometer_height_m),
             tangential_drag_coefficient_nondim: 0.0,
-            numerics: self.numerics.clone(),
+            numerics,
             gravity_m_s2: req.gravity_m_s2,
             required_safety_factor_nondim: req.required_safety_factor_nondim,
             winch: Some(req.winch.clone()),
