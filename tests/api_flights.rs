@@ -126,6 +126,12 @@ async fn a_flight_belongs_to_its_token_and_its_monitor_raises_and_latches() {
     }
     let (_, list) = as_json(&app, "alpha", "GET", "/api/v1/flights", None).await;
     assert_eq!(list["flights"][0]["id"], id);
+    // the committed plan, as the creation answered it; not to another token
+    let (s, plan) = as_json(&app, "alpha", "GET", &format!("{uri}/plan"), None).await;
+    assert_eq!(s, StatusCode::OK);
+    assert_eq!(plan, created["plan"]);
+    let (s, _) = send_as(&app, "beta", "GET", &format!("{uri}/plan"), None).await;
+    assert_eq!(s, StatusCode::NOT_FOUND);
 
     // 1000 N for 2 s: normal; then 4400 N (past 4000: stop) for 2 s; then
     // 1000 N for 10 s: the stop clears after 5 s but stays latched

@@ -211,6 +211,12 @@ fn every_route_is_documented_with_its_statuses() {
         ),
         (
             "get",
+            "/api/v1/flights/{id}/plan",
+            "flight_plan",
+            &["200", "401", "404", "500"],
+        ),
+        (
+            "get",
             "/api/v1/flights",
             "list_flights",
             &["200", "401", "500"],

@@ -29,7 +29,7 @@ pub(super) fn owner(caller: &Caller) -> String {
     caller.owner.clone().unwrap_or_default()
 }
 
-fn parse_id(id: &str) -> Result<i64, ApiError> {
+pub(super) fn parse_id(id: &str) -> Result<i64, ApiError> {
     id.parse::<i64>()
         .map_err(|_| ApiError::not_found(format!("no flight with id `{id}`")))
 }
@@ -153,6 +153,35 @@ pub async fn list_flights(
         })
         .collect();
     Ok(json_response(StatusCode::OK, &FlightListOutput { flights }))
+}
+
+/// The flight's committed plan, as its creation answered it.
+#[utoipa::path(
+    get, path = "/api/v1/flights/{id}/plan", operation_id = "flight_plan", tag = "flights",
+    params(("id" = i64, Path, description = "Flight id")),
+    responses(
+        (status = 200, description = "The committed plan", body = crate::contract::plan::PlanResponse),
+        (status = 404, description = "No such flight for this token", body = ErrorBody),
+        (status = 500, description = "Store failure", body = ErrorBody),
+    )
+)]
+pub async fn flight_plan(
+    State(app): State<AppState>,
+    Extension(caller): Extension<Caller>,
+    Path(id): Path<String>,
+) -> Result<Response, ApiError> {
+    let id = parse_id(&id)?;
+    let hub = app.flights.clone();
+    let owner = owner(&caller);
+    let row = blocking(move || hub.store.get_flight(id, &owner).map_err(ApiError::from))
+        .await?
+        .ok_or_else(|| ApiError::not_found(format!("no flight with id `{id}`")))?;
+    let mut resp = Response::new(axum::body::Body::from(row.plan));
+    resp.headers_mut().insert(
+        header::CONTENT_TYPE,
+        header::HeaderValue::from_static("application/json"),
+    );
+    Ok(resp)
 }
 
 /// A flight: its state, checks and alarms.

@@ -28,6 +28,7 @@ pub fn routes() -> Router<AppState> {
         .route("/api/v1/flights/simulate", post(tools::simulate_flight))
         .route("/api/v1/flights/{id}", get(handlers::get_flight))
         .route("/api/v1/flights/{id}/report", get(tools::flight_report))
+        .route("/api/v1/flights/{id}/plan", get(handlers::flight_plan))
         .route("/api/v1/flights/{id}/end", post(handlers::end_flight))
         .route(
             "/api/v1/flights/{id}/telemetry",
@@ -47,6 +48,7 @@ pub fn routes() -> Router<AppState> {
         handlers::create_flight,
         handlers::list_flights,
         handlers::get_flight,
+        handlers::flight_plan,
         handlers::end_flight,
         handlers::post_telemetry,
         handlers::acknowledge_alarms,
