@@ -14,8 +14,8 @@
 // Authorization header, which EventSource cannot send: with a token the
 // same stream is read with fetch, sending Last-Event-ID as a browser would.
 // Figures are shown in the page's units (shared/units.js). The committed
-// plan is the answer to the POST: it is kept in this browser (localStorage)
-// for the flights started here; the API does not give it back.
+// plan is the answer to the POST, kept in this browser (localStorage); a
+// flight opened in another browser reads it from GET …/plan.
 "use strict";
 
 import S from "./shared/index.js";
@@ -124,6 +124,11 @@ import { linePlot } from "./live_plot.js";
     Object.assign(st, { id, flight: null, samples: [], lastSeq: 0, stream: null, replan: null, local: false });
     st.plan = plan || storedPlan(id);
     showError("");
+    if (!st.plan) {
+      // opened in another browser: the committed plan from the server
+      const p = await S.api("GET", `api/v1/flights/${encodeURIComponent(id)}/plan`);
+      if (p.ok && st.id === id) st.plan = keepPlan(id, p.body);
+    }
     const r = await S.api("GET", `api/v1/flights/${encodeURIComponent(id)}`);
     if (!r.ok || st.id !== id) {
       if (!r.ok) S.renderApiError(roots, r.status, r.body, $("live-error"), SOURCE);

@@ -227,6 +227,12 @@ try {
   await small.selectOption("#live-flights", String(id));
   await small.click("#live-open");
   await small.waitForFunction(() => document.querySelector("#live-light").dataset.state !== "none", null, { timeout: 10_000 });
+  // a new browser holds no copy of the plan: it is read from GET …/plan
+  const planLine = await small.evaluate(() => ({
+    note: document.querySelector("#live-plan-note").hidden,
+    points: Number(document.querySelector("#live-corridor path.line.plan")?.dataset.points || 0),
+  }));
+  check(planLine.note && planLine.points > 1, `a flight opened in another browser draws its committed plan (${planLine.points} points, from GET …/plan)`);
   await small.evaluate(() => document.querySelector("#live").scrollIntoView({ block: "start" }));
   const fit = await small.evaluate(() => ({ overflow: document.documentElement.scrollWidth - window.innerWidth, bottom: document.querySelector("#live-light").getBoundingClientRect().bottom, h: window.innerHeight }));
   check(fit.overflow <= 0, `no horizontal scrolling at 390 px (overflow ${fit.overflow} px)`);
