@@ -4,8 +4,6 @@
 //! `Last-Event-ID`, the re-plan, and a real server killed with SIGKILL
 //! and restarted on the same database answering the same flight.
 
-use std::path::Path;
-use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
 use axum::body::Body;
@@ -15,7 +13,8 @@ use serde_json::{Value, json};
 use tower::ServiceExt;
 
 mod common;
-use common::http::{connect, exchange, spawn_listening};
+use common::flights::{batch, comparable};
+use common::http::ServeProcess;
 use common::{app_with_tokens, request, send_as};
 
 /// A calm-air plan to 300 m: allowed tension 20 000 / 5 = 4000 N, net
@@ -32,20 +31,6 @@ fn flight_body(name: &str) -> Value {
         "required_safety_factor_nondim": 5.0,
         "limits": {"max_operating_wind_m_s": 12.0, "max_gust_m_s": 18.0, "stale_after_s": 3600.0}
     })
-}
-
-/// 10 Hz samples from `t0` for `n` samples with tension `f(t)`, the
-/// length on the plan's first seconds (1 m), 5 m/s of wind.
-fn batch(t0: f64, n: usize, f: impl Fn(f64) -> f64) -> Value {
-    Value::Array(
-        (0..n)
-            .map(|k| {
-                let t = ((t0 * 10.0).round() as i64 + k as i64) as f64 / 10.0;
-                json!({"time_s": t, "tether_length_m": 1.0, "winch_rate_m_s": 0.0,
-                       "winch_tension_n": f(t), "wind_speed_m_s": 5.0})
-            })
-            .collect(),
-    )
 }
 
 async fn send_body(
@@ -460,61 +445,12 @@ async fn the_replan_starts_from_the_measured_length() {
     assert_eq!(r["plan"]["schedule"][0]["length_m"], 100.0);
 }
 
-/// A real server on a database file.
-struct Server {
-    child: Child,
-    addr: std::net::SocketAddr,
-}
-
-impl Server {
-    fn start(dir: &Path) -> Self {
-        let (child, addr) = spawn_listening(
-            Command::new(env!("CARGO_BIN_EXE_tetherplan"))
-                .args(["serve", "--addr", "127.0.0.1:0"])
-                .arg("--db")
-                .arg(dir.join("flights.db"))
-                .env("RUST_LOG", "warn")
-                .env("TETHERPLAN_JOB_THREADS", "1")
-                .env_remove("TETHERPLAN_API_TOKENS")
-                .env_remove("TETHERPLAN_DATABASE_URL")
-                .stderr(Stdio::inherit()),
-        );
-        Self { child, addr }
-    }
-
-    fn send(&self, method: &str, path: &str, ct: &str, body: &[u8]) -> (u16, Value) {
-        let s = connect(self.addr, Duration::from_secs(60));
-        let r = exchange(s, method, path, &self.addr.to_string(), Some(ct), body);
-        (
-            r.status,
-            serde_json::from_str(&r.body).unwrap_or(Value::Null),
-        )
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-/// The flight without what depends on the server's clock.
-fn comparable(mut f: Value) -> Value {
-    f.as_object_mut()
-        .unwrap()
-        .remove("seconds_since_last_sample_s");
-    let checks = f["checks"].as_array_mut().unwrap();
-    checks.retain(|c| c["name"] != "data");
-    f
-}
-
 #[test]
 fn a_server_killed_with_sigkill_keeps_every_acknowledged_sample_and_its_state() {
     let dir = std::env::temp_dir().join(format!("tetherplan-flight-kill-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let mut server = Server::start(&dir);
+    let mut server = ServeProcess::start(["--db".as_ref(), dir.join("flights.db").as_os_str()]);
     let (s, created) = server.send(
         "POST",
         "/api/v1/flights",
@@ -555,9 +491,8 @@ fn a_server_killed_with_sigkill_keeps_every_acknowledged_sample_and_its_state() 
     assert_eq!(before["state"], "caution", "{before}");
     assert_eq!(before["samples_received"], 160);
     // SIGKILL: no shutdown of any kind
-    server.child.kill().unwrap();
-    server.child.wait().unwrap();
-    let server = Server::start(&dir);
+    server.kill();
+    let server = ServeProcess::start(["--db".as_ref(), dir.join("flights.db").as_os_str()]);
     let (s, after) = server.send("GET", &uri, "application/json", b"");
     assert_eq!(s, 200);
     assert_eq!(comparable(after.clone()), comparable(before.clone()));

@@ -23,7 +23,7 @@ use rumqttc::{AsyncClient, MqttOptions, QoS};
 use serde_json::{Value, json};
 
 mod common;
-use common::http::{connect, exchange, spawn_listening};
+use common::http::ServeProcess;
 
 fn free_port() -> u16 {
     TcpListener::bind("127.0.0.1:0")
@@ -80,63 +80,23 @@ impl Drop for Broker {
 }
 
 /// A `tetherplan serve` on a database file, fed from the broker.
-struct Server {
-    child: Child,
-    addr: std::net::SocketAddr,
+fn start_server(dir: &Path, port: u16, client_id: &str) -> ServeProcess {
+    let url = format!("mqtt://127.0.0.1:{port}");
+    ServeProcess::start([
+        "--db".as_ref(),
+        dir.join("flights.db").as_os_str(),
+        "--mqtt-url".as_ref(),
+        url.as_ref(),
+        "--mqtt-client-id".as_ref(),
+        client_id.as_ref(),
+    ])
 }
 
-impl Server {
-    fn start(dir: &Path, port: u16, client_id: &str) -> Self {
-        let (child, addr) = spawn_listening(
-            Command::new(env!("CARGO_BIN_EXE_tetherplan"))
-                .args(["serve", "--addr", "127.0.0.1:0"])
-                .arg("--db")
-                .arg(dir.join("flights.db"))
-                .args(["--mqtt-url", &format!("mqtt://127.0.0.1:{port}")])
-                .args(["--mqtt-client-id", client_id])
-                .env("RUST_LOG", "warn")
-                .env("TETHERPLAN_JOB_THREADS", "1")
-                .env_remove("TETHERPLAN_API_TOKENS")
-                .env_remove("TETHERPLAN_DATABASE_URL")
-                .env_remove("TETHERPLAN_MQTT_TOPIC_PREFIX")
-                .stderr(Stdio::inherit()),
-        );
-        Self { child, addr }
-    }
-
-    fn send(&self, method: &str, path: &str, body: &Value) -> (u16, Value) {
-        let s = connect(self.addr, Duration::from_secs(60));
-        let bytes = if body.is_null() {
-            Vec::new()
-        } else {
-            body.to_string().into_bytes()
-        };
-        let r = exchange(
-            s,
-            method,
-            path,
-            &self.addr.to_string(),
-            Some("application/json"),
-            &bytes,
-        );
-        (
-            r.status,
-            serde_json::from_str(&r.body).unwrap_or(Value::Null),
-        )
-    }
-
-    fn samples(&self, uri: &str) -> u64 {
-        let (s, f) = self.send("GET", uri, &Value::Null);
-        assert_eq!(s, 200, "{f}");
-        f["samples_received"].as_u64().unwrap()
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
+/// The samples the flight at `uri` holds.
+fn samples(server: &ServeProcess, uri: &str) -> u64 {
+    let (s, f) = server.send_json("GET", uri, &Value::Null);
+    assert_eq!(s, 200, "{f}");
+    f["samples_received"].as_u64().unwrap()
 }
 
 /// Ten samples at 10 Hz from second `k`, as a JSON array.
@@ -168,10 +128,10 @@ fn csv_message(k: usize) -> Vec<u8> {
 }
 
 /// Polls until the flight holds `n` samples (and no more, ever).
-fn wait_for(server: &Server, uri: &str, n: u64, within: Duration) {
+fn wait_for(server: &ServeProcess, uri: &str, n: u64, within: Duration) {
     let start = Instant::now();
     loop {
-        let got = server.samples(uri);
+        let got = samples(server, uri);
         assert!(
             got <= n,
             "{got} samples stored, more than the {n} published"
@@ -202,8 +162,8 @@ fn mqtt_telemetry_survives_a_broker_restart_and_a_killed_server() {
     let port = free_port();
     let client_id = format!("tetherplan-test-{}", std::process::id());
     let mut broker = Broker::start(&bin, &dir, port);
-    let mut server = Server::start(&dir, port, &client_id);
-    let (s, created) = server.send(
+    let mut server = start_server(&dir, port, &client_id);
+    let (s, created) = server.send_json(
         "POST",
         "/api/v1/flights",
         &json!({
@@ -240,9 +200,9 @@ fn mqtt_telemetry_survives_a_broker_restart_and_a_killed_server() {
     };
     // Sends second 0 until it is stored: the server's subscription is live
     // (a repeat stores nothing: the same time_s).
-    let until_subscribed = |server: &Server, k: usize, stored: u64| {
+    let until_subscribed = |server: &ServeProcess, k: usize, stored: u64| {
         let start = Instant::now();
-        while server.samples(&uri) < stored + 10 {
+        while samples(server, &uri) < stored + 10 {
             assert!(
                 start.elapsed() < Duration::from_secs(30),
                 "the server never subscribed"
@@ -263,7 +223,7 @@ fn mqtt_telemetry_survives_a_broker_restart_and_a_killed_server() {
         publish(payload);
     }
     wait_for(&server, &uri, 200, Duration::from_secs(30));
-    let (_, f) = server.send("GET", &uri, &Value::Null);
+    let (_, f) = server.send_json("GET", &uri, &Value::Null);
     assert_eq!(f["last_sample_time_s"], 19.9, "{f}");
 
     // 2. the broker restarts and forgets the subscription
@@ -276,16 +236,15 @@ fn mqtt_telemetry_survives_a_broker_restart_and_a_killed_server() {
     wait_for(&server, &uri, 400, Duration::from_secs(30));
 
     // 3. the server is killed; the broker keeps its session's messages
-    server.child.kill().unwrap();
-    server.child.wait().unwrap();
+    server.kill();
     for k in 40..60 {
         publish(json_message(k));
     }
     // the broker has them all (the publisher's QoS 1 acknowledgements)
     std::thread::sleep(Duration::from_millis(500));
-    server = Server::start(&dir, port, &client_id);
+    server = start_server(&dir, port, &client_id);
     wait_for(&server, &uri, 600, Duration::from_secs(30));
-    let (_, f) = server.send("GET", &uri, &Value::Null);
+    let (_, f) = server.send_json("GET", &uri, &Value::Null);
     assert_eq!(f["last_sample_time_s"], 59.9, "{f}");
     assert_eq!(f["state"], "normal", "{f}");
     drop(broker);

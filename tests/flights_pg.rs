@@ -12,9 +12,6 @@
 //! Each test uses a database of its own (`common::pg`); without PostgreSQL
 //! they skip, unless `CI` is set.
 
-use std::process::{Child, Command, Stdio};
-use std::time::Duration;
-
 use serde_json::{Value, json};
 use tetherplan::jobs::flights::{FlightStore, NewFlight};
 use tetherplan::jobs::flights_sqlite::SqliteFlights;
@@ -22,7 +19,8 @@ use tetherplan::jobs::postgres::PgStore;
 use tetherplan::numerics::monitor::Sample;
 
 mod common;
-use common::http::{connect, exchange, spawn_listening};
+use common::flights::{batch, comparable};
+use common::http::ServeProcess;
 use common::pg::TestDb;
 
 fn sample(t: f64, tension: f64) -> Sample {
@@ -159,89 +157,15 @@ fn the_postgres_flight_store_answers_as_the_sqlite_one() {
     assert_eq!(version, 5);
 }
 
-/// A `tetherplan serve` on the database, killed (SIGKILL) when dropped.
-struct Server {
-    child: Child,
-    addr: std::net::SocketAddr,
-}
-
-impl Server {
-    fn start(url: &str) -> Self {
-        let (child, addr) = spawn_listening(
-            Command::new(env!("CARGO_BIN_EXE_tetherplan"))
-                .args(["serve", "--addr", "127.0.0.1:0", "--database-url", url])
-                .env("RUST_LOG", "warn")
-                .env("TETHERPLAN_JOB_THREADS", "1")
-                .env_remove("TETHERPLAN_API_TOKENS")
-                .env_remove("TETHERPLAN_DB")
-                .stderr(Stdio::inherit()),
-        );
-        Self { child, addr }
-    }
-
-    fn send(&self, method: &str, path: &str, body: &Value) -> (u16, Value) {
-        let s = connect(self.addr, Duration::from_secs(60));
-        let bytes = if body.is_null() {
-            Vec::new()
-        } else {
-            body.to_string().into_bytes()
-        };
-        let r = exchange(
-            s,
-            method,
-            path,
-            &self.addr.to_string(),
-            Some("application/json"),
-            &bytes,
-        );
-        (
-            r.status,
-            serde_json::from_str(&r.body).unwrap_or(Value::Null),
-        )
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-/// 10 Hz samples from `t0`, tension `f(t)`.
-fn batch(t0: f64, n: usize, f: impl Fn(f64) -> f64) -> Value {
-    Value::Array(
-        (0..n)
-            .map(|k| {
-                let t = ((t0 * 10.0).round() as i64 + k as i64) as f64 / 10.0;
-                json!({"time_s": t, "tether_length_m": 1.0, "winch_rate_m_s": 0.0,
-                       "winch_tension_n": f(t), "wind_speed_m_s": 5.0})
-            })
-            .collect(),
-    )
-}
-
-/// The flight without what depends on the server's clock.
-fn comparable(mut f: Value) -> Value {
-    f.as_object_mut()
-        .unwrap()
-        .remove("seconds_since_last_sample_s");
-    f["checks"]
-        .as_array_mut()
-        .unwrap()
-        .retain(|c| c["name"] != "data");
-    f
-}
-
 #[test]
 fn a_flight_fed_through_one_api_process_is_served_by_another_after_a_sigkill() {
     let Some(db) = TestDb::create("flight_failover") else {
         return;
     };
-    let a = Server::start(&db.url);
-    let b = Server::start(&db.url);
+    let a = ServeProcess::start(["--database-url", db.url.as_str()]);
+    let b = ServeProcess::start(["--database-url", db.url.as_str()]);
     // allowed tension 20 000 / 5 = 4000 N: caution above 3200 N, stop above 4000 N
-    let (s, created) = a.send(
+    let (s, created) = a.send_json(
         "POST",
         "/api/v1/flights",
         &json!({
@@ -269,16 +193,16 @@ fn a_flight_fed_through_one_api_process_is_served_by_another_after_a_sigkill() {
     };
     let mut accepted = 0;
     for k in 0..8 {
-        let (s, r) = a.send("POST", &tele, &batch(2.0 * k as f64, 20, f));
+        let (s, r) = a.send_json("POST", &tele, &batch(2.0 * k as f64, 20, f));
         assert_eq!(s, 200, "{r}");
         accepted += r["accepted"].as_u64().unwrap();
         if k == 1 {
-            let (s, _) = a.send("POST", &format!("{uri}/alarms/acknowledge"), &Value::Null);
+            let (s, _) = a.send_json("POST", &format!("{uri}/alarms/acknowledge"), &Value::Null);
             assert_eq!(s, 200);
         }
     }
     assert_eq!(accepted, 160);
-    let (_, before) = a.send("GET", &uri, &Value::Null);
+    let (_, before) = a.send_json("GET", &uri, &Value::Null);
     assert_eq!(before["state"], "caution", "{before}");
     assert_eq!(before["samples_received"], 160);
     let stop = before["alarms"]
@@ -289,21 +213,21 @@ fn a_flight_fed_through_one_api_process_is_served_by_another_after_a_sigkill() {
         .expect("the stop was raised");
     assert!(stop["acknowledged_at_s"].is_number(), "{stop}");
     drop(a); // SIGKILL
-    let (s, after) = b.send("GET", &uri, &Value::Null);
+    let (s, after) = b.send_json("GET", &uri, &Value::Null);
     assert_eq!(s, 200, "{after}");
     assert_eq!(comparable(after), comparable(before));
     // the other process goes on: the last batch again stores nothing
-    let (s, r) = b.send("POST", &tele, &batch(14.0, 20, f));
+    let (s, r) = b.send_json("POST", &tele, &batch(14.0, 20, f));
     assert_eq!(s, 200, "{r}");
     assert_eq!(
         (r["accepted"].as_u64(), r["duplicates"].as_u64()),
         (Some(0), Some(20))
     );
     // and new samples clear the caution after the 5 s dwell below 0.9 × 3200 N
-    let (s, r) = b.send("POST", &tele, &batch(16.0, 70, |_| 1000.0));
+    let (s, r) = b.send_json("POST", &tele, &batch(16.0, 70, |_| 1000.0));
     assert_eq!(s, 200, "{r}");
     assert_eq!(r["accepted"], 70);
-    let (_, now) = b.send("GET", &uri, &Value::Null);
+    let (_, now) = b.send_json("GET", &uri, &Value::Null);
     assert_eq!(now["state"], "normal", "{now}");
     assert_eq!(now["samples_received"], 230);
     // arrival numbers stayed contiguous across the two processes

@@ -14,75 +14,21 @@ use std::io::Read;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn admin_url() -> String {
-    std::env::var("TETHERPLAN_TEST_PG_URL")
-        .unwrap_or_else(|_| "postgres://postgres:postgres@127.0.0.1:5432/postgres".into())
-}
+mod common;
+use common::pg::{TestDb, admin_url};
 
-/// A fresh database, dropped at the end.
-struct TestDb {
-    admin_url: String,
-    name: String,
-    url: String,
-}
-
-impl TestDb {
-    fn create(test: &str) -> Option<Self> {
-        let admin_url = admin_url();
-        let mut admin = match postgres::Client::connect(&admin_url, postgres::NoTls) {
-            Ok(c) => c,
-            Err(e) => {
-                if std::env::var_os("CI").is_some() {
-                    panic!("PostgreSQL unreachable at {admin_url} with CI set: {e}");
-                }
-                eprintln!("SKIPPED {test}: PostgreSQL unreachable at {admin_url} ({e})");
-                return None;
-            }
-        };
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .unwrap()
-            .subsec_nanos();
-        let name = format!("tetherplan_test_{}_{}_{nanos}", test, std::process::id());
-        admin
-            .batch_execute(&format!("CREATE DATABASE {name}"))
-            .unwrap();
-        let base = admin_url.rsplit_once('/').unwrap().0;
-        Some(Self {
-            url: format!("{base}/{name}"),
-            admin_url,
-            name,
-        })
-    }
-
-    fn client(&self) -> postgres::Client {
-        postgres::Client::connect(&self.url, postgres::NoTls).unwrap()
-    }
-
-    /// Every table and index of the public schema, sorted.
-    fn relations(&self) -> Vec<String> {
-        let mut c = self.client();
-        c.query(
-            "SELECT relname::TEXT FROM pg_class c JOIN pg_namespace n ON n.oid = c.relnamespace
-             WHERE n.nspname = 'public' AND c.relkind IN ('r', 'i', 'S') ORDER BY 1",
-            &[],
-        )
-        .unwrap()
-        .iter()
-        .map(|r| r.get(0))
-        .collect()
-    }
-}
-
-impl Drop for TestDb {
-    fn drop(&mut self) {
-        if let Ok(mut admin) = postgres::Client::connect(&self.admin_url, postgres::NoTls) {
-            let _ = admin.batch_execute(&format!(
-                "DROP DATABASE IF EXISTS {} WITH (FORCE)",
-                self.name
-            ));
-        }
-    }
+/// Every table and index of the public schema of `db`, sorted.
+fn relations(db: &TestDb) -> Vec<String> {
+    let mut c = db.client();
+    c.query(
+        "SELECT relname::TEXT FROM pg_class c JOIN pg_namespace n ON n.oid = c.relnamespace
+         WHERE n.nspname = 'public' AND c.relkind IN ('r', 'i', 'S') ORDER BY 1",
+        &[],
+    )
+    .unwrap()
+    .iter()
+    .map(|r| r.get(0))
+    .collect()
 }
 
 /// Runs `tetherplan <args> --database-url url` to its end (at most 60 s):
@@ -156,7 +102,7 @@ fn a_table_it_did_not_make_stops_the_start_and_changes_nothing() {
     db.client()
         .batch_execute("CREATE TABLE systems (x INTEGER)")
         .unwrap();
-    let before = db.relations();
+    let before = relations(&db);
     assert_eq!(before, ["systems"]);
     for sub in ["serve", "worker"] {
         let (code, err) = run_to_end(sub, &db.url);
@@ -169,7 +115,7 @@ fn a_table_it_did_not_make_stops_the_start_and_changes_nothing() {
                 "nothing was changed",
             ],
         );
-        assert_eq!(db.relations(), before, "{sub} left the database changed");
+        assert_eq!(relations(&db), before, "{sub} left the database changed");
     }
 }
 
@@ -184,7 +130,7 @@ fn a_failed_migration_is_rolled_back_whole() {
     db.client()
         .batch_execute("CREATE TABLE other (x INTEGER); CREATE INDEX jobs_by_owner ON other (x)")
         .unwrap();
-    let before = db.relations();
+    let before = relations(&db);
     let (code, err) = run_to_end("serve", &db.url);
     assert_plain_failure(
         "serve",
@@ -196,7 +142,7 @@ fn a_failed_migration_is_rolled_back_whole() {
             "nothing was changed",
         ],
     );
-    assert_eq!(db.relations(), before);
+    assert_eq!(relations(&db), before);
     // An empty database then migrates, and the log says so after the commit.
     db.client().batch_execute("DROP TABLE other").unwrap();
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_tetherplan"));

@@ -171,3 +171,69 @@ pub fn serve_recorded_forecast() -> String {
     let addr = serve_fixed(200, body);
     format!("http://{addr}/v1/forecast?latitude=52.52&longitude=13.41")
 }
+
+/// A `tetherplan serve --addr 127.0.0.1:0` process with `args`, killed
+/// (SIGKILL) when dropped: the full-stack flight tests' server. One job
+/// thread, warnings logged; the environment's store, token, MQTT and
+/// forecast settings are cleared, so only `args` count.
+pub struct ServeProcess {
+    pub child: Child,
+    pub addr: SocketAddr,
+}
+
+impl ServeProcess {
+    pub fn start<S: AsRef<std::ffi::OsStr>>(args: impl IntoIterator<Item = S>) -> Self {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_tetherplan"));
+        cmd.args(["serve", "--addr", "127.0.0.1:0"])
+            .args(args)
+            .env("RUST_LOG", "warn")
+            .env("TETHERPLAN_JOB_THREADS", "1")
+            .stderr(Stdio::inherit());
+        for var in [
+            "TETHERPLAN_API_TOKENS",
+            "TETHERPLAN_DATABASE_URL",
+            "TETHERPLAN_DB",
+            "TETHERPLAN_MQTT_URL",
+            "TETHERPLAN_MQTT_TOPIC_PREFIX",
+            "TETHERPLAN_FORECAST_URL",
+        ] {
+            cmd.env_remove(var);
+        }
+        let (child, addr) = spawn_listening(&mut cmd);
+        Self { child, addr }
+    }
+
+    /// `method path` with `body` of content type `ct`: the status and the
+    /// answer as JSON (`Null` when it is not JSON).
+    pub fn send(&self, method: &str, path: &str, ct: &str, body: &[u8]) -> (u16, Value) {
+        let s = connect(self.addr, Duration::from_secs(60));
+        let r = exchange(s, method, path, &self.addr.to_string(), Some(ct), body);
+        (
+            r.status,
+            serde_json::from_str(&r.body).unwrap_or(Value::Null),
+        )
+    }
+
+    /// [`Self::send`] with a JSON body (`Null`: none).
+    pub fn send_json(&self, method: &str, path: &str, body: &Value) -> (u16, Value) {
+        let bytes = if body.is_null() {
+            Vec::new()
+        } else {
+            body.to_string().into_bytes()
+        };
+        self.send(method, path, "application/json", &bytes)
+    }
+
+    /// SIGKILL, and the exit reaped.
+    pub fn kill(&mut self) {
+        self.child.kill().unwrap();
+        self.child.wait().unwrap();
+    }
+}
+
+impl Drop for ServeProcess {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}

@@ -7,6 +7,7 @@
 // dead code in that binary although another one uses them.
 #![allow(dead_code)]
 
+pub mod flights;
 pub mod http;
 pub mod pg;
 
