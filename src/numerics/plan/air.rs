@@ -48,6 +48,7 @@ use rayon::prelude::*;
 
 use crate::numerics::params::AerostatSystem;
 use crate::numerics::plan::ascent::AscentDrag;
+use crate::numerics::plan::sparse::{RELATIVE_TOLERANCE, Solved, sparse_along};
 use crate::numerics::plan::{PlanProblem, STABILITY_MARGIN};
 use crate::numerics::tether::continuation::ShootingContinuation;
 use crate::numerics::tether::{
@@ -413,6 +414,28 @@ impl SteadyWind {
     }
 }
 
+impl SteadyWind {
+    /// The interpolation tolerances of [`sparse_along`] over `lengths`:
+    /// forces (N) relative to the full buoyancy plus the weight of the
+    /// longest tether, lengths (m) relative to the longest.
+    fn tolerances(&self, p: &PlanProblem, lengths: &[f64]) -> (f64, f64) {
+        let s = &p.system;
+        let longest = lengths.iter().fold(0.0, |m: f64, &l| m.max(l.abs()));
+        let force = s.net_buoyancy_n.abs() + s.mass_per_length_kg_m * s.gravity_m_s2 * longest;
+        (
+            RELATIVE_TOLERANCE * force,
+            RELATIVE_TOLERANCE * longest.max(1.0),
+        )
+    }
+
+    /// Whether a stability tension is in the criterion's smooth regime:
+    /// finite and not the "unstable" answer of a slack tether or a failed
+    /// shooting (`−(1 − r)F`).
+    fn smooth(&self, p: &PlanProblem, stability_tension_n: f64) -> bool {
+        stability_tension_n.is_finite() && stability_tension_n > -p.reserve_buoyancy_n()
+    }
+}
+
 /// The continuations of the shootings along one sequence of lengths: with
 /// the reserve and with the full buoyancy, each in the mean wind `[0]` and
 /// in the gust `[1]`.
@@ -527,28 +550,45 @@ impl Air {
                 .collect();
         };
         let s = &p.system;
-        along(lengths, |l, a| {
-            let stability_tension_n = w.stability_tension_along(p, l, Some(a));
+        let gusty = w.gust.is_some();
+        let (force, length) = w.tolerances(p, lengths);
+        let tolerance = [force, force, force, length, force, force, length];
+        let solved = |l: f64, a: &mut Along| {
+            let st = w.stability_tension_along(p, l, Some(a));
             let (winch, top, alt) = w.operating_along(s, l, Some(&mut a.full[0]));
-            let ascent = w.ascent_drag(l);
-            let mean = RestLoads {
-                stability_tension_n,
-                winch_tension_n: winch,
-                top_tension_n: top,
-                altitude_m: alt,
-                ascent,
-            };
-            let gust = w
+            let (gw, gt, ga) = w
                 .gust_operating_along(s, l, Some(a))
-                .map(|(winch, top, alt)| RestLoads {
+                .unwrap_or((0.0, 0.0, 0.0));
+            let values = [st, winch, top, alt, gw, gt, ga];
+            Solved {
+                values,
+                // the GE criterion's S is solved at every length
+                smooth: w.ge.is_none() && w.smooth(p, st) && values.iter().all(|v| v.is_finite()),
+            }
+        };
+        sparse_along(lengths, tolerance, solved)
+            .into_iter()
+            .zip(lengths)
+            .map(|(v, &l)| {
+                let [stability_tension_n, winch, top, alt, gw, gt, ga] = v;
+                let ascent = w.ascent_drag(l);
+                let mean = RestLoads {
                     stability_tension_n,
                     winch_tension_n: winch,
                     top_tension_n: top,
                     altitude_m: alt,
                     ascent,
+                };
+                let gust = gusty.then_some(RestLoads {
+                    stability_tension_n,
+                    winch_tension_n: gw,
+                    top_tension_n: gt,
+                    altitude_m: ga,
+                    ascent,
                 });
-            (mean, gust)
-        })
+                (mean, gust)
+            })
+            .collect()
     }
 
     /// The bound on the tension the aerostat's ascent takes off at a
@@ -588,7 +628,22 @@ impl Air {
                 .iter()
                 .map(|&l| self.rest_loads(p, l).stability_tension_n)
                 .collect(),
-            Self::Wind(w) => along(lengths, |l, a| w.stability_tension_along(p, l, Some(a))),
+            Self::Wind(w) if w.ge.is_some() => {
+                along(lengths, |l, a| w.stability_tension_along(p, l, Some(a)))
+            }
+            Self::Wind(w) => {
+                let (force, _) = w.tolerances(p, lengths);
+                sparse_along(lengths, [force], |l, a: &mut Along| {
+                    let st = w.stability_tension_along(p, l, Some(a));
+                    Solved {
+                        values: [st],
+                        smooth: w.smooth(p, st),
+                    }
+                })
+                .into_iter()
+                .map(|[st]| st)
+                .collect()
+            }
         }
     }
 
@@ -603,9 +658,19 @@ impl Air {
                     (r.winch_tension_n, r.top_tension_n)
                 })
                 .collect(),
-            Self::Wind(w) => along(lengths, |l, a| {
-                w.limit_tensions_along(&p.system, l, Some(a))
-            }),
+            Self::Wind(w) => {
+                let (force, _) = w.tolerances(p, lengths);
+                sparse_along(lengths, [force, force], |l, a: &mut Along| {
+                    let (winch, top) = w.limit_tensions_along(&p.system, l, Some(a));
+                    Solved {
+                        values: [winch, top],
+                        smooth: winch.is_finite() && top.is_finite(),
+                    }
+                })
+                .into_iter()
+                .map(|[winch, top]| (winch, top))
+                .collect()
+            }
         }
     }
 

@@ -36,6 +36,7 @@ pub mod jerk;
 pub mod pass;
 pub mod retrieval;
 pub mod schedule;
+pub mod sparse;
 
 use crate::numerics::params::{AerostatSystem, InvalidInput, require_positive};
 
