@@ -63,7 +63,8 @@ pub use problem::{
     Aerostat, DynamicsConfig, DynamicsError, DynamicsProblem, LengthSchedule, Tether,
 };
 pub use run::{
-    Outcome, Run, State, Statistics, StepView, aerostat, magnitude, simulate, simulate_from,
+    ENERGY_ALLOWANCE, ENERGY_FLOOR, Outcome, Run, State, Statistics, StepView, aerostat, magnitude,
+    simulate, simulate_from,
 };
 pub use start::{StaticStart, static_start};
 pub use wind::{GustHistory, SpectrumModel, Turbulence, TurbulenceField};
