@@ -159,5 +159,8 @@ fn a_haul_in_stop_at_a_coarse_step_through_the_contract() {
     );
     assert_eq!(a["outcome"], "completed");
     assert!(a["peak_winch_tension_n"].as_f64().unwrap() < 10_000.0);
-    assert!((lo - 400.0).abs() < 1.0 && (hi - 400.0).abs() < 1.0, "{lo} {hi}");
+    assert!(
+        (lo - 400.0).abs() < 1.0 && (hi - 400.0).abs() < 1.0,
+        "{lo} {hi}"
+    );
 }
