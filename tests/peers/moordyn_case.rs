@@ -21,6 +21,7 @@ pub fn python() -> Option<PathBuf> {
 
 /// The driver's case for the reference gust case `p` on `segments`
 /// segments (MoorDyn at dtM = 1 ms with RK2, coupled every 0.05 s).
+#[allow(dead_code)] // tests/peer_moordyn_winch.rs has cases of its own
 pub fn gust_case_json(p: &DynamicsProblem, segments: usize) -> serde_json::Value {
     let (t, a) = (&p.tether, &p.aerostat);
     let (gust_start, gust_duration, gust_amplitude) = reference::GUST_CASE_GUST;
@@ -91,4 +92,45 @@ pub fn run(py: &PathBuf, case: &serde_json::Value) -> History {
         aerostat_altitude_m: column("aerostat_altitude_m"),
         cpu_s: md["cpu_s"].as_f64().unwrap(),
     }
+}
+
+/// The driver's case for a winch run of `p` (a tether paid out or hauled
+/// in by the rate table `rate_points` `[t, L̇]`, linear between them and
+/// held after, stopped at `stop_time_s` if given) from `length_m`, in a
+/// uniform wind ramped from calm to `mean_m_s` over `ramp_s`; MoorDyn at
+/// `md_time_step_s` with RK2, its rate set every 5 ms (the mean of each
+/// 5 ms), recorded every `coupling_step_s`.
+#[allow(dead_code, clippy::too_many_arguments)] // each test binary uses its own cases
+pub fn winch_case_json(
+    p: &DynamicsProblem,
+    segments: usize,
+    length_m: f64,
+    mean_m_s: f64,
+    ramp_s: f64,
+    rate_points: &[[f64; 2]],
+    stop_time_s: Option<f64>,
+    duration_s: f64,
+    md_time_step_s: f64,
+    coupling_step_s: f64,
+) -> serde_json::Value {
+    let (t, a) = (&p.tether, &p.aerostat);
+    let mut c = serde_json::json!({
+        "segments": segments, "length_m": length_m,
+        "mass_per_length_kg_m": t.mass_per_length_kg_m, "diameter_m": t.diameter_m,
+        "normal_drag_coefficient": t.normal_drag_coefficient,
+        "axial_stiffness_n": t.axial_stiffness_n, "internal_damping_n_s": t.internal_damping_n_s,
+        "net_buoyancy_n": a.net_buoyancy_n, "aerostat_mass_kg": a.mass_kg,
+        "aerostat_drag_area_m2": a.drag_coefficient * a.reference_area_m2,
+        "added_mass_coefficient": a.added_mass_coefficient,
+        "air_density_kg_m3": p.air_density_kg_m3, "gravity_m_s2": p.gravity_m_s2,
+        "md_time_step_s": md_time_step_s, "md_tmax_ic_s": 200.0, "md_thresh_ic": 1e-6,
+        "coupling_step_s": coupling_step_s, "rate_update_s": 0.005, "duration_s": duration_s,
+        "mean_m_s": mean_m_s, "ramp_s": ramp_s,
+        "gust_start_s": 1e9, "gust_duration_s": 1.0, "gust_amplitude_m_s": 0.0,
+        "rate_points": rate_points,
+    });
+    if let Some(s) = stop_time_s {
+        c["stop_time_s"] = serde_json::json!(s);
+    }
+    c
 }

@@ -160,6 +160,12 @@ ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
         moordyn.Close(system)
     # MoorDyn writes to stdout too: the answer is the last line.
     sys.stdout.write("\n" + json.dumps(out) + "\n")
+    sys.stdout.flush()
+    # moordyn 2.7.2's C extension drops a reference to None on calls that
+    # return nothing (SetLineUnstretchedLengthVel, every rate change):
+    # after many, the interpreter's finalisation aborts on it. The answer
+    # is written: leave without finalising.
+    os._exit(0)
 
 
 if __name__ == "__main__":

@@ -344,6 +344,12 @@ pub enum DynamicsOutcomeOutput {
     /// The aerostat went below the winch (`stopped_at_s`): the state left
     /// the physical (the model has no ground).
     AerostatBelowWinch,
+    /// The tether and aerostat held more mechanical energy than they
+    /// started with plus all the winch and the air could have put in, past
+    /// the stated allowance (`stopped_at_s`; the numbers in
+    /// `explanation`): the step made energy, so the state left the
+    /// physical (try a smaller `numerics.time_step_s`).
+    EnergyGained,
 }
 
 /// How the answer was computed.

@@ -8,8 +8,8 @@ use crate::contract::{Progress, RequestError};
 use crate::numerics::aero::SteadyFlow;
 use crate::numerics::dynamics::limits::step_count;
 use crate::numerics::dynamics::{
-    DynamicsConfig, DynamicsError, DynamicsProblem, Outcome, Run, StepView, simulate_from,
-    static_start,
+    DynamicsConfig, DynamicsError, DynamicsProblem, ENERGY_ALLOWANCE, ENERGY_FLOOR, Outcome, Run,
+    StepView, simulate_from, static_start,
 };
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::{Equilibrium, EquilibriumConfig, WindProfile};
@@ -189,6 +189,7 @@ pub fn response(
         Outcome::AerostatBelowWinch { time_s, .. } => {
             (DynamicsOutcomeOutput::AerostatBelowWinch, time_s)
         }
+        Outcome::EnergyGained { time_s, .. } => (DynamicsOutcomeOutput::EnergyGained, time_s),
     };
     // A run that did not complete gives no final figure.
     let partial = outcome != DynamicsOutcomeOutput::Completed;
@@ -346,6 +347,18 @@ fn explain(
         DynamicsOutcomeOutput::AerostatBelowWinch => s.push_str(&format!(
             " The run stopped at t = {stopped_at_s:.2} s: the aerostat went below the winch, which no real tether does (the model has no ground); the state left the physical."
         )),
+        DynamicsOutcomeOutput::EnergyGained => {
+            if let Outcome::EnergyGained {
+                gained_j, put_in_j, ..
+            } = run.outcome
+            {
+                s.push_str(&format!(
+                    " The run stopped at t = {stopped_at_s:.2} s: the tether and aerostat held {gained_j:.4e} J more mechanical energy than at the start plus the most the winch and the air could have put in ({put_in_j:.4e} J), past the allowance of {:.0} % of that plus {:.0} % of the buoyancy's work down to the winch; the step made energy, so the state left the physical (try a smaller numerics.time_step_s).",
+                    100.0 * ENERGY_ALLOWANCE,
+                    100.0 * ENERGY_FLOOR
+                ));
+            }
+        }
     }
     s
 }

@@ -305,6 +305,7 @@ impl Setup {
             Outcome::AerostatBelowWinch { time_s, .. } => {
                 (DynamicsOutcomeOutput::AerostatBelowWinch, time_s)
             }
+            Outcome::EnergyGained { time_s, .. } => (DynamicsOutcomeOutput::EnergyGained, time_s),
         };
         let height = self.flight.limits.anemometer_height_m;
         let rate = self.sample_rate_hz;

@@ -35,7 +35,14 @@
 //! block-tridiagonal iteration matrix of [`model`] (`O(N)` per iteration);
 //! a step whose Newton iteration fails is retried as two half steps (up to
 //! [`MAX_HALVINGS`] times), and a run that still fails stops with
-//! [`Outcome::NewtonFailed`]: an outcome, not an error.
+//! [`Outcome::NewtonFailed`]: an outcome, not an error. A step that
+//! starts with a slack segment, or in the wave of a winch rate jump, is
+//! refined to a sixteenth of a segment's axial period (a slack segment
+//! snaps taut within one). After every step the run checks its energy
+//! balance (`run::EnergyCheck`): a tether and aerostat holding more
+//! mechanical energy than they started with plus all the winch and the
+//! air could have put in (past [`ENERGY_ALLOWANCE`] and [`ENERGY_FLOOR`])
+//! stop with [`Outcome::EnergyGained`], never `Completed`.
 //!
 //! **Start.** The run starts at rest in the static equilibrium of the
 //! steady flow: the shooting solution of SPEC §6
@@ -63,7 +70,8 @@ pub use problem::{
     Aerostat, DynamicsConfig, DynamicsError, DynamicsProblem, LengthSchedule, Tether,
 };
 pub use run::{
-    Outcome, Run, State, Statistics, StepView, aerostat, magnitude, simulate, simulate_from,
+    ENERGY_ALLOWANCE, ENERGY_FLOOR, Outcome, Run, State, Statistics, StepView, aerostat, magnitude,
+    simulate, simulate_from,
 };
 pub use start::{StaticStart, static_start};
 pub use wind::{GustHistory, SpectrumModel, Turbulence, TurbulenceField};

@@ -110,6 +110,10 @@ pub struct Evaluation {
     pub top_force: V2,
     /// Drag on the tether (excluding the aerostat), summed over the nodes `1 … N` (N).
     pub tether_drag: V2,
+    /// The power the air puts in, `Σ max(0, f_i·V_i)` over the drag (and
+    /// the aerostat's lift) at every node (W): an upper bound of the
+    /// energy the wind can feed the tether and aerostat.
+    pub air_power_in_w: f64,
 }
 
 impl Evaluation {
@@ -127,6 +131,7 @@ impl Evaluation {
             winch_force: [0.0; 2],
             top_force: [0.0; 2],
             tether_drag: [0.0; 2],
+            air_power_in_w: 0.0,
         }
     }
 }
@@ -422,6 +427,7 @@ pub fn evaluate_with<W: Fn(f64, f64) -> f64 + ?Sized, J: JacobianSink>(
     let any_drag = p.normal_drag > 0.0 || p.tangential_drag > 0.0;
     let weight = node_mass * p.gravity_m_s2;
     let mut tether_drag_sum = [0.0; 2];
+    let mut air_power = 0.0f64;
     for i in 1..n {
         let k = i - 1;
         let (below, above) = (
@@ -442,6 +448,7 @@ pub fn evaluate_with<W: Fn(f64, f64) -> f64 + ?Sized, J: JacobianSink>(
                 jac.velocity_diagonal(k, &d);
             }
             tether_drag_sum = add(tether_drag_sum, fd);
+            air_power += dot(fd, out.material_velocity[i]).max(0.0);
             f = add(f, fd);
         }
         out.force[k] = f;
@@ -471,6 +478,7 @@ pub fn evaluate_with<W: Fn(f64, f64) -> f64 + ?Sized, J: JacobianSink>(
             p.aerostat_drag * speed * ur[0] - p.aerostat_lift * speed * ur[1],
             p.aerostat_drag * speed * ur[1] + p.aerostat_lift * speed * ur[0],
         ];
+        air_power += dot(add(fd, fa), out.material_velocity[n]).max(0.0);
         out.force[k] = [
             -top[0] + fd[0] + fa[0],
             -top[1] - 0.5 * weight + p.net_buoyancy_n + fd[1] + fa[1],
@@ -487,6 +495,7 @@ pub fn evaluate_with<W: Fn(f64, f64) -> f64 + ?Sized, J: JacobianSink>(
         }
     }
     out.tether_drag = tether_drag_sum;
+    out.air_power_in_w = air_power;
 
     // The winch's half segment.
     {
@@ -556,6 +565,51 @@ pub fn energy(p: &Parameters, length_m: f64, pos: &[V2], vel: &[V2]) -> f64 {
         prev = r;
     }
     e - p.net_buoyancy_n * pos[n - 1][1]
+}
+
+/// Mechanical energy of the tether and aerostat (J), on the material
+/// velocities of `ev` (an evaluation of this state): kinetic
+/// `Σ ½ m_i |V_i|²`, strain `Σ ½ (EA/l)(ℓ − l)²` over stretched segments,
+/// gravity of the tether's lumped masses and `−F z_N` of the net buoyancy.
+/// With the length fixed and still air it only falls (drag and the
+/// integrator's dissipation take energy out, nothing puts it in).
+pub fn material_energy(p: &Parameters, length_m: f64, pos: &[V2], ev: &Evaluation) -> f64 {
+    let n = p.segments;
+    let l = length_m / n as f64;
+    let mut e = 0.0;
+    let mut prev = [0.0; 2];
+    for i in 1..=n {
+        let r = pos[i - 1];
+        let tether_mass = if i == n { 0.5 } else { 1.0 } * p.mass_per_length_kg_m * l;
+        let v = ev.material_velocity[i];
+        e += 0.5 * ev.mass[i - 1] * dot(v, v);
+        e += tether_mass * p.gravity_m_s2 * r[1];
+        let stretch = norm(sub(r, prev)) - l;
+        if stretch > 0.0 {
+            e += 0.5 * p.axial_stiffness_n / l * stretch * stretch;
+        }
+        prev = r;
+    }
+    e - p.net_buoyancy_n * pos[n - 1][1]
+}
+
+/// An upper bound of the power put into the tether and aerostat (W): the
+/// air's ([`Evaluation::air_power_in_w`]) plus, while the winch turns, the
+/// winch force's `|τ(0)| |V_0|` and the kinetic and strain energy the
+/// material carries through the winch, `|L̇| (½ ρA |V_0|² + ½ EA ε_1²)`
+/// (every term counted as going in, whichever way it goes).
+pub fn power_in_bound(p: &Parameters, len: Length, ev: &Evaluation) -> f64 {
+    let mut w = ev.air_power_in_w;
+    if len.rate_m_s != 0.0 {
+        let l = len.length_m / p.segments as f64;
+        let v0 = ev.material_velocity[0];
+        let eps = (ev.stretched[0] / l - 1.0).max(0.0);
+        w += norm(ev.winch_force) * norm(v0)
+            + len.rate_m_s.abs()
+                * (0.5 * p.mass_per_length_kg_m * dot(v0, v0)
+                    + 0.5 * p.axial_stiffness_n * eps * eps);
+    }
+    w
 }
 
 /// Block-tridiagonal solve helper re-exported for the integrator.

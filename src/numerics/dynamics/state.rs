@@ -32,6 +32,16 @@ pub enum Outcome {
         time_s: f64,
         altitude_m: f64,
     },
+    /// The tether and aerostat held `gained_j` more mechanical energy than
+    /// they started with plus every joule the winch and the air could have
+    /// put in (`put_in_j`, an upper bound), beyond the run's allowance
+    /// (see `run::EnergyCheck`): the step made energy, so the state left
+    /// the physical.
+    EnergyGained {
+        time_s: f64,
+        gained_j: f64,
+        put_in_j: f64,
+    },
     /// The observer asked to stop.
     Stopped {
         time_s: f64,
@@ -57,4 +67,7 @@ pub struct Statistics {
     /// Steps retried as two halves because a segment went slack or
     /// snapped taut within them (see `Stepper::step`).
     pub refinements: usize,
+    /// The largest energy gain over the run's allowance (see
+    /// [`Outcome::EnergyGained`]), as a share of it: above 1 ends the run.
+    pub energy_gain_nondim: f64,
 }
