@@ -221,11 +221,16 @@ fn plan_in_wind_converged_is_the_string_criterion() {
     let ge = plan_of(body(json!({"method": "quasi_static_ge"})));
     let string = plan_of(body(json!({"method": "string"})));
     assert!(ge.feasible && ge.go, "{:?}", ge.reason);
-    assert_eq!(ge.duration_s, string.duration_s);
+    // The string plan reads its grid loads from `plan::sparse` (every node
+    // within 1e-6 of the force scale of its own solve); the GE plan solves
+    // every node. The schedules agree to that tolerance, not bit for bit
+    // (2e-8 relative measured on the duration).
+    let (d_ge, d_string) = (ge.duration_s.unwrap(), string.duration_s.unwrap());
+    assert!((d_ge - d_string).abs() <= 1e-6 * d_string, "{d_ge} vs {d_string}");
     assert_eq!(ge.schedule.len(), string.schedule.len());
     for (a, b) in ge.schedule.iter().zip(&string.schedule) {
-        assert_eq!(a.length_m, b.length_m);
-        assert_eq!(a.rate_m_s, b.rate_m_s);
+        assert!((a.length_m - b.length_m).abs() <= 1e-6 * 1000.0, "{a:?} vs {b:?}");
+        assert!((a.rate_m_s - b.rate_m_s).abs() <= 1e-6 * 40.0, "{a:?} vs {b:?}");
     }
     let g = ge.ge_stability.expect("a GE block");
     assert!(g.converged);
