@@ -429,12 +429,25 @@ pub struct PlanGustOutput {
     pub target_downwind_m: Option<f64>,
     /// Angle of the winch–aerostat line from the vertical in the gust (deg).
     pub blowdown_angle_deg: Option<f64>,
-    /// Winch tension at the target at rest in the gust (N).
+    /// Winch tension at the target at rest in the gust (N), times
+    /// `dynamic_tension_factor_nondim`.
     pub target_winch_tension_n: Option<f64>,
-    /// Largest tension at the target at rest in the gust (N).
+    /// Largest tension at the target at rest in the gust (N), times
+    /// `dynamic_tension_factor_nondim`: the tension the rating is judged on.
     pub target_max_tension_n: Option<f64>,
-    /// Breaking strength / that tension; null without a breaking strength.
+    /// The static equilibrium's largest tension at the target in the gust
+    /// (N), before the factor.
+    pub static_target_max_tension_n: Option<f64>,
+    /// Breaking strength / `target_max_tension_n`; null without a breaking strength.
     pub target_safety_factor_nondim: Option<f64>,
+    /// Factor on every static gust tension of the plan (here, the schedule's
+    /// `gust_*_tension_n` and the limits): with a turbulence intensity the
+    /// 99th percentile of the hourly largest winch tension in the
+    /// time-domain dynamics over the static check, 1.363
+    /// (`docs/gust_check.md`); 1 for a gust given as a speed or `I = 0`.
+    pub dynamic_tension_factor_nondim: f64,
+    /// Where the factor comes from and whether this wind lies within its measurement.
+    pub dynamic_tension_note: String,
     /// Altitude in the gust at the lift limit (m).
     pub reachable_altitude_m: f64,
 }

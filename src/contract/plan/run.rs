@@ -16,6 +16,7 @@ use crate::contract::plan::ge::*;
 use crate::contract::plan::output::*;
 use crate::contract::plan::validate::{Validated, validate};
 use crate::contract::system::output::groups;
+use crate::contract::system::validate::GustWind;
 use crate::numerics::plan::air::Air;
 use crate::numerics::plan::deadline::{self, ExceededBy};
 use crate::numerics::plan::ge_stability::ScheduleCheck;
@@ -153,6 +154,24 @@ fn target_equilibrium(v: &Validated, p: &PlanProblem, gust: bool) -> Option<Equi
     problem.solve(&EquilibriumConfig::default()).ok()
 }
 
+/// Where the gust's tension factor comes from, in words.
+pub(crate) fn dynamic_tension_note(g: &GustWind) -> String {
+    use crate::numerics::tether::gust::{DYNAMIC_FACTOR_MAX_INTENSITY, DYNAMIC_FACTOR_MAX_WIND_M_S};
+    if g.tension_factor == 1.0 {
+        return "the gust is a given speed (or I = 0): its static tensions are judged as they are".into();
+    }
+    let mut note = format!(
+        "the static gust tensions are judged at {:.3}× their value: the 99th percentile of the hourly largest winch          tension in the time-domain dynamics (von Kármán turbulence, 200 one-hour seeds) over the 1 + 3I check, the          largest measured (docs/gust_check.md; cargo run --release --example gust_check_table)",
+        g.tension_factor
+    );
+    if g.factor_extrapolated {
+        note.push_str(&format!(
+            "; this wind lies beyond the measurement (mean ≤ {DYNAMIC_FACTOR_MAX_WIND_M_S} m/s, I ≤ {DYNAMIC_FACTOR_MAX_INTENSITY}),              where the factor grew with the wind and the intensity: run POST /api/v1/dynamics/peaks for this case"
+        ));
+    }
+    note
+}
+
 /// The plan in wind: the target's length, blow-down and tensions, in the
 /// mean wind and in the gust side by side.
 fn wind_output(v: &Validated, p: &PlanProblem) -> Option<PlanWindOutput> {
@@ -167,9 +186,15 @@ fn wind_output(v: &Validated, p: &PlanProblem) -> Option<PlanWindOutput> {
             target_altitude_m: e.as_ref().map(|e| e.altitude_m),
             target_downwind_m: e.as_ref().map(|e| e.downwind_m),
             blowdown_angle_deg: e.as_ref().map(|e| e.blowdown_angle_deg),
-            target_winch_tension_n: e.as_ref().map(|e| e.winch_tension_n),
-            target_max_tension_n: e.as_ref().map(|e| e.max_tension_n),
-            target_safety_factor_nondim: e.as_ref().and_then(|e| e.safety_factor),
+            target_winch_tension_n: e.as_ref().map(|e| g.tension_factor * e.winch_tension_n),
+            target_max_tension_n: e.as_ref().map(|e| g.tension_factor * e.max_tension_n),
+            static_target_max_tension_n: e.as_ref().map(|e| e.max_tension_n),
+            target_safety_factor_nondim: e
+                .as_ref()
+                .and_then(|e| e.safety_factor)
+                .map(|sf| sf / g.tension_factor),
+            dynamic_tension_factor_nondim: g.tension_factor,
+            dynamic_tension_note: dynamic_tension_note(g),
             reachable_altitude_m: v
                 .options
                 .air
@@ -556,6 +581,12 @@ fn verdict(
         }
         if let Some(t) = limits.gust_peak_tension_n {
             reason.push_str(&format!(", peak tension {t:.0} N"));
+            if g.dynamic_tension_factor_nondim != 1.0 {
+                reason.push_str(&format!(
+                    " (the static gust tension × {:.3}, the dynamic factor)",
+                    g.dynamic_tension_factor_nondim
+                ));
+            }
         }
         if let Some(t) = p.allowable_tension_n {
             reason.push_str(&format!(", within {t:.0} N"));

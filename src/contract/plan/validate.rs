@@ -64,7 +64,9 @@ fn steady_wind(
     let gust = w.gust_wind(&profile)?;
     let mut sw = SteadyWind::new(cable, body, profile, rho);
     if let Some(g) = &gust {
-        sw = sw.with_gust(g.profile.clone());
+        sw = sw
+            .with_gust(g.profile.clone())
+            .with_gust_tension_factor(g.tension_factor);
     }
     Ok((sw, gust))
 }

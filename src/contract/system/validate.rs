@@ -442,7 +442,20 @@ impl WindInput {
         }
         let profile = gust_profile_at(&gust, mean, z_ref, "wind.gust")?;
         let factor = gust_factor_at(&gust, mean, z_ref, "wind.gust")?;
+        let tension_factor = crate::numerics::tether::gust::dynamic_tension_factor(&gust);
+        let factor_extrapolated = match gust {
+            Gust::Intensity {
+                turbulence_intensity,
+                ..
+            } => {
+                turbulence_intensity > crate::numerics::tether::gust::DYNAMIC_FACTOR_MAX_INTENSITY
+                    || mean_ref > crate::numerics::tether::gust::DYNAMIC_FACTOR_MAX_WIND_M_S
+            }
+            Gust::AtReference { .. } => false,
+        };
         Ok(Some(GustWind {
+            tension_factor,
+            factor_extrapolated,
             factor,
             reference_height_m: z_ref,
             reference_speed_m_s: profile.speed_m_s(z_ref),
@@ -462,6 +475,12 @@ pub struct GustWind {
     pub reference_speed_m_s: f64,
     /// The gust profile (the mean's speeds times `G`; with I = 0 the mean bit for bit).
     pub profile: WindProfile,
+    /// The factor on the static gust tensions
+    /// ([`crate::numerics::tether::gust::dynamic_tension_factor`]).
+    pub tension_factor: f64,
+    /// Whether the mean wind or the intensity lies beyond the measurement
+    /// behind that factor.
+    pub factor_extrapolated: bool,
 }
 
 impl GustInput {

@@ -151,6 +151,10 @@ pub struct SteadyWind {
     pub ge: Option<super::ge_stability::GeCriterion>,
     /// The gust profile (SPEC §10); `None`: the mean wind only.
     pub gust: Option<WindProfile>,
+    /// The factor on the gust's static tensions (1 unless set by
+    /// [`Self::with_gust_tension_factor`]): the dynamic peak over the
+    /// static check (`crate::numerics::tether::gust::DYNAMIC_TENSION_FACTOR`).
+    pub gust_tension_factor: f64,
     /// Answers already computed, by (length, buoyancy, kind) bits: the
     /// pass, the bound, the constant-rate plan and the jerk check of one
     /// request share their grid's lengths.
@@ -173,6 +177,7 @@ impl SteadyWind {
             criterion_name: STRING_TENSION_CRITERION,
             ge: None,
             gust: None,
+            gust_tension_factor: 1.0,
             cache: Arc::default(),
         }
     }
@@ -180,6 +185,12 @@ impl SteadyWind {
     /// The same wind with gusts of profile `gust`.
     pub fn with_gust(mut self, gust: WindProfile) -> Self {
         self.gust = Some(gust);
+        self
+    }
+
+    /// The gust's static tensions judged at `factor` times their value.
+    pub fn with_gust_tension_factor(mut self, factor: f64) -> Self {
+        self.gust_tension_factor = factor;
         self
     }
 
@@ -382,10 +393,13 @@ impl SteadyWind {
         along: Option<&mut Along>,
     ) -> Option<(f64, f64, f64)> {
         let g = self.gust.as_ref()?;
-        if *g == self.wind {
-            return Some(self.operating_along(s, length_m, along.map(|a| &mut a.full[0])));
-        }
-        Some(self.full_buoyancy_state(g, 2, s, length_m, along.map(|a| &mut a.full[1])))
+        let k = self.gust_tension_factor;
+        let (w, t, alt) = if *g == self.wind {
+            self.operating_along(s, length_m, along.map(|a| &mut a.full[0]))
+        } else {
+            self.full_buoyancy_state(g, 2, s, length_m, along.map(|a| &mut a.full[1]))
+        };
+        Some((k * w, k * t, alt))
     }
 
     /// The winch and top tensions the limits bound: the larger of the
