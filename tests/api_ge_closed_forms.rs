@@ -226,11 +226,20 @@ fn plan_in_wind_converged_is_the_string_criterion() {
     // every node. The schedules agree to that tolerance, not bit for bit
     // (2e-8 relative measured on the duration).
     let (d_ge, d_string) = (ge.duration_s.unwrap(), string.duration_s.unwrap());
-    assert!((d_ge - d_string).abs() <= 1e-6 * d_string, "{d_ge} vs {d_string}");
+    assert!(
+        (d_ge - d_string).abs() <= 1e-6 * d_string,
+        "{d_ge} vs {d_string}"
+    );
     assert_eq!(ge.schedule.len(), string.schedule.len());
     for (a, b) in ge.schedule.iter().zip(&string.schedule) {
-        assert!((a.length_m - b.length_m).abs() <= 1e-6 * 1000.0, "{a:?} vs {b:?}");
-        assert!((a.rate_m_s - b.rate_m_s).abs() <= 1e-6 * 40.0, "{a:?} vs {b:?}");
+        assert!(
+            (a.length_m - b.length_m).abs() <= 1e-6 * 1000.0,
+            "{a:?} vs {b:?}"
+        );
+        assert!(
+            (a.rate_m_s - b.rate_m_s).abs() <= 1e-6 * 40.0,
+            "{a:?} vs {b:?}"
+        );
     }
     let g = ge.ge_stability.expect("a GE block");
     assert!(g.converged);

@@ -259,9 +259,6 @@ async fn envelope_with_zero_intensity_is_the_mean_envelope_and_its_gusts_are_the
             "aerostat_altitude_m",
             "aerostat_downwind_m",
             "blowdown_angle_deg",
-            "winch_tension_n",
-            "top_tension_n",
-            "max_tension_n",
             "min_tension_n",
             "safety_factor_nondim",
             "slack",
@@ -271,6 +268,41 @@ async fn envelope_with_zero_intensity_is_the_mean_envelope_and_its_gusts_are_the
         ] {
             assert_eq!(ga[k], b[k], "{k} at {a}");
         }
+        // The tensions are that equilibrium's at their dynamic value: the
+        // calm tension (F = 1000 N at the top, F − ρA g L at the winch) plus
+        // 1.41 times the increment over it (no breaking strength here, so
+        // the safety factor is null in both).
+        let f = |v: &Value| v.as_f64().unwrap();
+        let calm_winch = 1000.0 - 0.078 * 9.81 * f(&a["tether_length_m"]);
+        let dynamic = |t: f64, calm: f64| {
+            if t > calm {
+                calm + 1.41 * (t - calm)
+            } else {
+                t
+            }
+        };
+        assert_eq!(ga["static_max_tension_n"], b["max_tension_n"]);
+        assert_eq!(
+            f(&ga["max_tension_n"]),
+            dynamic(f(&b["max_tension_n"]), 1000.0)
+        );
+        assert_eq!(
+            f(&ga["top_tension_n"]),
+            dynamic(f(&b["top_tension_n"]), 1000.0)
+        );
+        assert_eq!(
+            f(&ga["winch_tension_n"]),
+            dynamic(f(&b["winch_tension_n"]), calm_winch)
+        );
+    }
+    // In calm air the dynamic factor adds nothing: the 0 m/s row's gust
+    // tensions are the static ones.
+    for p in &pg[..3] {
+        assert_eq!(p["wind_speed_m_s"], 0.0);
+        assert!(
+            (f64::abs(p["gust"]["max_tension_n"].as_f64().unwrap() - 1000.0)) < 1e-6,
+            "{p}"
+        );
     }
 }
 
@@ -315,6 +347,39 @@ async fn envelope_cells_are_judged_by_the_worst_of_mean_and_gust() {
     assert!(c["gust"]["safety_factor_nondim"].as_f64().unwrap() < 5.0);
     let r = ok(&app, "/api/v1/envelope", &rated(None)).await;
     assert_eq!(cell(&r)["feasible"], true, "{}", cell(&r));
+    // The gust cell's tensions are its static equilibrium's times the
+    // dynamic factor (docs/gust_check.md); a rating that holds the static
+    // gust tension but not the factored one is outside, on `tension`.
+    let k = gusty["gust"]["dynamic_tension_factor_nondim"]
+        .as_f64()
+        .unwrap();
+    assert_eq!(k, 1.41);
+    let ts = c["gust"]["static_max_tension_n"].as_f64().unwrap();
+    // the calm tension the increment is taken over: the net buoyancy, 1000 N
+    assert_eq!(tg, 1000.0 + k * (ts - 1000.0));
+    assert!(ts > 1000.0, "{ts}");
+    let mut between = envelope(Some(intensity(0.2)), json!({}));
+    between["cable"]["breaking_strength_n"] = json!(5.0 * 0.5 * (ts + tg));
+    let r = ok(&app, "/api/v1/envelope", &between).await;
+    let c2 = cell(&r);
+    assert_eq!(c2["binding_limit"], "tension", "{c2}");
+    assert_eq!(c2["gust"]["binds"], true);
+    let sf = c2["gust"]["safety_factor_nondim"].as_f64().unwrap();
+    assert!((sf - 2.5 * (ts + tg) / tg).abs() < 1e-12 * sf, "{sf}");
+    assert!(sf < 5.0 && sf * tg / ts > 5.0, "{sf}");
+    // A gust given as a speed is judged as it is: no factor.
+    let speed = ok(
+        &app,
+        "/api/v1/envelope",
+        &envelope(
+            None,
+            json!({"wind": {"flow": uniform(8.0), "gust": {"gust_m_s": 10.0}}}),
+        ),
+    )
+    .await;
+    assert_eq!(speed["gust"]["dynamic_tension_factor_nondim"], 1.0);
+    let c3 = &speed["points"][8]["gust"];
+    assert_eq!(c3["max_tension_n"], c3["static_max_tension_n"]);
     // A floor between the two altitudes: the gust goes below it.
     let floor = json!({"min_altitude_m": 0.5 * (am + ag)});
     let r = ok(
@@ -425,8 +490,30 @@ async fn the_plans_gust_figures_are_the_equilibrium_at_the_gust_speed() {
     assert_eq!(g["target_altitude_m"], eq["aerostat_altitude_m"]);
     assert_eq!(g["target_downwind_m"], eq["aerostat_downwind_m"]);
     assert_eq!(g["blowdown_angle_deg"], eq["blowdown_angle_deg"]);
-    assert_eq!(g["target_winch_tension_n"], eq["winch_tension_n"]);
-    assert_eq!(g["target_max_tension_n"], eq["max_tension_n"]);
+    // The tensions are the equilibrium's times the dynamic factor (a gust
+    // given by a turbulence intensity), and say so; the static one is kept.
+    // The tensions are the calm tension plus the dynamic factor times the
+    // equilibrium's increment over it (a gust given by a turbulence
+    // intensity), and say so; the static one is kept. Calm air, 1000 N of
+    // buoyancy on 0.078 kg/m: F at the top, F − ρA g L at the winch.
+    let k = g["dynamic_tension_factor_nondim"].as_f64().unwrap();
+    assert_eq!(k, 1.41, "{g}");
+    let f = |v: &Value| v.as_f64().unwrap();
+    let calm_winch = 1000.0 - 0.078 * 9.81 * l;
+    let (ew, em) = (f(&eq["winch_tension_n"]), f(&eq["max_tension_n"]));
+    assert!(ew > calm_winch && em > 1000.0, "{eq}");
+    assert_eq!(
+        f(&g["target_winch_tension_n"]),
+        calm_winch + k * (ew - calm_winch)
+    );
+    assert_eq!(f(&g["target_max_tension_n"]), 1000.0 + k * (em - 1000.0));
+    assert_eq!(g["static_target_max_tension_n"], eq["max_tension_n"]);
+    assert!(
+        g["dynamic_tension_note"]
+            .as_str()
+            .is_some_and(|n| n.contains("1.41") && n.contains("docs/gust_check.md")),
+        "{g}"
+    );
     assert_eq!(g["reference_speed_m_s"].as_f64(), Some(6.0 * factor(0.15)));
     // The mean's figures at the target are the equilibrium in the mean wind.
     let eq_mean = ok(
@@ -449,7 +536,9 @@ async fn the_plans_gust_figures_are_the_equilibrium_at_the_gust_speed() {
     assert_eq!(last["length_m"].as_f64(), Some(l), "{last}");
     assert_eq!(last["gust_altitude_m"], eq["aerostat_altitude_m"]);
     if last["acceleration_m_s2"].as_f64() == Some(0.0) {
-        assert_eq!(last["gust_winch_tension_n"], eq["winch_tension_n"]);
+        let t = f(&last["gust_winch_tension_n"]);
+        let want = calm_winch + k * (ew - calm_winch);
+        assert!((t - want).abs() <= 1e-6 * want, "{t} vs {want}");
     }
 }
 
@@ -479,6 +568,28 @@ async fn the_plan_keeps_the_gusts_tension_within_the_rating_and_a_gust_that_brea
     // The same rating without gusts flies.
     let r = ok(&app, "/api/v1/plan", &rated(None, mid)).await;
     assert_eq!(r["go"], true, "{}", r["reason"]);
+    // A rating that holds the static gust tension at rest but not its
+    // dynamic value (docs/gust_check.md): no-go, and the reason names the factor.
+    let ts = free["wind"]["gust"]["static_target_max_tension_n"]
+        .as_f64()
+        .unwrap();
+    assert!(ts + 10.0 < tg, "{ts} {tg}");
+    let r = ok(
+        &app,
+        "/api/v1/plan",
+        &rated(Some(intensity(0.15)), 0.5 * (ts + tg)),
+    )
+    .await;
+    assert_eq!(r["go"], false, "{}", r["reason"]);
+    assert_eq!(r["binding_limit"], "gust_tension_limit", "{}", r["reason"]);
+    assert!(
+        r["reason"]
+            .as_str()
+            .unwrap()
+            .contains("× 1.41, the dynamic factor"),
+        "{}",
+        r["reason"]
+    );
     // A rating just above the gust's tension at rest: every instant keeps
     // the gust's tension (with the braking) within it.
     let allowable = 1.02 * tg;

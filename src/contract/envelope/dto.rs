@@ -124,10 +124,20 @@ pub struct EnvelopeGustPointOutput {
     pub aerostat_altitude_m: f64,
     pub aerostat_downwind_m: f64,
     pub blowdown_angle_deg: f64,
+    /// Winch tension (N) in the gust's static equilibrium times
+    /// `gust.dynamic_tension_factor_nondim`.
     pub winch_tension_n: f64,
+    /// Top tension (N), times the dynamic factor.
     pub top_tension_n: f64,
+    /// Largest tension (N), times the dynamic factor: the tension the
+    /// rating is judged on.
     pub max_tension_n: f64,
+    /// Largest tension of the static equilibrium in the gust (N), before the factor.
+    pub static_max_tension_n: f64,
+    /// Smallest tension of the static equilibrium in the gust (N), not
+    /// factored (slack and stability are judged on it as it is).
     pub min_tension_n: f64,
+    /// Breaking strength / `max_tension_n`; null without a breaking strength.
     pub safety_factor_nondim: Option<f64>,
     pub slack: bool,
     /// With a payout rate (string criterion): `min T − ρA v²` in the gust (N).
@@ -144,6 +154,12 @@ pub struct EnvelopeGustPointOutput {
 pub struct EnvelopeGustOutput {
     /// Gust over mean at every height: each row's gust is its wind times this.
     pub gust_factor_nondim: f64,
+    /// Factor on the gust cells' static tensions (1.363 with a turbulence
+    /// intensity, 1 for a gust given as a speed): the dynamic peak over the
+    /// static check (`docs/gust_check.md`).
+    pub dynamic_tension_factor_nondim: f64,
+    /// Where that factor comes from and whether this wind lies within its measurement.
+    pub dynamic_tension_note: String,
     /// How a cell is judged with gusts.
     pub rule: String,
 }

@@ -13,12 +13,14 @@ use crate::contract::equilibrium::dto::WindFlowInput;
 use crate::contract::equilibrium::dto::{ResolvedAerostatOutput, ResolvedCableOutput};
 use crate::contract::system::bounds::{self, require_range};
 use crate::contract::system::grid::GridBounds;
+use crate::contract::system::validate::GustWind;
 use crate::contract::{Progress, RequestError};
 use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::InvalidInput;
 use crate::numerics::tether::envelope::{
     EnvelopeProblem, Limit, Limits, MAX_ENVELOPE_POINTS, WindShape,
 };
+use crate::numerics::tether::gust::{DynamicTension, dynamic_tension_n};
 use crate::numerics::tether::{EquilibriumConfig, EquilibriumProblem, WindProfile};
 use dto::*;
 
@@ -160,6 +162,7 @@ impl EnvelopeRequest {
                     ceiling_m: self.ceiling_m,
                     min_altitude_m: self.min_altitude_m,
                     payout_rate_m_s: self.payout_rate_m_s,
+                    dynamic_tension: None,
                 },
             },
             EquilibriumConfig {
@@ -207,11 +210,17 @@ impl EnvelopeRequest {
     /// With `wind.gust`: the gust factor `G` on the flow (each row's gust
     /// is its wind times `G`).
     pub fn gust_factor(&self) -> Result<Option<f64>, InvalidInput> {
+        Ok(self.gust_wind()?.map(|g| g.factor))
+    }
+
+    /// With `wind.gust`: the gust as the plan resolves it (its factor on
+    /// the flow and its dynamic tension factor).
+    pub fn gust_wind(&self) -> Result<Option<GustWind>, InvalidInput> {
         if self.wind.gust.is_none() {
             return Ok(None);
         }
         let mean = self.wind.flow.profile("wind.flow")?;
-        Ok(self.wind.gust_wind(&mean)?.map(|g| g.factor))
+        self.wind.gust_wind(&mean)
     }
 
     /// Whether the quasi-static GE judges stability.
@@ -242,7 +251,9 @@ pub(crate) fn envelope_of(
     parallelism: Parallelism,
     progress: &dyn Progress,
 ) -> Result<EnvelopeResponse, RequestError> {
-    let gust_factor = req.gust_factor()?;
+    let gust_wind = req.gust_wind()?;
+    let gust_factor = gust_wind.as_ref().map(|g| g.factor);
+    let tension_factor = gust_wind.as_ref().map_or(1.0, |g| g.tension_factor);
     // With gusts the mean and the gust envelopes report half the progress each.
     let passes = if gust_factor.is_some() { 2 } else { 1 };
     let report = |done: usize, total: usize| progress.report(done, passes * total);
@@ -268,7 +279,7 @@ pub(crate) fn envelope_of(
     };
     let gust_env = match gust_factor {
         Some(g) => {
-            let gust_problem = gust_problem(problem, g, spec.is_some());
+            let gust_problem = gust_problem(problem, g, tension_factor, spec.is_some());
             let total = problem.wind_speeds_m_s.len();
             let report = |done: usize, _: usize| progress.report(total + done, 2 * total);
             match gust_problem.solve(config, parallelism, &report, &cancelled)? {
@@ -303,7 +314,7 @@ pub(crate) fn envelope_of(
                 feasible: limit.is_none(),
                 binding_limit: limit.map(|l| l.name().to_string()),
                 max_growth_rate_1_s: ge.as_ref().and_then(|g| g.max_growth_rate_1_s[k]),
-                gust: gust.map(|g| gust_point_output(g, in_gust)),
+                gust: gust.map(|g| gust_point_output(g, problem, tension_factor, in_gust)),
             }
         })
         .collect();
@@ -336,8 +347,10 @@ pub(crate) fn envelope_of(
         ceiling_m: req.ceiling_m,
         min_altitude_m: req.min_altitude_m,
         payout_rate_m_s: req.payout_rate_m_s,
-        gust: gust_factor.map(|g| EnvelopeGustOutput {
-            gust_factor_nondim: g,
+        gust: gust_wind.as_ref().map(|g| EnvelopeGustOutput {
+            gust_factor_nondim: g.factor,
+            dynamic_tension_factor_nondim: g.tension_factor,
+            dynamic_tension_note: g.dynamic_tension_note(),
             rule: if spec.is_some() {
                 GUST_RULE_GE
             } else {
@@ -377,11 +390,22 @@ pub const GUST_RULE: &str = "each cell is judged by the worst of the mean wind a
 /// [`GUST_RULE`] with the quasi-static GE criterion.
 pub const GUST_RULE_GE: &str = "each cell is judged by the worst of the mean wind and the gust (the row's wind times the gust factor, the static equilibrium at that speed, SPEC §10): slack, tension, ceiling and min_altitude in either put it outside; the quasi-static GE stability is judged in the mean wind only";
 
-/// The envelope problem in the gust: each row's wind times `factor`; with
+/// The envelope problem in the gust: each row's wind times `factor`, its
+/// largest tension judged at its dynamic value (`tension_factor` on the
+/// increment over the calm tension, the net buoyancy); with
 /// the GE criterion stability is left to the mean (no payout rate).
-fn gust_problem(problem: &EnvelopeProblem, factor: f64, ge: bool) -> EnvelopeProblem {
+fn gust_problem(
+    problem: &EnvelopeProblem,
+    factor: f64,
+    tension_factor: f64,
+    ge: bool,
+) -> EnvelopeProblem {
     let mut g = problem.clone();
     g.wind_speeds_m_s = problem.wind_speeds_m_s.iter().map(|u| u * factor).collect();
+    g.limits.dynamic_tension = Some(DynamicTension {
+        factor_nondim: tension_factor,
+        calm_max_tension_n: problem.base.body.net_buoyancy_n,
+    });
     if ge {
         g.limits.payout_rate_m_s = None;
     }
@@ -411,21 +435,35 @@ fn worst_limit(mean: Option<Limit>, gust: Option<Limit>) -> (Option<Limit>, bool
     }
 }
 
+/// One gust cell, its tensions at their dynamic value (`tension_factor` on
+/// the increment over calm air: the net buoyancy at the top and along the
+/// tether, `F − ρA g L` at the winch).
 fn gust_point_output(
     p: &crate::numerics::tether::envelope::EnvelopePoint,
+    problem: &EnvelopeProblem,
+    tension_factor: f64,
     binds: bool,
 ) -> EnvelopeGustPointOutput {
     let e = &p.equilibrium;
+    let f = problem.base.body.net_buoyancy_n;
+    let calm_winch = (f - problem.base.cable.mass_per_length_kg_m
+        * problem.base.gravity_m_s2
+        * p.tether_length_m)
+        .max(0.0);
+    let k = |t: f64, calm: f64| dynamic_tension_n(t, calm, tension_factor);
     EnvelopeGustPointOutput {
         wind_speed_m_s: p.wind_speed_m_s,
         aerostat_altitude_m: e.altitude_m,
         aerostat_downwind_m: e.downwind_m,
         blowdown_angle_deg: e.blowdown_angle_deg,
-        winch_tension_n: e.winch_tension_n,
-        top_tension_n: e.top_tension_n,
-        max_tension_n: e.max_tension_n,
+        winch_tension_n: k(e.winch_tension_n, calm_winch),
+        top_tension_n: k(e.top_tension_n, f),
+        max_tension_n: k(e.max_tension_n, f),
+        static_max_tension_n: e.max_tension_n,
         min_tension_n: e.min_tension_n,
-        safety_factor_nondim: e.safety_factor,
+        safety_factor_nondim: e
+            .safety_factor
+            .map(|sf| sf * e.max_tension_n / k(e.max_tension_n, f)),
         slack: e.slack,
         stability_margin_n: p.verdict.stability_margin_n,
         stable: p.verdict.stable,

@@ -129,6 +129,7 @@ fn state_output(
         ceiling_m: None,
         min_altitude_m: None,
         payout_rate_m_s: req.payout_rate_m_s,
+        dynamic_tension: None,
     };
     let verdict = judge(eq, problem.cable.mass_per_length_kg_m, &limits);
     let limit = verdict.limit.map(|l| l.name().to_string());

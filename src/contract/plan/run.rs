@@ -16,14 +16,14 @@ use crate::contract::plan::ge::*;
 use crate::contract::plan::output::*;
 use crate::contract::plan::validate::{Validated, validate};
 use crate::contract::system::output::groups;
-use crate::contract::system::validate::GustWind;
-use crate::numerics::plan::air::Air;
+use crate::numerics::plan::air::{Air, calm_tensions_n};
 use crate::numerics::plan::deadline::{self, ExceededBy};
 use crate::numerics::plan::ge_stability::ScheduleCheck;
 use crate::numerics::plan::retrieval::{self, TransientCheck};
 use crate::numerics::plan::schedule::{self, PlanOptions, PlanOutcome, Schedule};
 use crate::numerics::plan::{BindingLimit, PlanProblem, STABILITY_MARGIN};
 use crate::numerics::string::transient::{Observer, TransientError};
+use crate::numerics::tether::gust::dynamic_tension_n;
 use crate::numerics::tether::{Equilibrium, EquilibriumConfig};
 
 pub use crate::contract::plan::validate::{MAX_PLAN_SAMPLES, MIN_TARGET_M, validate_plan};
@@ -100,6 +100,18 @@ impl<'a> Context<'a> {
         self.p.direction() < 0.0
     }
 
+    /// After a gust tension limit judged at its dynamic value: what the
+    /// factor did (empty otherwise).
+    fn dynamic_gust_note(&self, b: BindingLimit) -> String {
+        match (&b, self.v.gust.as_ref()) {
+            (BindingLimit::GustTension { .. }, Some(g)) if g.tension_factor != 1.0 => format!(
+                " (the static gust tension's increment over calm air × {:.2}, the dynamic factor)",
+                g.tension_factor
+            ),
+            _ => String::new(),
+        }
+    }
+
     /// The answer when no schedule exists.
     fn infeasible(&self, b: BindingLimit, limits: PlanLimitsOutput) -> PlanResponse {
         let opts = &self.v.options;
@@ -110,8 +122,9 @@ impl<'a> Context<'a> {
             duration_s: None,
             binding_limit: Some(b.name().into()),
             reason: format!(
-                "no-go: {}{}",
+                "no-go: {}{}{}",
                 b.reason(self.p.lift_reserve),
+                self.dynamic_gust_note(b),
                 self.unchecked_note
             ),
             tension_checked: self.tension_checked,
@@ -154,24 +167,6 @@ fn target_equilibrium(v: &Validated, p: &PlanProblem, gust: bool) -> Option<Equi
     problem.solve(&EquilibriumConfig::default()).ok()
 }
 
-/// Where the gust's tension factor comes from, in words.
-pub(crate) fn dynamic_tension_note(g: &GustWind) -> String {
-    use crate::numerics::tether::gust::{DYNAMIC_FACTOR_MAX_INTENSITY, DYNAMIC_FACTOR_MAX_WIND_M_S};
-    if g.tension_factor == 1.0 {
-        return "the gust is a given speed (or I = 0): its static tensions are judged as they are".into();
-    }
-    let mut note = format!(
-        "the static gust tensions are judged at {:.3}× their value: the 99th percentile of the hourly largest winch          tension in the time-domain dynamics (von Kármán turbulence, 200 one-hour seeds) over the 1 + 3I check, the          largest measured (docs/gust_check.md; cargo run --release --example gust_check_table)",
-        g.tension_factor
-    );
-    if g.factor_extrapolated {
-        note.push_str(&format!(
-            "; this wind lies beyond the measurement (mean ≤ {DYNAMIC_FACTOR_MAX_WIND_M_S} m/s, I ≤ {DYNAMIC_FACTOR_MAX_INTENSITY}),              where the factor grew with the wind and the intensity: run POST /api/v1/dynamics/peaks for this case"
-        ));
-    }
-    note
-}
-
 /// The plan in wind: the target's length, blow-down and tensions, in the
 /// mean wind and in the gust side by side.
 fn wind_output(v: &Validated, p: &PlanProblem) -> Option<PlanWindOutput> {
@@ -179,6 +174,8 @@ fn wind_output(v: &Validated, p: &PlanProblem) -> Option<PlanWindOutput> {
     let at_target = target_equilibrium(v, p, false);
     let gust = v.gust.as_ref().map(|g| {
         let e = target_equilibrium(v, p, true);
+        let (calm_winch, calm_max) = calm_tensions_n(&p.system, p.target_length_m);
+        let dynamic = |t: f64, calm: f64| dynamic_tension_n(t, calm, g.tension_factor);
         PlanGustOutput {
             gust_factor_nondim: g.factor,
             reference_height_m: g.reference_height_m,
@@ -186,15 +183,15 @@ fn wind_output(v: &Validated, p: &PlanProblem) -> Option<PlanWindOutput> {
             target_altitude_m: e.as_ref().map(|e| e.altitude_m),
             target_downwind_m: e.as_ref().map(|e| e.downwind_m),
             blowdown_angle_deg: e.as_ref().map(|e| e.blowdown_angle_deg),
-            target_winch_tension_n: e.as_ref().map(|e| g.tension_factor * e.winch_tension_n),
-            target_max_tension_n: e.as_ref().map(|e| g.tension_factor * e.max_tension_n),
+            target_winch_tension_n: e.as_ref().map(|e| dynamic(e.winch_tension_n, calm_winch)),
+            target_max_tension_n: e.as_ref().map(|e| dynamic(e.max_tension_n, calm_max)),
             static_target_max_tension_n: e.as_ref().map(|e| e.max_tension_n),
-            target_safety_factor_nondim: e
-                .as_ref()
-                .and_then(|e| e.safety_factor)
-                .map(|sf| sf / g.tension_factor),
+            target_safety_factor_nondim: e.as_ref().and_then(|e| {
+                e.safety_factor
+                    .map(|sf| sf * e.max_tension_n / dynamic(e.max_tension_n, calm_max))
+            }),
             dynamic_tension_factor_nondim: g.tension_factor,
-            dynamic_tension_note: dynamic_tension_note(g),
+            dynamic_tension_note: g.dynamic_tension_note(),
             reachable_altitude_m: v
                 .options
                 .air
@@ -583,7 +580,7 @@ fn verdict(
             reason.push_str(&format!(", peak tension {t:.0} N"));
             if g.dynamic_tension_factor_nondim != 1.0 {
                 reason.push_str(&format!(
-                    " (the static gust tension × {:.3}, the dynamic factor)",
+                    " (the static gust tension's increment over calm air × {:.2}, the dynamic factor)",
                     g.dynamic_tension_factor_nondim
                 ));
             }

@@ -483,6 +483,32 @@ pub struct GustWind {
     pub factor_extrapolated: bool,
 }
 
+impl GustWind {
+    /// Where the gust's tension factor comes from, in words.
+    pub fn dynamic_tension_note(&self) -> String {
+        use crate::numerics::tether::gust::{
+            DYNAMIC_FACTOR_MAX_INTENSITY, DYNAMIC_FACTOR_MAX_WIND_M_S,
+        };
+        if self.tension_factor == 1.0 {
+            return "the gust is a given speed (or I = 0): its static tensions are judged as they are".into();
+        }
+        let mut note = format!(
+            "the static gust tensions are judged at their dynamic value, the calm-air tension plus {:.2}× their \
+             increment over it: the largest measured ratio of the 99th percentile of the hourly largest winch tension \
+             in the time-domain dynamics (von Kármán turbulence, 200 one-hour seeds) to the 1 + 3I check, both over \
+             calm air (docs/gust_check.md; cargo run --release --example gust_check_table)",
+            self.tension_factor
+        );
+        if self.factor_extrapolated {
+            note.push_str(&format!(
+                "; this wind lies beyond the measurement (mean ≤ {DYNAMIC_FACTOR_MAX_WIND_M_S} m/s, I ≤ {DYNAMIC_FACTOR_MAX_INTENSITY}), \
+                 where the factor grew with the wind and the intensity: run POST /api/v1/dynamics/peaks for this case"
+            ));
+        }
+        note
+    }
+}
+
 impl GustInput {
     /// The gust, its fields range-checked (each error names its field).
     pub fn gust(&self) -> Result<Gust, InvalidInput> {

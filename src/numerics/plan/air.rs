@@ -51,6 +51,7 @@ use crate::numerics::plan::ascent::AscentDrag;
 use crate::numerics::plan::sparse::{RELATIVE_TOLERANCE, Solved, sparse_along};
 use crate::numerics::plan::{PlanProblem, STABILITY_MARGIN};
 use crate::numerics::tether::continuation::ShootingContinuation;
+use crate::numerics::tether::gust::dynamic_tension_n;
 use crate::numerics::tether::{
     Body, Cable, Equilibrium, EquilibriumConfig, EquilibriumProblem, WindProfile,
 };
@@ -151,14 +152,24 @@ pub struct SteadyWind {
     pub ge: Option<super::ge_stability::GeCriterion>,
     /// The gust profile (SPEC §10); `None`: the mean wind only.
     pub gust: Option<WindProfile>,
-    /// The factor on the gust's static tensions (1 unless set by
-    /// [`Self::with_gust_tension_factor`]): the dynamic peak over the
-    /// static check (`crate::numerics::tether::gust::DYNAMIC_TENSION_FACTOR`).
+    /// The factor on the gust's static tensions' increment over calm air (1
+    /// unless set by [`Self::with_gust_tension_factor`]): the dynamic peak
+    /// over the static check
+    /// (`crate::numerics::tether::gust::DYNAMIC_TENSION_FACTOR`).
     pub gust_tension_factor: f64,
     /// Answers already computed, by (length, buoyancy, kind) bits: the
     /// pass, the bound, the constant-rate plan and the jerk check of one
     /// request share their grid's lengths.
     cache: Arc<Mutex<HashMap<CacheKey, [f64; 3]>>>,
+}
+
+/// Winch and top tension of the tether hanging still in calm air at full
+/// buoyancy (N): `F − ρA g L` (0 once the tether would rest on the ground)
+/// and `F`, the base the gust's dynamic factor amplifies over.
+pub fn calm_tensions_n(s: &AerostatSystem, length_m: f64) -> (f64, f64) {
+    let f = s.net_buoyancy_n;
+    let winch = (f - s.mass_per_length_kg_m * s.gravity_m_s2 * length_m).max(0.0);
+    (winch, f)
 }
 
 impl SteadyWind {
@@ -188,7 +199,9 @@ impl SteadyWind {
         self
     }
 
-    /// The gust's static tensions judged at `factor` times their value.
+    /// The gust's static tensions judged at their dynamic value: the calm
+    /// tension plus `factor` times their increment over it
+    /// ([`dynamic_tension_n`]).
     pub fn with_gust_tension_factor(mut self, factor: f64) -> Self {
         self.gust_tension_factor = factor;
         self
@@ -393,13 +406,18 @@ impl SteadyWind {
         along: Option<&mut Along>,
     ) -> Option<(f64, f64, f64)> {
         let g = self.gust.as_ref()?;
-        let k = self.gust_tension_factor;
         let (w, t, alt) = if *g == self.wind {
             self.operating_along(s, length_m, along.map(|a| &mut a.full[0]))
         } else {
             self.full_buoyancy_state(g, 2, s, length_m, along.map(|a| &mut a.full[1]))
         };
-        Some((k * w, k * t, alt))
+        let (calm_w, calm_t) = calm_tensions_n(s, length_m);
+        let k = self.gust_tension_factor;
+        Some((
+            dynamic_tension_n(w, calm_w, k),
+            dynamic_tension_n(t, calm_t, k),
+            alt,
+        ))
     }
 
     /// The winch and top tensions the limits bound: the larger of the

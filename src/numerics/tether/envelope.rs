@@ -121,6 +121,21 @@ pub struct Limits {
     pub min_altitude_m: Option<f64>,
     /// Payout rate for the stability criterion (m/s).
     pub payout_rate_m_s: Option<f64>,
+    /// The largest tension judged at its dynamic value (a gust of a
+    /// turbulence intensity, `docs/gust_check.md`); `None`: as it is.
+    pub dynamic_tension: Option<crate::numerics::tether::gust::DynamicTension>,
+}
+
+impl Limits {
+    /// The safety factor `eq` is judged on: breaking strength over its
+    /// largest tension, taken at its dynamic value when asked.
+    pub fn safety_factor(&self, eq: &Equilibrium) -> Option<f64> {
+        let sf = eq.safety_factor?;
+        Some(match &self.dynamic_tension {
+            Some(d) => sf * eq.max_tension_n / d.max_tension_n(eq.max_tension_n),
+            None => sf,
+        })
+    }
 }
 
 /// The verdict on one equilibrium.
@@ -155,8 +170,8 @@ pub fn judge_with(
         Some(Limit::NotConverged)
     } else if eq.slack || eq.min_tension_n <= 0.0 {
         Some(Limit::Slack)
-    } else if eq
-        .safety_factor
+    } else if limits
+        .safety_factor(eq)
         .is_some_and(|f| f < limits.required_safety_factor)
     {
         Some(Limit::Tension)
