@@ -174,6 +174,13 @@ import S from "./shared/index.js";
   }
   document.addEventListener("tetherplan:units", () => state.current && state.plan && state.request && showVerdict(state.plan, state.request));
 
+  // With a turbulent gust the tensions are judged at their dynamic value
+  // (docs/gust_check.md): say so wherever the gust's tension is shown.
+  function dynamicNote(w) {
+    const k = w?.gust?.dynamic_tension_factor_nondim;
+    return k != null && k !== 1 ? ` (turbulence: the static tension's rise over calm air × ${fmt(k, 2)})` : "";
+  }
+
   function headline(r, req) {
     const H = req.target_elevation_m;
     const U = req.wind?.flow?.speed_m_s;
@@ -192,7 +199,7 @@ import S from "./shared/index.js";
       case "tension_limit":
         return "The tether would be overloaded: its tension exceeds the breaking strength divided by the safety factor.";
       case "gust_tension_limit":
-        return `The gust of ${S.speedText(w?.gust?.reference_speed_m_s, 1)} would overload the tether: ${fmt(r.limits?.gust_peak_tension_n, 0)} N in the gust, above the breaking strength divided by the safety factor (${fmt(r.limits?.allowable_tension_n, 0)} N).`;
+        return `The gust of ${S.speedText(w?.gust?.reference_speed_m_s, 1)} would overload the tether: ${fmt(r.limits?.gust_peak_tension_n, 0)} N in the gust, above the breaking strength divided by the safety factor (${fmt(r.limits?.allowable_tension_n, 0)} N)${dynamicNote(w)}.`;
       case "min_altitude":
         return `${w?.gust ? `The gust of ${S.speedText(w.gust.reference_speed_m_s, 1)} blows` : "The wind blows"} the aerostat down to ${S.lengthText(w?.gust?.target_altitude_m ?? req.target_elevation_m, 0)}, below the lowest altitude allowed (${S.lengthText(req.min_altitude_m, 0)}).`;
       case "amplification_limit":
@@ -384,7 +391,7 @@ import S from "./shared/index.js";
       ["Minimum-time bound", r.bound ? `${fmt(r.bound.duration_s, 1)} s: ${r.bound.explanation}` : null],
       ["Lift limit with the reserve (calm air)", r.limits ? `${fmt(r.limits.lift_limit_m, 1)} m` : null],
       ["Reachable altitude in this wind", r.wind ? `${fmt(r.wind.reachable_altitude_m, 1)} m` : null],
-      ["Gust", r.wind?.gust ? `${fmt(r.wind.gust.reference_speed_m_s, 1)} m/s at ${fmt(r.wind.gust.reference_height_m, 0)} m (${fmt(r.wind.gust.gust_factor_nondim, 2)} × the mean); reachable altitude in the gust ${fmt(r.wind.gust.reachable_altitude_m, 1)} m` : null],
+      ["Gust", r.wind?.gust ? `${fmt(r.wind.gust.reference_speed_m_s, 1)} m/s at ${fmt(r.wind.gust.reference_height_m, 0)} m (${fmt(r.wind.gust.gust_factor_nondim, 2)} × the mean); reachable altitude in the gust ${fmt(r.wind.gust.reachable_altitude_m, 1)} m${dynamicNote(r.wind)}` : null],
       ["Stability criterion", r.wind?.stability_criterion ?? null],
       ["Smallest stability margin", r.limits?.min_stability_margin_m_s == null ? null : `${fmt(r.limits.min_stability_margin_m_s, 2)} m/s`],
       ["Allowable tension", r.limits?.allowable_tension_n ? `${fmt(r.limits.allowable_tension_n, 0)} N` : null],

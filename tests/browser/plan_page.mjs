@@ -180,6 +180,9 @@ try {
   check(broken.state === "no-go" && broken.word === "NO-GO" && broken.plan?.binding_limit === "gust_tension_limit",
     `a gust that breaks the tension limit: NO-GO (${broken.state}, ${broken.plan?.binding_limit})`);
   check(/gust/i.test(broken.why) && !/_/.test(broken.why), `the headline names the gust (“${broken.why}”)`);
+  // A turbulent gust's tension is judged at its dynamic value (docs/gust_check.md): the operator is told.
+  check(broken.plan?.wind?.gust?.dynamic_tension_factor_nondim === 1.41 && broken.why.includes("× 1.41"),
+    `the headline says the gust's tension is taken at the dynamic factor 1.41 (“${broken.why}”)`);
   await page.fill(field("wind.gust.turbulence_intensity_nondim"), "");
   await page.fill(field("cable.breaking_strength_n"), "");
 
