@@ -26,6 +26,13 @@
 //! * `seeds_4_hours_2_threads`: four seeds of the hour on a rayon pool of
 //!   two threads (100 seeds take 25 times as long).
 //!
+//! * `TETHERPLAN_DYNAMICS_ONCE=peaks_200` (plain, not criterion: one run
+//!   takes a minute or more): `POST /api/v1/dynamics/peaks` as the API
+//!   runs it, 200 seeds of one hour on the gust-check system of
+//!   `docs/gust_check.md` (10 m/s, I = 0.15) on rayon over every core,
+//!   `TETHERPLAN_BENCH_RUNS` (3) times; prints each wall and process CPU
+//!   time and the median wall (issue 31: ≤ 2 min on 2 cores).
+//!
 //! The `_cpu` variants time the CPU of the running thread rather than the
 //! wall clock: the machine is shared, and the wall clock of a loaded
 //! machine measures the load.
@@ -238,9 +245,68 @@ fn step_study() {
     }
 }
 
+/// CPU time of the whole process (every rayon thread).
+fn process_cpu() -> Duration {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec.
+    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
+}
+
+/// The 200-seed hourly peak distribution, as the API runs it.
+fn peaks_200() {
+    use tetherplan::contract::dynamics::parse_peaks;
+    use tetherplan::contract::dynamics::peaks::peaks;
+    use tetherplan::numerics::parallel::Parallelism;
+    let runs: usize = std::env::var("TETHERPLAN_BENCH_RUNS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3);
+    let body = serde_json::json!({
+        "cable": {"mass_per_length_kg_m": 0.078, "diameter_m": 0.005,
+                  "normal_drag_coefficient_nondim": 1.2, "axial_stiffness_n": 1.0e7},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0,
+                     "drag_coefficient_nondim": 0.3, "reference_area_m2": 20.0},
+        "wind": {"flow": {"kind": "uniform", "speed_m_s": 10.0},
+                 "time_history": {"kind": "turbulence", "model": "von_karman",
+                                  "turbulence_intensity_nondim": 0.15,
+                                  "length_scale_m": 340.0, "seed": 1}},
+        "tether_length_m": 1000.0,
+        "exposure_s": 3600.0,
+        "samples": 200,
+        "percentiles_nondim": [0.5, 0.9, 0.99]
+    });
+    let req = parse_peaks(body.to_string().as_bytes()).expect("a valid request");
+    let mut walls = Vec::new();
+    for _ in 0..runs {
+        let (clock, cpu) = (Instant::now(), process_cpu());
+        let a = peaks(&req, Parallelism::Rayon, &NoProgress).expect("the peaks");
+        let wall = clock.elapsed().as_secs_f64();
+        println!(
+            "peaks_200: {wall:.1} s wall, {:.1} s CPU on {} threads; p99 of the hourly peak winch tension {:.1} N",
+            (process_cpu() - cpu).as_secs_f64(),
+            rayon::current_num_threads(),
+            a.max_winch_tension.percentiles[2].value_n
+        );
+        walls.push(wall);
+    }
+    walls.sort_by(f64::total_cmp);
+    println!(
+        "peaks_200: median {:.1} s wall of {walls:?}",
+        walls[walls.len() / 2]
+    );
+}
+
 fn main() {
     if std::env::var("TETHERPLAN_DYNAMICS_ONCE").as_deref() == Ok("step_study") {
         step_study();
+        return;
+    }
+    if std::env::var("TETHERPLAN_DYNAMICS_ONCE").as_deref() == Ok("peaks_200") {
+        peaks_200();
         return;
     }
     if std::env::var("TETHERPLAN_DYNAMICS_ONCE").as_deref() == Ok("converged_hour") {

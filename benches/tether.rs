@@ -60,6 +60,7 @@ fn benches(c: &mut Criterion) {
             ceiling_m: None,
             min_altitude_m: None,
             payout_rate_m_s: None,
+            dynamic_tension: None,
         },
     };
     let mut group = c.benchmark_group("envelope");
