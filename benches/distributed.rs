@@ -5,7 +5,7 @@
 //!    `tetherplan worker` processes (one rayon thread each) behind an
 //!    API-only `tetherplan serve`: wall time from submission to `done`,
 //!    median of `TETHERPLAN_BENCH_RUNS` (3) runs each, and the speed-up;
-//!    and a `dynamics_peaks` job (24 seeds of 600 s of von Kármán turbulence
+//!    and a `dynamics_peaks` job (40 seeds of 900 s of von Kármán turbulence
 //!    on the §10 1000 m tether at 10 m/s, I = 0.15, chunked by sample) the
 //!    same way (issue 31: 2 workers ≥ 1.8× as fast as one);
 //! 2. the overhead of one chunk: claim + finish of an empty chunk through
@@ -151,7 +151,7 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// A `dynamics_peaks` job: 24 one-run samples of 600 s (the gust-check
+/// A `dynamics_peaks` job: 40 one-run samples of 900 s (the gust-check
 /// system of `docs/gust_check.md`), chunked by sample.
 fn peaks_job() -> Value {
     json!({"kind": "dynamics_peaks", "request": {
@@ -164,8 +164,8 @@ fn peaks_job() -> Value {
                                   "turbulence_intensity_nondim": 0.15,
                                   "length_scale_m": 340.0, "seed": 1}},
         "tether_length_m": 1000.0,
-        "exposure_s": 600.0,
-        "samples": 24
+        "exposure_s": 900.0,
+        "samples": 40
     }})
 }
 
