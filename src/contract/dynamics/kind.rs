@@ -155,8 +155,9 @@ impl Analysis for DynamicsPeaksRequest {
         Estimate::new(
             "samples",
             est::SIMULATE_BASE
-                + (self.samples as u64).saturating_mul(PER_PEAK_SAMPLE)
-                + 2 * (self.percentiles_nondim.len() as u64) * 4 * est::PER_NUMBER,
+                // the samples and the step check's block (about one sample's)
+                + (self.samples as u64 + 1).saturating_mul(PER_PEAK_SAMPLE)
+                + 2 * (self.percentiles_nondim.len() as u64) * 5 * est::PER_NUMBER,
         )
     }
     /// By sample.
