@@ -11,7 +11,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 mod common;
-use common::http::{Reply, connect, exchange, spawn_listening};
+use common::http::{Reply, connect, exchange, probe_healthz, spawn_listening};
 
 struct Server {
     child: Child,
@@ -44,7 +44,10 @@ impl Server {
             .arg(dir.join("jobs.db"))
             .arg("--static-dir")
             .arg(dir.join("static"))
-            .env("RUST_LOG", "error")
+            .env(
+                "RUST_LOG",
+                std::env::var("TP_DEBUG_LOG").unwrap_or("error".into()),
+            )
             .env("TETHERPLAN_JOB_THREADS", "0")
             .stderr(Stdio::inherit());
         for (k, v) in envs {
@@ -64,23 +67,10 @@ impl Server {
             .unwrap()
     }
 
-    /// `GET /healthz` over a fresh connection, within `timeout`.
-    fn healthy(&self, timeout: Duration) -> bool {
-        let Ok(mut s) = TcpStream::connect_timeout(&self.addr, timeout) else {
-            return false;
-        };
-        s.set_read_timeout(Some(timeout)).unwrap();
-        s.set_write_timeout(Some(timeout)).unwrap();
-        let req = format!(
-            "GET /healthz HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n\r\n",
-            self.addr
-        );
-        if s.write_all(req.as_bytes()).is_err() {
-            return false;
-        }
-        let mut raw = Vec::new();
-        let _ = s.read_to_end(&mut raw);
-        raw.starts_with(b"HTTP/1.1 200")
+    /// `GET /healthz` over a fresh connection, each step within
+    /// `timeout`; the error says what failed.
+    fn healthy(&self, timeout: Duration) -> Result<(), String> {
+        probe_healthz(self.addr, timeout)
     }
 
     /// Sends `head` (a request head, blank line included) and reads the
@@ -182,22 +172,26 @@ fn slow_bodies_do_not_hold_the_connection_cap() {
         .collect();
     std::thread::sleep(Duration::from_millis(500));
     let probes = 10;
-    let mut ok = 0;
-    for _ in 0..probes {
-        if server.healthy(Duration::from_secs(2)) {
-            ok += 1;
+    let mut failed = Vec::new();
+    for i in 0..probes {
+        if let Err(why) = server.healthy(Duration::from_secs(2)) {
+            failed.push(format!("probe {i}: {why}"));
         }
         std::thread::sleep(Duration::from_millis(300));
     }
+    let ok = probes - failed.len();
     let times: Vec<Duration> = clients.into_iter().map(|c| c.join().unwrap().0).collect();
-    assert_eq!(ok, probes, "/healthz answered {ok} of {probes} probes");
+    assert_eq!(
+        ok, probes,
+        "/healthz answered {ok} of {probes} probes; the others: {failed:?}"
+    );
     let slowest = times.iter().max().unwrap();
     // deadline 3 s + the server's reaction (a phase change or a timer) + scheduling
     assert!(
         *slowest < Duration::from_secs(7),
         "a slow body was held {slowest:?} (body deadline 3 s)"
     );
-    assert!(server.healthy(Duration::from_secs(2)));
+    server.healthy(Duration::from_secs(2)).unwrap();
 }
 
 /// Item 2: 60 bodies of 1,000,000 bytes, each sent up to 900 kB at once
@@ -257,7 +251,7 @@ fn request_bodies_are_bounded_in_total() {
     );
     let slowest = results.iter().map(|(t, _)| *t).max().unwrap();
     assert!(slowest < Duration::from_secs(9), "held {slowest:?}");
-    assert!(server.healthy(Duration::from_secs(2)));
+    server.healthy(Duration::from_secs(2)).unwrap();
 }
 
 /// Item 2: an answer the client never reads is dropped at the write
@@ -287,7 +281,7 @@ fn an_unread_answer_is_dropped_at_the_write_deadline() {
         got < 48 << 20,
         "the whole 48 MiB answer arrived ({got} bytes) after the write deadline"
     );
-    assert!(server.healthy(Duration::from_secs(2)));
+    server.healthy(Duration::from_secs(2)).unwrap();
 }
 
 /// Item 8: a too-large `Content-Length` is 413 from the head alone: no
@@ -436,5 +430,5 @@ fn unread_job_answers_are_streamed_not_held() {
     // first read (6 s), not held open to the end of the answer
     let slowest = results.iter().map(|r| r.1).max().unwrap();
     assert!(slowest < Duration::from_secs(12), "held {slowest:?}");
-    assert!(server.healthy(Duration::from_secs(2)));
+    server.healthy(Duration::from_secs(2)).unwrap();
 }

@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 mod common;
-use common::http::spawn_listening;
+use common::http::{probe_healthz, spawn_listening};
 
 struct Server {
     child: Child,
@@ -57,23 +57,10 @@ impl Server {
         kb / 1024.0
     }
 
-    /// `GET /healthz` over a fresh connection, within `timeout`.
-    fn healthy(&self, timeout: Duration) -> bool {
-        let Ok(mut s) = TcpStream::connect_timeout(&self.addr, timeout) else {
-            return false;
-        };
-        s.set_read_timeout(Some(timeout)).unwrap();
-        s.set_write_timeout(Some(timeout)).unwrap();
-        let req = format!(
-            "GET /healthz HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n\r\n",
-            self.addr
-        );
-        if s.write_all(req.as_bytes()).is_err() {
-            return false;
-        }
-        let mut raw = Vec::new();
-        let _ = s.read_to_end(&mut raw);
-        raw.starts_with(b"HTTP/1.1 200")
+    /// `GET /healthz` over a fresh connection, each step within
+    /// `timeout`; the error says what failed.
+    fn healthy(&self, timeout: Duration) -> Result<(), String> {
+        probe_healthz(self.addr, timeout)
     }
 
     /// The lowest resident memory seen within `within` (MB), polling
@@ -109,7 +96,7 @@ impl Drop for Server {
 #[test]
 fn a_trickled_body_holds_its_bytes_not_its_pieces() {
     let server = Server::start("pieces", &[("TETHERPLAN_BODY_DEADLINE_S", "60")]);
-    assert!(server.healthy(Duration::from_secs(5)));
+    server.healthy(Duration::from_secs(5)).unwrap();
     let before = server.rss_mb();
     const CONNECTIONS: usize = 50;
     const BODY: usize = 2000;
@@ -168,7 +155,7 @@ fn a_trickled_body_holds_its_bytes_not_its_pieces() {
         after - before < 20.0,
         "{before:.1} MB before, {after:.1} MB after the trickle ended"
     );
-    assert!(server.healthy(Duration::from_secs(5)));
+    server.healthy(Duration::from_secs(5)).unwrap();
 }
 
 /// Item 7: a reconnect storm (24 clients opening connections as fast as
@@ -184,7 +171,7 @@ fn healthz_answers_through_a_reconnect_storm() {
             ("TETHERPLAN_HEADER_TIMEOUT_S", "5"),
         ],
     );
-    assert!(server.healthy(Duration::from_secs(5)));
+    server.healthy(Duration::from_secs(5)).unwrap();
     let before = server.rss_mb();
     let stop = Arc::new(AtomicBool::new(false));
     let opened = Arc::new(AtomicUsize::new(0));
@@ -211,8 +198,9 @@ fn healthz_answers_through_a_reconnect_storm() {
     let mut peak = before;
     let probes = 80;
     for _ in 0..probes {
-        if !server.healthy(Duration::from_secs(2)) {
+        if let Err(why) = server.healthy(Duration::from_secs(2)) {
             failures += 1;
+            eprintln!("probe failed: {why}");
         }
         peak = peak.max(server.rss_mb());
         std::thread::sleep(Duration::from_millis(200));
@@ -232,5 +220,5 @@ fn healthz_answers_through_a_reconnect_storm() {
         "/healthz failed {failures} of {probes} times in the storm"
     );
     assert!(after - before < 100.0, "{before:.1} → {after:.1} MB");
-    assert!(server.healthy(Duration::from_secs(5)));
+    server.healthy(Duration::from_secs(5)).unwrap();
 }

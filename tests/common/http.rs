@@ -38,6 +38,28 @@ pub fn connect(addr: SocketAddr, timeout: Duration) -> TcpStream {
     s
 }
 
+/// `GET /healthz` over a fresh connection, each step within `timeout`:
+/// `Ok` for a 200, otherwise what went wrong and when (for the test's
+/// message).
+pub fn probe_healthz(addr: SocketAddr, timeout: Duration) -> Result<(), String> {
+    let start = std::time::Instant::now();
+    let at = |what: String| format!("{what} after {:?}", start.elapsed());
+    let mut s = TcpStream::connect_timeout(&addr, timeout)
+        .map_err(|e| at(format!("connect failed ({e})")))?;
+    s.set_read_timeout(Some(timeout)).unwrap();
+    s.set_write_timeout(Some(timeout)).unwrap();
+    let req = format!("GET /healthz HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n");
+    s.write_all(req.as_bytes())
+        .map_err(|e| at(format!("write failed ({e})")))?;
+    let mut raw = Vec::new();
+    let read = s.read_to_end(&mut raw);
+    if raw.starts_with(b"HTTP/1.1 200") {
+        return Ok(());
+    }
+    let first = String::from_utf8_lossy(&raw[..raw.len().min(40)]).into_owned();
+    Err(at(format!("reply {first:?} ({read:?})")))
+}
+
 /// Sends `method path` with `body` (and `content_type` when given) over
 /// `s`, then reads the reply to the end.
 pub fn exchange(
