@@ -44,9 +44,10 @@ impl Server {
             .arg(dir.join("jobs.db"))
             .arg("--static-dir")
             .arg(dir.join("static"))
+            // TETHERPLAN_TEST_SERVER_LOG=tetherplan=debug shows the connection layer.
             .env(
                 "RUST_LOG",
-                std::env::var("TP_DEBUG_LOG").unwrap_or("error".into()),
+                std::env::var("TETHERPLAN_TEST_SERVER_LOG").unwrap_or("error".into()),
             )
             .env("TETHERPLAN_JOB_THREADS", "0")
             .stderr(Stdio::inherit());
