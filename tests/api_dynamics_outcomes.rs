@@ -86,9 +86,15 @@ fn a_gust_shorter_than_the_steps_is_refused() {
 }
 
 /// The case of issue 31 through the contract: paid out at 2 m/s from 200 m
-/// in calm air, stopping at 1000 m (400 s), held to 430 s: completed, the
-/// largest winch tension below 5 kN (before: 2.2e7 N and the aerostat at
-/// −107 m, "completed"), the lowest altitude above 990 m after the stop.
+/// in calm air, stopping at 1000 m (400 s), held to 430 s: completed
+/// (before: 2.2e7 N and the aerostat at −107 m, "completed"), the lowest
+/// altitude above 990 m after the stop. The largest winch tension, taken
+/// over every sub-step of the refined window after the stop, is 5526 N at
+/// 400.19 s (the tether's rebound from slack snapping at the winch; the
+/// same to 1e-9 at outer steps of 0.05 to 0.00625 s): asserted above the
+/// stop's wave `T + ρA c ΔV` (about 2.0 kN) and below the energy bound
+/// `√(2 EA E_k / l)` = 12.5 kN (the kinetic energy ½ · 78 kg · (2 m/s)²
+/// all in one 20 m segment).
 /// The fixed probe reads the calm air (0 m/s) at its height.
 #[test]
 fn a_winch_stop_through_the_contract() {
@@ -105,7 +111,10 @@ fn a_winch_stop_through_the_contract() {
         a["outcome"], a["peak_winch_tension_n"], a["peak_winch_tension_time_s"], a["slack_events"]
     );
     assert_eq!(a["outcome"], "completed");
-    assert!(a["peak_winch_tension_n"].as_f64().unwrap() < 5000.0);
+    let peak = a["peak_winch_tension_n"].as_f64().unwrap();
+    let wave = (1e7f64 * 0.078).sqrt() * 2.0;
+    let energy_bound = (2.0 * 1e7 * 0.5 * 78.0 * 4.0 / 20.0f64).sqrt();
+    assert!(peak > wave && peak < energy_bound, "{peak} N");
     let lowest = a["samples"]
         .as_array()
         .unwrap()

@@ -3,7 +3,7 @@
 //! and segment tensions, every step checked ([`Recorder`]).
 
 use super::blocks::{V2, norm};
-use super::integrator::AirAt;
+use super::integrator::{AirAt, InsideState};
 use super::model::{Evaluation, Length};
 
 /// One kept sample.
@@ -105,6 +105,29 @@ impl Recorder {
             next_shape: 0,
             half_step_s: 0.5 * step_s,
             probe,
+        }
+    }
+
+    /// Takes the extremes of the sub-step ends inside an outer step (no
+    /// sample: samples stay on the step grid).
+    pub fn record_inside(&mut self, inside: &[InsideState]) {
+        for s in inside {
+            let at = |value: f64| Extreme {
+                value,
+                time_s: s.time_s,
+            };
+            if s.winch_tension_n > self.peak_winch.value {
+                self.peak_winch = at(s.winch_tension_n);
+            }
+            if s.winch_tension_n < self.min_winch.value {
+                self.min_winch = at(s.winch_tension_n);
+            }
+            if s.max_tension_n > self.peak.value {
+                self.peak = at(s.max_tension_n);
+            }
+            if s.aerostat_altitude_m < self.min_altitude.value {
+                self.min_altitude = at(s.aerostat_altitude_m);
+            }
         }
     }
 

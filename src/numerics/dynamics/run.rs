@@ -149,7 +149,10 @@ pub fn simulate_from(
                 _ => t_end,
             };
             if target - st.t > shortest {
-                if !st.step(target - st.t, 0) {
+                let stepped = st.step(target - st.t, 0);
+                rec.record_inside(&st.inside);
+                st.inside.clear();
+                if !stepped {
                     outcome = Outcome::NewtonFailed { time_s: st.t };
                     break 'steps;
                 }
