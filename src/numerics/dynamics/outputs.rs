@@ -112,22 +112,30 @@ impl Recorder {
     /// sample: samples stay on the step grid).
     pub fn record_inside(&mut self, inside: &[InsideState]) {
         for s in inside {
-            let at = |value: f64| Extreme {
-                value,
-                time_s: s.time_s,
-            };
-            if s.winch_tension_n > self.peak_winch.value {
-                self.peak_winch = at(s.winch_tension_n);
-            }
-            if s.winch_tension_n < self.min_winch.value {
-                self.min_winch = at(s.winch_tension_n);
-            }
-            if s.max_tension_n > self.peak.value {
-                self.peak = at(s.max_tension_n);
-            }
-            if s.aerostat_altitude_m < self.min_altitude.value {
-                self.min_altitude = at(s.aerostat_altitude_m);
-            }
+            self.note_extremes(
+                s.time_s,
+                s.winch_tension_n,
+                s.max_tension_n,
+                s.aerostat_altitude_m,
+            );
+        }
+    }
+
+    /// Updates the extremes with one state's winch tension, largest segment
+    /// tension and aerostat altitude at `t`.
+    fn note_extremes(&mut self, t: f64, winch: f64, largest: f64, altitude: f64) {
+        let at = |value: f64| Extreme { value, time_s: t };
+        if winch > self.peak_winch.value {
+            self.peak_winch = at(winch);
+        }
+        if winch < self.min_winch.value {
+            self.min_winch = at(winch);
+        }
+        if largest > self.peak.value {
+            self.peak = at(largest);
+        }
+        if altitude < self.min_altitude.value {
+            self.min_altitude = at(altitude);
         }
     }
 
@@ -145,18 +153,6 @@ impl Recorder {
     ) {
         let n = x.len();
         let winch = norm(ev.winch_force);
-        if winch > self.peak_winch.value {
-            self.peak_winch = Extreme {
-                value: winch,
-                time_s: t,
-            };
-        }
-        if winch < self.min_winch.value {
-            self.min_winch = Extreme {
-                value: winch,
-                time_s: t,
-            };
-        }
         let l = len.length_m / n as f64;
         let mut lowest_slack = None;
         let mut largest = f64::NEG_INFINITY;
@@ -166,12 +162,8 @@ impl Recorder {
                 lowest_slack = Some((j as f64 + 0.5) * l);
             }
         }
-        if largest > self.peak.value {
-            self.peak = Extreme {
-                value: largest,
-                time_s: t,
-            };
-        }
+        let top = x[n - 1];
+        self.note_extremes(t, winch, largest, top[1]);
         match (lowest_slack, self.slack_events.last_mut()) {
             (Some(s), Some(e)) if e.end_s.is_none() => e.lowest_s_m = e.lowest_s_m.min(s),
             (Some(s), _) => self.slack_events.push(SlackEvent {
@@ -181,13 +173,6 @@ impl Recorder {
             }),
             (None, Some(e)) if e.end_s.is_none() => e.end_s = Some(t),
             _ => {}
-        }
-        let top = x[n - 1];
-        if top[1] < self.min_altitude.value {
-            self.min_altitude = Extreme {
-                value: top[1],
-                time_s: t,
-            };
         }
         let eps = 1e-9 * self.sample_interval_s;
         if force_sample || t >= self.next_sample - eps {
