@@ -15,8 +15,11 @@
 //! than the tolerance (measured: a slack tether snapping taut after an
 //! abrupt winch stop, whose peaks change by 5–30 % at every halving down
 //! to 0.4 ms), or the segments do, the request is refused naming
-//! `numerics`, with the changes in the reason: no figure is handed out as
-//! converged that is not.
+//! `numerics`, with the changes in the reason and the cause found in the
+//! finest run: a slack tether that snapped taut (an instantaneous stop has
+//! no converged peak: give the winch its deceleration), or axial waves the
+//! default steps do not resolve (the step they need is named): no figure
+//! is handed out as converged that is not.
 //!
 //! **Fixed** (the request gives either): that discretisation's run is the
 //! answer, the run at twice its step and the one at half its segments
@@ -82,6 +85,41 @@ pub fn dynamics(
     Ok(answer)
 }
 
+/// Why the default ladder's figures did not converge, from the finest
+/// run (see the module docs): a slack tether that snapped taut, or the
+/// tether's axial waves (first period `4L/c`, `c = √(EA/ρA)`, shortest at
+/// the shortest length), rung by the winch's changes of rate or
+/// acceleration, at steps too long for them. Measured on the §10 tether
+/// paid out 200 → 1000 m with 2 s ramps in calm air: with
+/// `internal_damping_n_s` 1e4 the peak winch tension is 932.13 and
+/// 932.50 N at 0.0044 and 0.0022 s (a 16th and a 32nd of the period at
+/// 200 m, 0.0707 s), against 959.7, 883.0, 925.1 N at 0.05, 0.025,
+/// 0.0125 s; without damping it still changes by 1.1 % at 0.00625 s.
+fn unconverged_cause(prepared: &Prepared, run: &crate::numerics::dynamics::Run) -> String {
+    let tether = &prepared.problem.tether;
+    let shortest = prepared
+        .problem
+        .length
+        .shortest_m(prepared.config.duration_s);
+    let period = 4.0 * shortest / (tether.axial_stiffness_n / tether.mass_per_length_kg_m).sqrt();
+    let damping = if tether.internal_damping_n_s > 0.0 {
+        String::new()
+    } else {
+        ", with the tether's internal damping (`internal_damping_n_s`: none by default, so only the integrator damps the waves)".to_string()
+    };
+    match run.slack_events.first() {
+        Some(first) => format!(
+            "the tether went slack {} time(s) (first at {:.2} s) and snapped taut: the snap of an instantaneous winch stop has no converged peak (undamped, it changes with the segment count and converges only as about the square root of the segment length; damped, the damper's force at the stop is `c ΔV` over one segment's length, which grows as the segments shrink). Give the winch its deceleration (a `trapezoidal` profile's `ramp_down_s`){damping}",
+            run.slack_events.len(),
+            first.start_s
+        ),
+        None => format!(
+            "the tether's axial waves (first period 4L/c = {period:.4} s at its shortest, {shortest:.0} m), rung by the winch's changes of rate or acceleration, are not resolved by the default steps: give numerics.time_step_s of at most {:.5} s (a 32nd of that period){damping}",
+            period / 32.0
+        ),
+    }
+}
+
 /// Runs the ladder of `prepared` and gives the answer's run with its
 /// converged figures, or refuses naming `numerics`.
 pub fn run_converged(
@@ -129,7 +167,7 @@ pub fn run_converged(
                 "{unfinished} of the runs did not reach the end (see `outcome` at a fixed discretisation)"
             )
         } else {
-            "a slack tether snapping taut (an abrupt winch stop) is not converged at any affordable step".to_string()
+            unconverged_cause(prepared, &answer.run)
         };
         return Err(InvalidInput::new(
             "numerics",
@@ -163,11 +201,12 @@ pub fn run_converged(
             return Err(InvalidInput::new(
                 "numerics",
                 format!(
-                    "the figures changed by more than {} of their scale between {} and {} segments at {h} s: {}. Give numerics.segments (and numerics.time_step_s) to have the answer at that discretisation with its error estimate, or a larger numerics.tolerance_nondim",
+                    "the figures changed by more than {} of their scale between {} and {} segments at {h} s: {}. Likely cause: {}. Give numerics.segments (and numerics.time_step_s) to have the answer at that discretisation with its error estimate, or a larger numerics.tolerance_nondim",
                     ladder.tolerance,
                     ladder.check_segments,
                     ladder.segments,
-                    ladder_words(&runs)
+                    ladder_words(&runs),
+                    unconverged_cause(prepared, &answer.run)
                 ),
             )
             .into());

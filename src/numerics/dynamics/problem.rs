@@ -106,9 +106,16 @@ impl LengthSchedule {
 
     /// The longest length over `[0, until]` (sampled; profiles are monotone between knots).
     pub fn longest_m(&self, until_s: f64) -> f64 {
-        (0..=512)
-            .map(|i| self.at(until_s * i as f64 / 512.0).length_m)
-            .fold(0.0, f64::max)
+        self.sampled(until_s).fold(0.0, f64::max)
+    }
+
+    /// The shortest length over `[0, until]` (sampled as [`Self::longest_m`]).
+    pub fn shortest_m(&self, until_s: f64) -> f64 {
+        self.sampled(until_s).fold(f64::INFINITY, f64::min)
+    }
+
+    fn sampled(&self, until_s: f64) -> impl Iterator<Item = f64> + '_ {
+        (0..=512).map(move |i| self.at(until_s * i as f64 / 512.0).length_m)
     }
 }
 
