@@ -207,7 +207,7 @@ fn an_undamped_snap_converges_only_slowly_in_the_segments() {
 /// within 0.2 % of the tension scale), where without damping it still
 /// changes by 1.1 % between 0.0125 and 0.00625 s.
 #[test]
-fn a_two_second_ramp_is_refused_naming_the_axial_waves_and_the_advice_converges() {
+fn a_two_second_ramp_converges_by_default_when_damped_and_is_refused_naming_the_waves_when_not() {
     let ramp = |damping: f64| {
         let mut v = request(
             0.0,
@@ -237,6 +237,11 @@ fn a_two_second_ramp_is_refused_naming_the_axial_waves_and_the_advice_converges(
         other => panic!("expected a refusal naming numerics, got {other:?}"),
     }
     let damped = ramp(1e4);
+    // By default the damped ramp's ladder goes on below 0.05 s until the
+    // figures agree (at most to the step that resolves the waves).
+    let a = check_default_bounds("2 s ramps, damped", &damped);
+    let h = a["converged"]["time_step_s"].as_f64().unwrap();
+    assert!(h < 0.05 && h >= step / 2.0, "{h}");
     let (coarse, fine) = (
         figures_at(&damped, 2.0 * step, 50),
         figures_at(&damped, step, 50),

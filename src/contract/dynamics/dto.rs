@@ -134,7 +134,10 @@ pub struct DynamicsNumericsInput {
     /// Time step (s); the generalized-α step is unconditionally stable, so
     /// it is set by the accuracy wanted. Default: chosen (0.2, 0.1 or
     /// 0.05 s, at most a quarter of the shortest gust or sinusoid period)
-    /// so that the figures meet `tolerance_nondim`.
+    /// so that the figures meet `tolerance_nondim`; for a damped tether
+    /// (`internal_damping_n_s` > 0) whose winch changes its rate or
+    /// acceleration, halved further (at most 6 times) down to a 32nd of
+    /// the first axial period `4L/c` at the shortest length.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(example = 0.05, minimum = 0.0001, maximum = 10.0)]
     pub time_step_s: Option<f64>,

@@ -42,6 +42,15 @@ pub const BASE_TIME_STEP_S: f64 = 0.2;
 /// at 0.2 + 0.1 + 0.05 s and the segment check at 0.05 s on half the
 /// segments: 1 + 2 + 4 + 2 units of the 0.2 s run, against 4).
 pub const DEFAULT_LEVELS: usize = 3;
+/// Rungs the default ladder may add below its finest step for a damped
+/// tether whose winch changes its rate or acceleration (down to
+/// [`AXIAL_STEPS_PER_PERIOD`] steps per axial period at the shortest
+/// length: 0.05 s / 2⁶ = 0.78 ms at most).
+pub const MAX_EXTRA_LEVELS: usize = 6;
+/// Steps per period of the first axial mode that resolve the waves a
+/// change of the winch rings (measured on a 2 s ramp, see
+/// `tests/verification_dynamics_converged.rs`).
+pub const AXIAL_STEPS_PER_PERIOD: f64 = 32.0;
 /// The step of `/dynamics/peaks` samples without a `numerics.time_step_s` (s).
 pub const PEAKS_TIME_STEP_S: f64 = 0.05;
 
@@ -106,6 +115,49 @@ impl Prepared {
             .map(|&(s, n)| s as f64 * n as f64)
             .sum()
     }
+}
+
+/// The default ladder of a damped tether whose winch changes its rate or
+/// acceleration within the run: the changes ring the axial waves, which
+/// the default steps do not resolve (a 2 s ramp's peak changes by 3–8 %
+/// per halving down to 0.0125 s), so the ladder goes on halving until a
+/// step resolves them ([`AXIAL_STEPS_PER_PERIOD`] per period at the
+/// shortest length), at most [`MAX_EXTRA_LEVELS`] more rungs and within
+/// the step limits; it still stops at the first that agrees with the one
+/// before. Undamped, the waves ring on and the finer steps do not
+/// converge either (the refusal says so). The new finest step and its
+/// count, when rungs were added.
+fn extend_for_winch_changes(
+    ladder: &mut Ladder,
+    problem: &DynamicsProblem,
+    duration_s: f64,
+) -> Option<(f64, usize)> {
+    if !ladder.enforced
+        || problem.tether.internal_damping_n_s <= 0.0
+        || problem.length.breakpoints_s(duration_s).is_empty()
+    {
+        return None;
+    }
+    let needed = problem.shortest_axial_period_s(duration_s) / AXIAL_STEPS_PER_PERIOD;
+    let mut added = None;
+    for _ in 0..MAX_EXTRA_LEVELS {
+        let h = *ladder.time_steps_s.last().expect("a step");
+        if h <= needed {
+            break;
+        }
+        let Ok(n) = check_steps(
+            "duration_s",
+            "numerics.time_step_s",
+            duration_s,
+            0.5 * h,
+            ladder.segments,
+        ) else {
+            break;
+        };
+        ladder.time_steps_s.push(0.5 * h);
+        added = Some((0.5 * h, n));
+    }
+    added
 }
 
 /// The reference height of a flow (m): where a time history's "speed" is
@@ -424,11 +476,11 @@ impl DynamicsRequest {
                 }
             }
         };
-        let dt = *time_steps_s.last().expect("a step");
+        let mut dt = *time_steps_s.last().expect("a step");
         let rho_inf =
             check_spectral_radius("numerics.spectral_radius_nondim", n.spectral_radius_nondim)?;
-        let steps = check_steps("duration_s", "numerics.time_step_s", duration, dt, segments)?;
-        let ladder = Ladder {
+        let mut steps = check_steps("duration_s", "numerics.time_step_s", duration, dt, segments)?;
+        let mut ladder = Ladder {
             time_steps_s,
             segments,
             check_segments: (segments / 2).max(MIN_SEGMENTS),
@@ -494,6 +546,9 @@ impl DynamicsRequest {
             length,
         };
         problem.validate()?;
+        if let Some((h, n)) = extend_for_winch_changes(&mut ladder, &problem, duration) {
+            (dt, steps) = (h, n);
+        }
         // A tabulated flow's "speed" is read at the aerostat's starting altitude.
         let start_altitude =
             if reference_height(&self.wind.flow).is_none() && self.wind.time_history.is_some() {

@@ -188,6 +188,14 @@ impl Default for DynamicsConfig {
 }
 
 impl DynamicsProblem {
+    /// The period of the tether's first axial mode at its shortest length
+    /// over `[0, until]`, `4 L/c` with `c = √(EA/ρA)` (s): the waves a
+    /// change of the winch's rate or acceleration rings.
+    pub fn shortest_axial_period_s(&self, until_s: f64) -> f64 {
+        let c = (self.tether.axial_stiffness_n / self.tether.mass_per_length_kg_m).sqrt();
+        4.0 * self.length.shortest_m(until_s) / c
+    }
+
     /// `ΔU(t)`, the sum of the gusts (m/s).
     pub fn gust_change_m_s(&self, t: f64) -> f64 {
         self.gusts.iter().map(|g| g.change_m_s(t)).sum()
