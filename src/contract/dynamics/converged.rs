@@ -121,7 +121,7 @@ fn unconverged_cause(prepared: &Prepared, run: &crate::numerics::dynamics::Run) 
             first.start_s
         ),
         None => format!(
-            "the tether's axial waves (first period 4L/c = {period:.4} s at its shortest, {shortest:.0} m), rung by the winch's changes of rate or acceleration, are not resolved by the default steps: give numerics.time_step_s of at most {:.5} s (a {}th of that period){damping}",
+            "the tether's axial waves (first period 4L/c = {period:.4} s at its shortest, {shortest:.0} m), rung by the winch's changes of rate or acceleration, are not resolved by the default steps: give numerics.time_step_s of at most {:.5} s (1/{} of that period){damping}",
             period / AXIAL_STEPS_PER_PERIOD,
             AXIAL_STEPS_PER_PERIOD
         ),
