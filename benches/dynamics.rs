@@ -21,7 +21,9 @@
 //!   wall (the wall clock measures the load); `TETHERPLAN_DYNAMICS_ONCE=
 //!   converged_hour` once: 0.922 s CPU. Figures: peak winch tension
 //!   523.7 ± 3.5 N, minimum 344.6 ± 2.4 N, peak tension 1106.7 ± 7.8 N,
-//!   lowest altitude 748.45 ± 0.03 m. `TETHERPLAN_DYNAMICS_CONVERGED_ONLY=1`
+//!   lowest altitude 748.45 ± 0.03 m. Measured again 2026-12-05 on the
+//!   idle machine (load average 0.2): median 0.950 s wall, 0.959 s CPU
+//!   (target ≤ 1 s). `TETHERPLAN_DYNAMICS_CONVERGED_ONLY=1`
 //!   runs only this bench;
 //! * `seeds_4_hours_2_threads`: four seeds of the hour on a rayon pool of
 //!   two threads (100 seeds take 25 times as long).
