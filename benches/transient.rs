@@ -62,7 +62,7 @@ fn frequency_response(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("frequency_response_64_150s_n50_rayon", |b| {
         b.iter(|| {
-            transient::frequency_response(
+            tetherplan::numerics::string::frequency_response::frequency_response(
                 &model,
                 &profile,
                 &config,

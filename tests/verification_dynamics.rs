@@ -10,7 +10,7 @@ use tetherplan::numerics::params::AerostatSystem;
 use tetherplan::numerics::params::NondimState;
 use tetherplan::numerics::profile::Profile;
 use tetherplan::numerics::string::StringModel;
-use tetherplan::numerics::string::transient::{rest_eigenvalue, rest_mode_shape};
+use tetherplan::numerics::string::rest_modes::{rest_eigenvalue, rest_mode_shape};
 use tetherplan::numerics::tether::equilibrium::EquilibriumConfig;
 use tetherplan::numerics::tether::wind::WindProfile;
 

@@ -12,10 +12,11 @@ use tetherplan::numerics::params::{AerostatSystem, NondimState};
 use tetherplan::numerics::profile::Profile;
 use tetherplan::numerics::string::StringModel;
 use tetherplan::numerics::string::critical::{Onset, SearchConfig, critical_time};
+use tetherplan::numerics::string::frequency_response;
 use tetherplan::numerics::string::reduced::ReducedModel;
+use tetherplan::numerics::string::rest_modes::modal_energies;
 use tetherplan::numerics::string::transient::{
     self, EigenTracking, InitialState, RunOutcome, Sample, Silent, TransientConfig, TransientRun,
-    modal_energies,
 };
 
 fn thesis_model(elements: usize) -> StringModel {
@@ -423,7 +424,7 @@ fn frequency_response_surface() {
     cfg.aero = Some(aero);
     let ws: Vec<f64> = (1..=16).map(|i| 0.5 * i as f64).collect();
     let count = Count(AtomicUsize::new(0), AtomicUsize::new(0));
-    let par = transient::frequency_response(
+    let par = frequency_response::frequency_response(
         &model,
         &profile,
         &cfg,
@@ -440,7 +441,7 @@ fn frequency_response_surface() {
         ),
         (16, 16)
     );
-    let ser = transient::frequency_response(
+    let ser = frequency_response::frequency_response(
         &model,
         &profile,
         &cfg,

@@ -343,7 +343,7 @@ bounded_grid!(
         min: 0.0,
         exclusive_min: false,
         max: 1e4,
-        max_count: crate::numerics::string::transient::MAX_FREQUENCIES,
+        max_count: crate::numerics::string::frequency_response::MAX_FREQUENCIES,
         unit: "rad/s",
     }
 );

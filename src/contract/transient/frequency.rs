@@ -179,7 +179,7 @@ pub fn frequency_response(
         config,
     } = setup(req)?;
     let sys = model.system;
-    let fr = transient::frequency_response(
+    let fr = crate::numerics::string::frequency_response::frequency_response(
         &model,
         &profile,
         &config,
@@ -246,7 +246,7 @@ mod tests {
                 other => panic!("accepted: {:?}", other.map(|r| r.frequencies_rad_s)),
             }
         };
-        let max = crate::numerics::string::transient::MAX_FREQUENCIES;
+        let max = crate::numerics::string::frequency_response::MAX_FREQUENCIES;
         assert_eq!(
             refused(serde_json::json!({"min": 1, "max": 4, "count": max + 1})),
             "frequencies_rad_s.count"

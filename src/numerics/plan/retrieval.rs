@@ -64,7 +64,8 @@ pub fn wkb_growth_fe(model: &StringModel, start_m: f64, end_m: f64) -> Option<f6
     let l0 = model.system.initial_length_m;
     let action = |length_m: f64| -> Option<f64> {
         let l = length_m / l0;
-        let (phi, omega) = transient::rest_mode_shape(model, l, 0.0, 1).ok()?;
+        let (phi, omega) =
+            crate::numerics::string::rest_modes::rest_mode_shape(model, l, 0.0, 1).ok()?;
         if !(omega > 0.0) {
             return None;
         }
@@ -184,7 +185,8 @@ pub fn check_transient(
         .fold(0.0, f64::max);
     let final_amp = if matches!(run.outcome, RunOutcome::Completed) {
         let l_end = run.final_kinematics.length_m / l_start;
-        let (phi, omega) = transient::rest_mode_shape(&model, l_end, 0.0, 1)?;
+        let (phi, omega) =
+            crate::numerics::string::rest_modes::rest_mode_shape(&model, l_end, 0.0, 1)?;
         let mass = model
             .matrices(NondimState {
                 length: l_end,

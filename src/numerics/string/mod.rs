@@ -5,8 +5,10 @@
 pub mod chart;
 pub mod converged;
 pub mod critical;
+pub mod frequency_response;
 pub mod operators;
 pub mod reduced;
+pub mod rest_modes;
 pub mod transient;
 
 use std::sync::Arc;

@@ -1,7 +1,8 @@
 //! Transient response of the linear string (SPEC §2, thesis ch. 3.5, 4.3,
 //! 4.4, app. A): Newmark average acceleration on the time-varying
 //! `M, C, K` of the deployment, with the aerostat loaded by the air flow,
-//! and the frequency response built from many such runs.
+//! and the pieces the frequency response builds on (its runs, one per
+//! frequency, are in the `frequency_response` module beside this one).
 //!
 //! The run is non-dimensional inside (`t̄ = t c/L0`, `η = y/L0`); the tip
 //! load enters the last equation as `F/F_net` (the natural boundary
@@ -20,14 +21,8 @@
 //! (operators of [`super::operators`]); the last term is the kinetic energy of
 //! the axial motion, reported apart as well (`vibration` excludes it).
 
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-use nalgebra::{DMatrix, DVector};
-use rayon::prelude::*;
-
-use crate::numerics::aero::{Aerodynamics, AirFlow};
+use crate::numerics::aero::Aerodynamics;
 use crate::numerics::newmark::{Newmark, NewmarkParameters, NewmarkState, StepError};
-use crate::numerics::parallel::Parallelism;
 use crate::numerics::params::{
     InvalidInput, Kinematics, NondimState, require_finite, require_positive,
 };
@@ -35,6 +30,7 @@ use crate::numerics::profile::Profile;
 use crate::numerics::qep::{self, QepError};
 use crate::numerics::string::StringModel;
 use crate::numerics::string::operators::{MatrixCoefficients, SecondOrderSystem, StringOperators};
+use crate::numerics::string::rest_modes::{rest_eigenvalue, rest_mode_shape, rest_system};
 use crate::numerics::tridiag::Tridiagonal;
 
 /// Most time steps one run may take.
@@ -48,10 +44,6 @@ pub const MAX_EIGEN_EVALUATIONS: usize = 10_000;
 /// Most `evaluations × (2n)³` of the eigenvalue tracking of one run (dense
 /// QEP solves cost `O((2n)³)`: about a minute at this bound).
 pub const MAX_EIGEN_WORK: f64 = 5e10;
-/// Most forcing frequencies of one frequency response.
-pub const MAX_FREQUENCIES: usize = 1_024;
-/// Most `steps × elements × frequencies` of one frequency response.
-pub const MAX_RESPONSE_WORK: usize = 20_000_000_000;
 /// Steps per period of the fastest resolved motion when the step is automatic.
 pub const STEPS_PER_PERIOD: f64 = 64.0;
 /// Steps per ramp of the profile when the step is automatic.
@@ -313,51 +305,6 @@ pub fn energy_nondim(
     (vib + axial, vib)
 }
 
-/// The `k`-th (1-based) eigenvalue `ω²` of the symmetric pencil `(K, M)` of
-/// a cable at rest (`l̇ = l̈ = 0`), by bisection on the inertia of
-/// `K − σM` (the number of negative pivots is the number of eigenvalues
-/// below `σ`): `O(n)` per step, no dense solve.
-pub fn rest_eigenvalue(sys: &SecondOrderSystem, k: usize) -> Option<f64> {
-    let n = sys.mass.dim();
-    if k == 0 || k > n {
-        return None;
-    }
-    let below = |sigma: f64| {
-        Tridiagonal::combination(&[(1.0, &sys.stiffness), (-sigma, &sys.mass)]).negative_pivots()
-    };
-    let (mut lo, mut hi) = (-1.0, 1.0);
-    while below(lo) >= k {
-        lo *= 2.0;
-        if lo < -1e300 {
-            return None;
-        }
-    }
-    while below(hi) < k {
-        hi *= 2.0;
-        if hi > 1e300 {
-            return None;
-        }
-    }
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi || hi - lo <= 1e-15 * hi.abs().max(lo.abs()) {
-            break;
-        }
-        if below(mid) >= k { hi = mid } else { lo = mid }
-    }
-    Some(0.5 * (lo + hi))
-}
-
-fn rest_system(model: &StringModel, length: f64, added_mass_nondim: f64) -> SecondOrderSystem {
-    let mut c = model.coefficients(NondimState {
-        length,
-        rate: 0.0,
-        acceleration: 0.0,
-    });
-    c.tip_mass += added_mass_nondim;
-    model.operators.assemble(&c)
-}
-
 /// First natural frequency (rad/s) of the cable at rest at `length_m`;
 /// `None` if the cable cannot hold that length at rest. Used to pick the
 /// automatic step.
@@ -524,50 +471,6 @@ fn added_mass_nondim(model: &StringModel, aero: Option<&Aerodynamics>) -> f64 {
     })
 }
 
-/// Mode `mode` (1-based, by frequency) of the cable at rest at length `l`
-/// (`l̇ = l̈ = 0`, `K` symmetric), by shifted inverse iteration; normalised
-/// to a unit tip deflection. Returns the shape and `ω` (1/t̄).
-pub fn rest_mode_shape(
-    model: &StringModel,
-    length: f64,
-    added_mass_nondim: f64,
-    mode: usize,
-) -> Result<(Vec<f64>, f64), QepError> {
-    let sys = rest_system(model, length, added_mass_nondim);
-    let eig = |k: usize| rest_eigenvalue(&sys, k);
-    let w2 = eig(mode).ok_or(QepError::NoConvergence)?;
-    // Shift just below the target, by a small fraction of the gap to its
-    // neighbours, so inverse iteration converges to this mode alone.
-    let gap = [mode.checked_sub(1).and_then(eig), eig(mode + 1)]
-        .into_iter()
-        .flatten()
-        .map(|v| (v - w2).abs())
-        .filter(|g| *g > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    let shift = w2 - 1e-3 * gap.min(w2.abs().max(1e-300));
-    let omega = w2.max(0.0).sqrt();
-    let shifted = Tridiagonal::combination(&[(1.0, &sys.stiffness), (-shift, &sys.mass)]);
-    let n = model.elements();
-    let mut x = vec![1.0; n];
-    let mut y = vec![0.0; n];
-    for _ in 0..30 {
-        sys.mass.mul_vec(&x, &mut y);
-        shifted.solve_columns_in_place(&mut y, 1);
-        let norm = y.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-        if !(norm.is_finite() && norm > 0.0) {
-            return Err(QepError::NonFinite);
-        }
-        for (xi, yi) in x.iter_mut().zip(&y) {
-            *xi = yi / norm;
-        }
-    }
-    let tip = x[n - 1];
-    if tip == 0.0 {
-        return Err(QepError::NonFinite);
-    }
-    Ok((x.iter().map(|v| v / tip).collect(), omega))
-}
-
 /// Runs the transient response.
 pub fn simulate(
     model: &StringModel,
@@ -579,7 +482,7 @@ pub fn simulate(
     run_planned(model, profile, config, plan, observer, true)
 }
 
-fn run_planned(
+pub(crate) fn run_planned(
     model: &StringModel,
     profile: &Profile,
     config: &TransientConfig,
@@ -803,358 +706,5 @@ fn run_planned(
     })
 }
 
-/// Energies of the modes of the cable at rest at length `length` (non-dim),
-/// for a state `(q, q̇)` measured from the static equilibrium under the tip
-/// load `tip_load` (non-dim, `F/F_net`): `(ω_k [1/t̄], E_k [F L0])`, by
-/// frequency. They sum to `½q̇ᵀMq̇ + ½(q−q_s)ᵀK(q−q_s)` and are constant in
-/// time once the length is fixed and the load steady and undamped.
-/// `None` if `length ≤ 0` or the state has the wrong size.
-pub fn modal_energies(
-    model: &StringModel,
-    length: f64,
-    tip_mass_nondim: f64,
-    tip_load: f64,
-    q: &[f64],
-    qd: &[f64],
-) -> Option<Vec<(f64, f64)>> {
-    let n = model.elements();
-    if length.is_nan() || length <= 0.0 || q.len() != n || qd.len() != n {
-        return None;
-    }
-    let s = NondimState {
-        length,
-        rate: 0.0,
-        acceleration: 0.0,
-    };
-    let mut c = model.coefficients(s);
-    c.tip_mass = tip_mass_nondim;
-    let sys = model.operators.assemble(&c);
-    let dense = |t: &Tridiagonal| DMatrix::from_fn(n, n, |i, j| t.get(i, j));
-    let (m, k) = (dense(&sys.mass), dense(&sys.stiffness));
-    // static equilibrium K q_s = f
-    let mut qs = vec![0.0; n];
-    qs[n - 1] = tip_load;
-    sys.stiffness.solve_columns_in_place(&mut qs, 1);
-    let l = nalgebra::Cholesky::new(m)?.l();
-    let l_inv = l.clone().try_inverse()?;
-    let a = &l_inv * &k * l_inv.transpose();
-    let a = (&a + a.transpose()) * 0.5;
-    let eig = nalgebra::SymmetricEigen::new(a);
-    let dq = DVector::from_iterator(n, q.iter().zip(&qs).map(|(a, b)| a - b));
-    let dv = DVector::from_column_slice(qd);
-    let xi = eig.eigenvectors.transpose() * (l.transpose() * dq);
-    let xid = eig.eigenvectors.transpose() * (l.transpose() * dv);
-    let mut out: Vec<(f64, f64)> = (0..n)
-        .map(|i| {
-            let lam = eig.eigenvalues[i];
-            (
-                lam.max(0.0).sqrt(),
-                0.5 * xid[i] * xid[i] + 0.5 * lam * xi[i] * xi[i],
-            )
-        })
-        .collect();
-    out.sort_by(|a, b| a.0.total_cmp(&b.0));
-    Some(out)
-}
-
-/// Frequency response: one run per forcing frequency of a uniform flow
-/// `u = U0 sin(ω t)`, reporting the tip envelope against time.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FrequencyResponse {
-    pub frequencies_rad_s: Vec<f64>,
-    /// Sample times (s), common to all runs.
-    pub time_s: Vec<f64>,
-    /// `envelope_m[i][j]`: `max |y_tip|` for frequency `i` over the window
-    /// ending at `time_s[j]`.
-    pub envelope_m: Vec<Vec<f64>>,
-    /// Largest tip deflection of each run (m) and when (s).
-    pub peak_m: Vec<f64>,
-    pub peak_time_s: Vec<f64>,
-    pub outcomes: Vec<RunOutcome>,
-    pub time_step_s: f64,
-    pub steps: usize,
-}
-
-/// Runs the frequency response. `config.aero` gives the force model and
-/// the body; its flow is replaced by `U0 sin(ω t)` for each `ω`. All runs
-/// share one time step (set by the highest frequency when automatic), so
-/// the sample times agree. `observer.report(done, total)` counts finished
-/// runs. Parallel and serial results are identical.
-pub fn frequency_response(
-    model: &StringModel,
-    profile: &Profile,
-    config: &TransientConfig,
-    amplitude_m_s: f64,
-    frequencies_rad_s: &[f64],
-    parallelism: Parallelism,
-    observer: &dyn Observer,
-) -> Result<FrequencyResponse, TransientError> {
-    require_finite("wind_amplitude_m_s", amplitude_m_s)?;
-    if frequencies_rad_s.is_empty() || frequencies_rad_s.len() > MAX_FREQUENCIES {
-        return Err(InvalidInput::new(
-            "frequencies_rad_s.count",
-            format!(
-                "must be between 1 and {MAX_FREQUENCIES}, got {}",
-                frequencies_rad_s.len()
-            ),
-        )
-        .into());
-    }
-    let Some(aero) = config.aero.as_ref() else {
-        return Err(InvalidInput::new(
-            "aero",
-            "a frequency response needs the aerostat's aerodynamics",
-        )
-        .into());
-    };
-    let with_frequency = |w: f64| -> Result<TransientConfig, InvalidInput> {
-        let mut c = config.clone();
-        c.eigen = None;
-        let mut a = aero.clone();
-        a.flow = AirFlow::sinusoidal(amplitude_m_s, w)?;
-        c.aero = Some(a);
-        Ok(c)
-    };
-    let w_max = frequencies_rad_s.iter().copied().fold(0.0, f64::max);
-    for (i, &w) in frequencies_rad_s.iter().enumerate() {
-        with_frequency(w)
-            .map_err(|e| InvalidInput::new(format!("frequencies_rad_s[{i}]"), e.reason))?;
-    }
-    let plan = plan(model, profile, &with_frequency(w_max)?)?;
-    let work = plan.steps as f64 * model.elements() as f64 * frequencies_rad_s.len() as f64;
-    if work > MAX_RESPONSE_WORK as f64 {
-        return Err(InvalidInput::new(
-            "frequencies_rad_s.count",
-            format!(
-                "{} runs of {} steps on {} elements exceed the limit of {MAX_RESPONSE_WORK} step-elements",
-                frequencies_rad_s.len(),
-                plan.steps,
-                model.elements()
-            ),
-        )
-        .into());
-    }
-    let total = frequencies_rad_s.len();
-    let done = AtomicUsize::new(0);
-    observer.report(0, total);
-    let one = |w: f64| -> Result<TransientRun, TransientError> {
-        let c = with_frequency(w)?;
-        let run = run_planned(model, profile, &c, plan, observer, false)?;
-        observer.report(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-        Ok(run)
-    };
-    let runs: Vec<Result<TransientRun, TransientError>> = match parallelism {
-        Parallelism::Serial => frequencies_rad_s.iter().map(|&w| one(w)).collect(),
-        Parallelism::Rayon => frequencies_rad_s.par_iter().map(|&w| one(w)).collect(),
-    };
-    let runs = runs.into_iter().collect::<Result<Vec<_>, _>>()?;
-    let time_s = runs[0].samples.iter().map(|s| s.time_s).collect();
-    let mut out = FrequencyResponse {
-        frequencies_rad_s: frequencies_rad_s.to_vec(),
-        time_s,
-        envelope_m: vec![],
-        peak_m: vec![],
-        peak_time_s: vec![],
-        outcomes: vec![],
-        time_step_s: plan.time_step_s,
-        steps: plan.steps,
-    };
-    for run in runs {
-        let (peak, at) = run.samples.iter().fold((0.0f64, 0.0), |(p, t), s| {
-            if s.tip_envelope_m > p {
-                (s.tip_envelope_m, s.time_s)
-            } else {
-                (p, t)
-            }
-        });
-        out.envelope_m
-            .push(run.samples.iter().map(|s| s.tip_envelope_m).collect());
-        out.peak_m.push(peak);
-        out.peak_time_s.push(at);
-        out.outcomes.push(run.outcome);
-    }
-    Ok(out)
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::numerics::params::AerostatSystem;
-
-    #[test]
-    fn in_place_assembly_matches_the_operators() {
-        let model = StringModel::new(AerostatSystem::thesis(), 7).unwrap();
-        let c = model.coefficients(NondimState {
-            length: 3.0,
-            rate: 0.2,
-            acceleration: 0.01,
-        });
-        let want = model.operators.assemble(&c);
-        let mut got = zero_system(7);
-        assemble_into(&model.operators, &c, &mut got);
-        for (a, b) in [
-            (&got.mass, &want.mass),
-            (&got.damping, &want.damping),
-            (&got.stiffness, &want.stiffness),
-        ] {
-            for (x, y) in a
-                .diag
-                .iter()
-                .chain(&a.lower)
-                .chain(&a.upper)
-                .zip(b.diag.iter().chain(&b.lower).chain(&b.upper))
-            {
-                assert!((x - y).abs() < 1e-12 * y.abs().max(1.0));
-            }
-        }
-    }
-
-    #[test]
-    fn rejects_bad_configurations_naming_the_field() {
-        let model = StringModel::new(AerostatSystem::thesis(), 10).unwrap();
-        let profile = Profile::constant_rate(1.0, 1.0, None).unwrap();
-        let base = TransientConfig {
-            duration_s: 10.0,
-            time_step_s: Some(0.01),
-            samples: 100,
-            initial: InitialState::Rest,
-            aero: None,
-            eigen: None,
-        };
-        let field = |c: TransientConfig| match plan(&model, &profile, &c) {
-            Err(TransientError::Invalid(e)) => e.field,
-            other => panic!("expected invalid input, got {other:?}"),
-        };
-        assert_eq!(
-            field(TransientConfig {
-                duration_s: -1.0,
-                ..base.clone()
-            }),
-            "duration_s"
-        );
-        assert_eq!(
-            field(TransientConfig {
-                samples: 1,
-                ..base.clone()
-            }),
-            "samples"
-        );
-        assert_eq!(
-            field(TransientConfig {
-                time_step_s: Some(1e-9),
-                ..base.clone()
-            }),
-            "time_step_s"
-        );
-        assert_eq!(
-            field(TransientConfig {
-                eigen: Some(EigenTracking {
-                    interval_s: 1e-4,
-                    count: 3
-                }),
-                ..base.clone()
-            }),
-            "eigenvalues.interval_s"
-        );
-        assert_eq!(
-            field(TransientConfig {
-                initial: InitialState::Mode {
-                    mode: 0,
-                    tip_deflection_m: 0.1
-                },
-                ..base
-            }),
-            "initial.mode"
-        );
-    }
-
-    /// A tip force switched on at t = 0 on a cable of fixed length: the tip
-    /// swings about the static deflection `K⁻¹f` (up to about twice it, the
-    /// step response of the dominant first mode) and, once released,
-    /// oscillates about zero.
-    #[test]
-    fn held_tip_force_swings_about_the_static_deflection() {
-        let model = StringModel::new(AerostatSystem::thesis(), 20).unwrap();
-        let profile = Profile::constant_rate(1.0, 0.0, None).unwrap();
-        let (force, hold) = (10.0, 3.0);
-        let cfg = TransientConfig {
-            duration_s: 6.0,
-            time_step_s: Some(1e-3),
-            samples: 6001,
-            initial: InitialState::TipForce {
-                force_n: force,
-                duration_s: hold,
-            },
-            aero: None,
-            eigen: None,
-        };
-        let r = simulate(&model, &profile, &cfg, &Silent).unwrap();
-        let sys = model.matrices(NondimState {
-            length: 1.0,
-            rate: 0.0,
-            acceleration: 0.0,
-        });
-        let mut q = vec![0.0; 20];
-        q[19] = force / 1000.0;
-        sys.stiffness.solve_columns_in_place(&mut q, 1);
-        let static_m = q[19];
-        let held: Vec<f64> = r
-            .samples
-            .iter()
-            .filter(|s| s.time_s < hold)
-            .map(|s| s.tip_deflection_m)
-            .collect();
-        let max = held.iter().cloned().fold(f64::MIN, f64::max);
-        let min = held.iter().cloned().fold(f64::MAX, f64::min);
-        assert!(
-            min > -0.05 * static_m && (max / (2.0 * static_m) - 1.0).abs() < 0.05,
-            "{min} {max} {static_m}"
-        );
-        assert!(
-            r.samples
-                .iter()
-                .filter(|s| s.time_s < hold)
-                .all(|s| s.tip_force_n == force)
-        );
-        assert!(
-            r.samples
-                .iter()
-                .filter(|s| s.time_s > hold)
-                .all(|s| s.tip_force_n == 0.0)
-        );
-        let released: Vec<f64> = r
-            .samples
-            .iter()
-            .filter(|s| s.time_s > hold)
-            .map(|s| s.tip_deflection_m)
-            .collect();
-        let mean = released.iter().sum::<f64>() / released.len() as f64;
-        assert!(mean.abs() < 0.3 * static_m, "released mean {mean}");
-    }
-
-    #[test]
-    fn rest_eigenvalues_by_inertia_match_the_qep() {
-        let model = StringModel::new(AerostatSystem::thesis(), 30).unwrap();
-        let sys = rest_system(&model, 250.0, 0.3);
-        let spectrum = qep::solve(&sys).unwrap();
-        for (k, mode) in spectrum.modes().iter().take(4).enumerate() {
-            let w = rest_eigenvalue(&sys, k + 1).unwrap().sqrt();
-            assert!(
-                (w / mode.im - 1.0).abs() < 1e-9,
-                "mode {}: {w} vs {}",
-                k + 1,
-                mode.im
-            );
-        }
-        let (shape, w) = rest_mode_shape(&model, 250.0, 0.3, 2).unwrap();
-        assert!((w / spectrum.modes()[1].im - 1.0).abs() < 1e-9);
-        // K φ = ω² M φ
-        let (mut kx, mut mx) = (vec![0.0; 30], vec![0.0; 30]);
-        sys.stiffness.mul_vec(&shape, &mut kx);
-        sys.mass.mul_vec(&shape, &mut mx);
-        let scale = kx.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-        for (a, b) in kx.iter().zip(&mx) {
-            assert!((a - w * w * b).abs() < 1e-8 * scale);
-        }
-    }
-}
+mod tests;
