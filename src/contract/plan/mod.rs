@@ -12,7 +12,7 @@ pub mod run;
 mod validate;
 
 pub use dto::{PlanRequest, PlanResponse};
-pub use run::{plan, validate_plan};
+pub use run::{PlanVerdict, plan, plan_verdict, validate_plan};
 
 use crate::contract::RequestError;
 

@@ -6,7 +6,9 @@
 //! schedule's limits and margins (mean and gust), the orientation figures
 //! (constant rate, bound, oscillation growth, retrieval), the haul-down
 //! deadline ([`crate::numerics::plan::deadline`]: the earlier of the
-//! wind's and the gust's exceedance) and the verdict.
+//! wind's and the gust's exceedance; no-go when no haul-down can be
+//! planned) and the verdict. [`plan_verdict`] runs the steps that decide
+//! and skips those that only report.
 
 use std::time::Instant;
 
@@ -73,6 +75,18 @@ struct Context<'a> {
 
 impl<'a> Context<'a> {
     fn new(req: &'a PlanRequest, v: &'a Validated, started: Instant) -> Self {
+        Self::with_outputs(req, v, started, true)
+    }
+
+    /// With `outputs` false, the context of a verdict only
+    /// ([`plan_verdict`]): no echoed inputs and no wind figures, which only
+    /// the full answer reports.
+    fn with_outputs(
+        req: &'a PlanRequest,
+        v: &'a Validated,
+        started: Instant,
+        outputs: bool,
+    ) -> Self {
         let p = v.problem;
         let tension_checked = v.breaking_strength_n.is_some();
         Self {
@@ -85,14 +99,18 @@ impl<'a> Context<'a> {
             } else {
                 "deployment"
             },
-            inputs: serde_json::to_value(req).expect("requests serialise"),
+            inputs: if outputs {
+                serde_json::to_value(req).expect("requests serialise")
+            } else {
+                serde_json::Value::Null
+            },
             tension_checked,
             unchecked_note: if tension_checked {
                 ""
             } else {
                 "; tension NOT checked (no cable.breaking_strength_n)"
             },
-            wind_out: wind_output(v, &p),
+            wind_out: if outputs { wind_output(v, &p) } else { None },
         }
     }
 
@@ -268,7 +286,9 @@ fn end_binding(v: &Validated, p: &PlanProblem) -> Option<BindingLimit> {
 /// The schedule found and how.
 struct Found {
     schedule: Schedule,
-    check: TransientCheck,
+    /// The transient check; `None` when not asked ([`plan_verdict`]: it
+    /// reports, it does not decide).
+    check: Option<TransientCheck>,
     /// Rate limit the plan used (m/s).
     rate_used: f64,
     /// Slowed below the winch rate for an amplification limit.
@@ -286,6 +306,7 @@ struct Found {
 fn find_schedule(
     cx: &Context,
     observer: &ProgressObserver,
+    with_transient: bool,
 ) -> Result<Result<Found, BindingLimit>, RequestError> {
     let (req, v, p) = (cx.req, cx.v, &cx.p);
     let opts = &v.options;
@@ -303,7 +324,7 @@ fn find_schedule(
             {
                 Ok(b) => Found {
                     schedule: b.schedule,
-                    check: b.check,
+                    check: Some(b.check),
                     rate_used: b.rate_limit_m_s,
                     slowed: b.slowed,
                     ge_check: None,
@@ -334,12 +355,16 @@ fn find_schedule(
                 let (chk, check) = rayon::join(
                     || ge_check_of(&tightened.air, &s, ge_check_count(req)),
                     || {
-                        retrieval::check_transient(
-                            &v.model,
-                            &s,
-                            req.disturbance_tip_deflection_m,
-                            if tightenings == 0 { observer } else { &quiet },
-                        )
+                        with_transient
+                            .then(|| {
+                                retrieval::check_transient(
+                                    &v.model,
+                                    &s,
+                                    req.disturbance_tip_deflection_m,
+                                    if tightenings == 0 { observer } else { &quiet },
+                                )
+                            })
+                            .transpose()
                     },
                 );
                 let Some(chk) = chk else {
@@ -468,7 +493,7 @@ fn oscillation_output(v: &Validated, p: &PlanProblem, found: &Found) -> Oscillat
         wkb_amplification_nondim: wkb.map(|w| w.amplitude),
         wkb_fe_mode_amplification_nondim: retrieval::wkb_growth_fe(&v.model, l_start, l_end),
         wkb_energy_amplification_nondim: wkb.map(|w| w.energy),
-        transient_amplification_nondim: Some(found.check.amplification),
+        transient_amplification_nondim: found.check.as_ref().map(|c| c.amplification),
         max_amplification_nondim: v.amplification_limit,
         slowed_for_amplification: found.slowed,
         rate_limit_used_m_s: found.rate_used,
@@ -493,11 +518,45 @@ fn retrieval_output(cx: &Context, found: &Found) -> Option<RetrievalOutput> {
     })
 }
 
+/// The haul-down of a plan.
+enum HaulDown {
+    /// No forecast: no deadline asked.
+    NotAsked,
+    Planned(HaulDownOutput),
+    /// No safe haul-down schedule exists from `from_m` to `to_m`: the plan
+    /// is no-go, since the aerostat could not be brought down.
+    Impossible {
+        from_m: f64,
+        to_m: f64,
+        binding: BindingLimit,
+    },
+}
+
+impl HaulDown {
+    /// Whether the haul-down lets the plan go.
+    fn go(&self) -> bool {
+        match self {
+            Self::NotAsked => true,
+            Self::Planned(h) => h.go,
+            Self::Impossible { .. } => false,
+        }
+    }
+
+    fn output(self) -> Option<HaulDownOutput> {
+        match self {
+            Self::Planned(h) => Some(h),
+            _ => None,
+        }
+    }
+}
+
 /// The haul-down deadline: from the operating altitude down to the lower
 /// end, before the wind passes its limit or the gust passes its own,
 /// whichever comes first.
-fn haul_down_output(cx: &Context, opts: &PlanOptions, found: &Found) -> Option<HaulDownOutput> {
-    let f = cx.v.forecast.as_ref()?;
+fn haul_down_output(cx: &Context, opts: &PlanOptions, found: &Found) -> HaulDown {
+    let Some(f) = cx.v.forecast.as_ref() else {
+        return HaulDown::NotAsked;
+    };
     let p = &cx.p;
     let (l_start, l_end) = (p.system.initial_length_m, p.target_length_m);
     let (high, low) = (l_start.max(l_end), l_start.min(l_end));
@@ -506,7 +565,13 @@ fn haul_down_output(cx: &Context, opts: &PlanOptions, found: &Found) -> Option<H
     } else {
         match schedule::fastest_with(&p.between(high, low), opts) {
             PlanOutcome::Feasible(s) => s.duration_s,
-            PlanOutcome::Infeasible(_) => return None,
+            PlanOutcome::Infeasible(binding) => {
+                return HaulDown::Impossible {
+                    from_m: high,
+                    to_m: low,
+                    binding,
+                };
+            }
         }
     };
     let aloft_from = if cx.retrieving() {
@@ -516,7 +581,7 @@ fn haul_down_output(cx: &Context, opts: &PlanOptions, found: &Found) -> Option<H
     };
     let gust = f.gust.as_ref().map(|(g, limit)| (g, *limit));
     let (h, by) = deadline::haul_down_with_gusts(&f.mean, f.limit_m_s, gust, duration, aloft_from);
-    Some(HaulDownOutput {
+    HaulDown::Planned(HaulDownOutput {
         wind_exceeds_limit_at_s: h.exceeds_at_s,
         retrieval_duration_s: h.retrieval_duration_s,
         from_length_m: high,
@@ -540,10 +605,10 @@ fn verdict(
     cx: &Context,
     found: &Found,
     limits: &PlanLimitsOutput,
-    haul_down: Option<&HaulDownOutput>,
+    haul_down: &HaulDown,
 ) -> (bool, String) {
     let p = &cx.p;
-    let go = haul_down.is_none_or(|h| h.go);
+    let go = haul_down.go();
     let mut reason = format!(
         "{}: {} from {:.1} m to {:.1} m in {:.1} s, stable with a {:.1} % lift reserve at every instant",
         if go { "go" } else { "no-go" },
@@ -565,8 +630,17 @@ fn verdict(
         reason.push_str(&format!(", tension within {t:.0} N"));
     }
     reason.push_str(cx.unchecked_note);
-    if let Some(h) = haul_down {
-        reason.push_str(&format!("; haul-down: {}", h.reason));
+    match haul_down {
+        HaulDown::NotAsked => {}
+        HaulDown::Planned(h) => reason.push_str(&format!("; haul-down: {}", h.reason)),
+        HaulDown::Impossible {
+            from_m,
+            to_m,
+            binding,
+        } => reason.push_str(&format!(
+            "; haul-down: no-go: no safe haul-down from {from_m:.1} m to {to_m:.1} m exists in this wind ({})",
+            binding.reason(p.lift_reserve)
+        )),
     }
     if let Some(g) = cx.wind_out.as_ref().and_then(|w| w.gust.as_ref()) {
         reason.push_str(&format!(
@@ -602,7 +676,7 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
     if let Some(b) = end_binding(&v, &p) {
         return Ok(cx.infeasible(b, limits_base));
     }
-    let found = match find_schedule(&cx, &ProgressObserver(progress))? {
+    let found = match find_schedule(&cx, &ProgressObserver(progress), true)? {
         Ok(f) => f,
         Err(b) => return Ok(cx.infeasible(b, limits_base)),
     };
@@ -613,7 +687,7 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
     let schedule_out = samples_output(&p, &opts.air, &found.schedule, req.samples);
     let limits = schedule_limits(limits_base, &schedule_out, v.breaking_strength_n);
     let haul_down = haul_down_output(&cx, opts, &found);
-    let (go, reason) = verdict(&cx, &found, &limits, haul_down.as_ref());
+    let (go, reason) = verdict(&cx, &found, &limits, &haul_down);
     let sched = &found.schedule;
     Ok(PlanResponse {
         feasible: true,
@@ -627,10 +701,10 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         phases: phases_output(sched),
         constant_rate: constant_rate_output(&p, opts, &found),
         bound: bound_output(&p, opts, &found),
-        transient_check: Some(check_output(&found.check)),
+        transient_check: found.check.as_ref().map(check_output),
         oscillation: Some(oscillation_output(&v, &p, &found)),
         retrieval: retrieval_output(&cx, &found),
-        haul_down,
+        haul_down: haul_down.output(),
         limits,
         wind: cx.wind_out.clone(),
         jerk: opts.max_jerk_m_s3.map(|j| JerkOutput {
@@ -643,5 +717,82 @@ pub fn plan(req: &PlanRequest, progress: &dyn Progress) -> Result<PlanResponse, 
         compute_time_s: started.elapsed().as_secs_f64(),
         inputs: cx.inputs.clone(),
         groups: groups(&v.model.system),
+    })
+}
+
+/// What a plan decides, without the figures only its full answer reports:
+/// [`plan_verdict`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanVerdict {
+    /// `/plan`'s `go`.
+    pub go: bool,
+    /// `/plan`'s `duration_s` (s); `None` when infeasible, or when a
+    /// haul-down that must already have started decided the verdict first.
+    pub duration_s: Option<f64>,
+    /// `/plan`'s `haul_down.retrieval_duration_s` (s), under the same terms.
+    pub haul_down_s: Option<f64>,
+    /// `/plan`'s `wind.reachable_altitude_m`, in calm air its
+    /// `limits.lift_limit_m` (m).
+    pub max_altitude_m: f64,
+}
+
+/// The verdict of [`plan`] by the same code, without what only reports:
+/// the schedule's samples and their limits, the transient check (it
+/// decides only a retrieval bounded by an amplification limit, which it
+/// still runs), the constant-rate plan, the bound, the oscillation
+/// growth, the wind figures at the target and the echoed inputs. Its
+/// `go`, durations and altitude are `plan`'s bit for bit (the windows'
+/// ensemble members, `tests/windows_verdict.rs`).
+///
+/// One shortcut: a haul-down forecast whose wind or gust is already past
+/// its limit at `t = 0` on a path of positive length makes `plan` no-go
+/// whatever the schedule (the haul-down should have started `D > 0` s
+/// ago, or cannot be planned at all), so no schedule is searched.
+pub fn plan_verdict(
+    req: &PlanRequest,
+    progress: &dyn Progress,
+) -> Result<PlanVerdict, RequestError> {
+    let started = Instant::now();
+    let v = validate(req)?;
+    let cx = Context::with_outputs(req, &v, started, false);
+    let p = cx.p;
+    let max_altitude_m = v
+        .wind
+        .as_ref()
+        .map_or(p.lift_limit_m(), |w| w.reachable_altitude_m);
+    let no_go = PlanVerdict {
+        go: false,
+        duration_s: None,
+        haul_down_s: None,
+        max_altitude_m,
+    };
+    if end_binding(&v, &p).is_some() {
+        return Ok(no_go);
+    }
+    if let Some(f) = &v.forecast {
+        let gust = f.gust.as_ref().map(|(g, limit)| (g, *limit));
+        let now = deadline::first_limit_exceedance(&f.mean, f.limit_m_s, gust)
+            .is_some_and(|(t, _)| t <= 0.0);
+        if now && p.system.initial_length_m != p.target_length_m {
+            return Ok(no_go);
+        }
+    }
+    let found = match find_schedule(&cx, &ProgressObserver(progress), false)? {
+        Ok(f) => f,
+        Err(_) => return Ok(no_go),
+    };
+    if progress.cancelled() {
+        return Err(RequestError::Cancelled);
+    }
+    let opts = found.tightened.as_ref().unwrap_or(&v.options);
+    let haul_down = haul_down_output(&cx, opts, &found);
+    Ok(PlanVerdict {
+        go: haul_down.go(),
+        duration_s: Some(found.schedule.duration_s),
+        haul_down_s: match &haul_down {
+            HaulDown::Planned(h) => Some(h.retrieval_duration_s),
+            _ => None,
+        },
+        max_altitude_m,
     })
 }

@@ -1,7 +1,10 @@
 //! Runs a windows request: the forecast parsed ([`super::source`]), each
 //! period's winds fitted to a flow ([`crate::numerics::forecast::profile`]),
-//! each distinct wind planned once by the plan's own code
-//! ([`crate::contract::plan::plan`], on rayon), the periods judged against
+//! each distinct wind planned once by the plan's own code (on rayon: in
+//! full, [`crate::contract::plan::plan`], for the first member, whose hours
+//! the answer reports; for the other members its verdict only,
+//! [`crate::contract::plan::plan_verdict`], the same `go`, durations and
+//! altitude without the figures only `/plan` reports), the periods judged against
 //! the limits shrunk by the lead-time factor, the windows found
 //! ([`crate::numerics::forecast::windows`]) and, with an ensemble, the
 //! members' shares of GO.
@@ -11,8 +14,9 @@
 //! deadline of that wind at the target held from now (a wind or gust past
 //! the limit makes it no-go, and says so). Without `haul_down` the plan is
 //! run with a limit no wind reaches (200 m/s) to learn the haul-down's
-//! duration; its verdict is unchanged and its reason given without that
-//! clause, so each hour's answer is `/plan`'s exactly.
+//! duration; its verdict is `/plan`'s without a forecast (whether a
+//! schedule exists) and its reason given without that clause, so each
+//! hour's answer is `/plan`'s exactly.
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -21,8 +25,8 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde_json::{Map, Value};
 
-use crate::contract::plan::PlanRequest;
 use crate::contract::plan::dto::{HaulDownInput, PlanResponse, WindForecastPointInput};
+use crate::contract::plan::{PlanRequest, PlanVerdict, plan_verdict};
 use crate::contract::system::{GustInput, WindFlowInput, WindInput};
 use crate::contract::windows::dto::*;
 use crate::contract::windows::source::{ParsedForecast, RawPeriod, parse_forecast};
@@ -298,23 +302,57 @@ impl Progress for PlanProgress<'_> {
     }
 }
 
-/// Runs the distinct plans on rayon, in their order.
-fn run_plans(
-    prepared: &Prepared,
-    progress: &dyn Progress,
-) -> Result<Vec<PlanResponse>, RequestError> {
+/// One distinct plan's answer: its verdict, and `/plan`'s whole answer
+/// when a period of the first member (the one whose hours are reported)
+/// uses it.
+struct Planned {
+    verdict: PlanVerdict,
+    full: Option<PlanResponse>,
+}
+
+impl Planned {
+    fn from_full(plan: PlanResponse) -> Self {
+        Self {
+            verdict: PlanVerdict {
+                go: plan.go,
+                duration_s: plan.duration_s,
+                haul_down_s: plan.haul_down.as_ref().map(|h| h.retrieval_duration_s),
+                max_altitude_m: max_altitude(&plan),
+            },
+            full: Some(plan),
+        }
+    }
+}
+
+/// Runs the distinct plans on rayon, in their order: in full those the
+/// first member uses, the verdict only ([`plan_verdict`], the same `go`,
+/// durations and altitude) for the others.
+fn run_plans(prepared: &Prepared, progress: &dyn Progress) -> Result<Vec<Planned>, RequestError> {
     let done = AtomicUsize::new(0);
     let total = prepared.plans.len();
     let quiet = PlanProgress { outer: progress };
+    let mut full = vec![false; total];
+    for c in prepared.cases.first().into_iter().flatten() {
+        full[c.plan] = true;
+    }
     prepared
         .plans
         .par_iter()
         .zip(&prepared.plan_times)
-        .map(|(r, time)| {
+        .zip(&full)
+        .map(|((r, time), &full)| {
             if progress.cancelled() {
                 return Err(RequestError::Cancelled);
             }
-            let out = crate::contract::plan::plan(r, &quiet).map_err(|e| match e {
+            let out = if full {
+                crate::contract::plan::plan(r, &quiet).map(Planned::from_full)
+            } else {
+                plan_verdict(r, &quiet).map(|verdict| Planned {
+                    verdict,
+                    full: None,
+                })
+            };
+            let out = out.map_err(|e| match e {
                 RequestError::Invalid(InvalidInput { field, reason }) => {
                     RequestError::Invalid(InvalidInput {
                         field,
@@ -337,12 +375,23 @@ struct Judged {
     period: Period,
 }
 
+/// `/plan`'s `go` for the request: with `haul_down`, the plan's own;
+/// without it, whether a schedule exists (the internal haul-down, asked
+/// only for its duration, does not decide).
+fn go_of(req: &WindowsRequest, v: &PlanVerdict) -> bool {
+    if req.haul_down.is_some() {
+        v.go
+    } else {
+        v.duration_s.is_some()
+    }
+}
+
 fn judge(
     req: &WindowsRequest,
     prepared: &Prepared,
     p: &RawPeriod,
     c: &Case,
-    plan: &PlanResponse,
+    plan: &PlanVerdict,
 ) -> (Judged, f64) {
     let alpha = prepared.factor.at(p.start_s - prepared.forecast.origin_s);
     let within = req.haul_down.as_ref().is_none_or(|h| {
@@ -350,14 +399,14 @@ fn judge(
             && h.max_gust_m_s
                 .is_none_or(|g| c.gust_at_target_m_s.unwrap_or(c.wind_at_target_m_s) <= alpha * g)
     });
-    let haul = plan.haul_down.as_ref().map(|h| h.retrieval_duration_s);
-    let durations = plan.duration_s.zip(haul).map(|(d, h)| d + h);
-    let in_limits = plan.go && within && durations.is_some();
+    let go = go_of(req, plan);
+    let durations = plan.duration_s.zip(plan.haul_down_s).map(|(d, h)| d + h);
+    let in_limits = go && within && durations.is_some();
     (
         Judged {
-            go: plan.go,
+            go,
             in_limits,
-            max_altitude_m: max_altitude(plan),
+            max_altitude_m: plan.max_altitude_m,
             period: Period {
                 start_s: p.start_s,
                 end_s: p.end_s,
@@ -376,14 +425,24 @@ fn max_altitude(plan: &PlanResponse) -> f64 {
         .map_or(plan.limits.lift_limit_m, |w| w.reachable_altitude_m)
 }
 
-/// The plan's reason without the internal haul-down clause (no `haul_down` asked).
+/// The plan's reason; without `haul_down` asked, with the internal
+/// haul-down's clause taken out (it runs up to the gust's clause or the
+/// end) and the verdict `/plan` gives without it.
 fn reason(req: &WindowsRequest, plan: &PlanResponse) -> String {
-    match (&req.haul_down, &plan.haul_down) {
-        (None, Some(h)) => plan
-            .reason
-            .replacen(&format!("; haul-down: {}", h.reason), "", 1),
-        _ => plan.reason.clone(),
+    if req.haul_down.is_some() {
+        return plan.reason.clone();
     }
+    let mut r = plan.reason.clone();
+    if let Some(at) = r.find("; haul-down: ") {
+        let end = r[at + 1..]
+            .find("; in the gust (")
+            .map_or(r.len(), |e| at + 1 + e);
+        r.replace_range(at..end, "");
+    }
+    if plan.feasible && !plan.go {
+        r = r.replacen("no-go: ", "go: ", 1);
+    }
+    r
 }
 
 /// Answers a windows request.
@@ -410,7 +469,7 @@ pub fn answer(
     for (k, (member, cases)) in f.members.iter().zip(&prepared.cases).enumerate() {
         let mut js = Vec::with_capacity(cases.len());
         for (p, c) in member.periods.iter().zip(cases) {
-            let (j, alpha) = judge(req, prepared, p, c, &plans[c.plan]);
+            let (j, alpha) = judge(req, prepared, p, c, &plans[c.plan].verdict);
             if k == 0 {
                 first.push((
                     Judged {
@@ -442,14 +501,17 @@ pub fn answer(
     let control = &f.members[0];
     let mut hours = Vec::with_capacity(control.periods.len());
     for ((p, c), (j, alpha)) in control.periods.iter().zip(&prepared.cases[0]).zip(&first) {
-        let plan = &plans[c.plan];
+        let plan = plans[c.plan]
+            .full
+            .as_ref()
+            .expect("the first member's plans are run in full");
         let mut h = WindowsHourOutput {
             time: p.time.clone(),
             end: f.style.format(p.end_s),
             lead_time_s: p.start_s - f.origin_s,
             group: p.group.clone(),
             wind: c.wind.clone(),
-            verdict: if plan.go { "go" } else { "no-go" }.into(),
+            verdict: if j.go { "go" } else { "no-go" }.into(),
             reason: reason(req, plan),
             max_altitude_m: j.max_altitude_m,
             peak_tension_n: plan.limits.peak_tension_n,
@@ -523,7 +585,8 @@ pub fn answer(
             "each period's speeds at their heights: a power law fitted through two or more (least squares in \
              ln z, ln U, exponent within [0, 2]), a log law of roughness {} m through one, uniform when calm; \
              the gust the mean times the period's gust ratio at its height; each distinct wind planned once by \
-             /plan's own code",
+             /plan's own code (the first member's in full, the other members' verdict only: the same go, \
+             durations and altitude)",
             prepared.roughness_length_m
         ),
         notes: f.notes.clone(),
