@@ -48,6 +48,7 @@ use rayon::prelude::*;
 
 use crate::numerics::params::AerostatSystem;
 use crate::numerics::plan::ascent::AscentDrag;
+use crate::numerics::plan::boundary::bracket_crossing;
 use crate::numerics::plan::sparse::{RELATIVE_TOLERANCE, Solved, sparse_along};
 use crate::numerics::plan::{PlanProblem, STABILITY_MARGIN};
 use crate::numerics::tether::continuation::ShootingContinuation;
@@ -528,8 +529,11 @@ pub enum Air {
     Wind(Box<SteadyWind>),
 }
 
-/// Bisection steps of the lift limit and of the length for an altitude.
-pub const LENGTH_BISECTIONS: usize = 48;
+/// The tolerance of the lift limit and of the length for an altitude,
+/// relative to the longest length searched: a micrometre at a kilometre,
+/// far below the equilibrium's own discretisation error (about 1e-6 of the
+/// length in a sheared wind, [`super::sparse`]).
+pub const LENGTH_TOLERANCE: f64 = 1e-9;
 
 impl Air {
     pub fn is_calm(&self) -> bool {
@@ -708,44 +712,45 @@ impl Air {
 
     /// The longest length whose rest state keeps the margin, `S(L) ≥
     /// ε(1 − r)F` (m): the static lift limit. Calm air: the closed form
-    /// [`PlanProblem::lift_limit_m`]; wind: bisection
-    /// ([`LENGTH_BISECTIONS`] steps) below the calm-air limit (the wind
-    /// only shortens it for this criterion when the tether goes slack;
-    /// `S` is taken as decreasing in `L`).
+    /// [`PlanProblem::lift_limit_m`]; wind: the crossing of `S` below the
+    /// calm-air limit ([`bracket_crossing`] to [`LENGTH_TOLERANCE`] of it;
+    /// the wind only shortens it for this criterion when the tether goes
+    /// slack; `S` is taken as decreasing in `L`), its admissible end.
     pub fn lift_limit_m(&self, p: &PlanProblem) -> f64 {
         let calm = p.lift_limit_m();
         let Self::Wind(w) = self else {
             return calm;
         };
         let need = STABILITY_MARGIN * p.reserve_buoyancy_n();
-        // the bisection's shootings start from its earlier points
+        // the search's shootings start from its earlier points
         let mut along = Along::default();
-        let mut ok = |l: f64| w.stability_tension_along(p, l, Some(&mut along)) >= need;
+        let mut margin = |l: f64| w.stability_tension_along(p, l, Some(&mut along)) - need;
         // The GE criterion may allow more than the calm string (bending).
         let calm = match &w.ge {
             Some(ge) => ge.search_upper_m(&**w, p).map_or(calm, |u| u.max(calm)),
             None => calm,
         };
-        if ok(calm) {
+        let at_calm = margin(calm);
+        if at_calm >= 0.0 {
             return calm;
         }
-        let (mut lo, mut hi) = (0.0, calm);
-        for _ in 0..LENGTH_BISECTIONS {
-            let mid = 0.5 * (lo + hi);
-            if ok(mid) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        lo
+        bracket_crossing(
+            0.0,
+            f64::INFINITY,
+            calm,
+            at_calm,
+            LENGTH_TOLERANCE * calm,
+            margin,
+        )
+        .0
     }
 
     /// The tether length at which the aerostat (full buoyancy) flies at
-    /// `altitude_m`, searched up to `max_length_m` by bisection on the
-    /// equilibrium altitude ([`LENGTH_BISECTIONS`] steps, taken as
-    /// increasing in `L`). Calm air: the altitude itself. `Err(reachable)`
-    /// with the altitude at `max_length_m` when it is lower.
+    /// `altitude_m`, searched up to `max_length_m` ([`bracket_crossing`] on
+    /// the equilibrium altitude, taken as increasing in `L`, to
+    /// [`LENGTH_TOLERANCE`] of `max_length_m`), its end at or above the
+    /// altitude. Calm air: the altitude itself. `Err(reachable)` with the
+    /// altitude at `max_length_m` when it is lower.
     pub fn length_for_altitude(
         &self,
         s: &AerostatSystem,
@@ -756,23 +761,25 @@ impl Air {
             return Ok(altitude_m);
         };
         let mut along = ShootingContinuation::default();
-        let mut alt = |l: f64| w.operating_along(s, l, Some(&mut along)).2;
-        let top = alt(max_length_m);
-        if !(top >= altitude_m) {
+        let mut above = |l: f64| w.operating_along(s, l, Some(&mut along)).2 - altitude_m;
+        let top = above(max_length_m);
+        if !(top >= 0.0) {
+            let top = top + altitude_m;
             return Err(if top.is_finite() { top } else { 0.0 });
         }
-        let (mut lo, mut hi) = (altitude_m.min(max_length_m), max_length_m);
-        if alt(lo) >= altitude_m {
+        let lo = altitude_m.min(max_length_m);
+        let at_lo = above(lo);
+        if at_lo >= 0.0 {
             return Ok(lo);
         }
-        for _ in 0..LENGTH_BISECTIONS {
-            let mid = 0.5 * (lo + hi);
-            if alt(mid) >= altitude_m {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        Ok(hi)
+        Ok(bracket_crossing(
+            max_length_m,
+            top,
+            lo,
+            at_lo,
+            LENGTH_TOLERANCE * max_length_m,
+            above,
+        )
+        .0)
     }
 }

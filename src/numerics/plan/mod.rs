@@ -30,6 +30,7 @@
 
 pub mod air;
 pub mod ascent;
+pub mod boundary;
 pub mod deadline;
 pub mod ge_stability;
 pub mod jerk;
