@@ -9,11 +9,11 @@
 //!
 //! Medians on the 2-core machine (2026-12-05): control 1.11 s; 2 448
 //! distinct winds 13.4 s (each member beyond the control judged by
-//! `plan_verdict`: 285–480 shootings, 11–21 ms on one core for a GO
-//! verdict; it was about 56 s with full plans); rounded 7.45 s. The target is not met: a verdict needs the loads along the whole
-//! path (four sparse sequences of about 100 shootings on the plan's 4 000
-//! segment grid), and 2 448 of them at about 10 ms of one core is 12 s on
-//! two.
+//! `plan_verdict`: 285–480 shootings, 11–21 ms of one core for a GO
+//! verdict; with full plans it took about 56 s); rounded 7.45 s. The
+//! target is not met: a verdict needs the loads along the whole path (four
+//! sparse sequences of about 100 shootings on the plan's 4 000-segment
+//! grid), and 2 448 of them at about 10 ms of one core is 12 s on two.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use serde_json::{Value, json};
