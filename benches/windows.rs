@@ -32,7 +32,13 @@ fn spread(member: u64, hour: u64) -> f64 {
 
 /// `rounded`: to 0.1 km/h, as Open-Meteo sends its speeds.
 fn forecast(members: u64, rounded: bool) -> Value {
-    let r = |v: f64| if rounded { (v * 10.0).round() / 10.0 } else { v };
+    let r = |v: f64| {
+        if rounded {
+            (v * 10.0).round() / 10.0
+        } else {
+            v
+        }
+    };
     let hours = 48;
     let mut hourly = serde_json::Map::new();
     let mut units = serde_json::Map::new();
@@ -61,7 +67,9 @@ fn forecast(members: u64, rounded: bool) -> Value {
             units.insert(key, json!("km/h"));
         }
         let key = format!("wind_gusts_10m{suffix}");
-        let v: Vec<f64> = (0..hours).map(|h| r(base(h) * spread(m, h) * 1.6)).collect();
+        let v: Vec<f64> = (0..hours)
+            .map(|h| r(base(h) * spread(m, h) * 1.6))
+            .collect();
         hourly.insert(key.clone(), json!(v));
         units.insert(key, json!("km/h"));
     }
