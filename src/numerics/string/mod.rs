@@ -4,6 +4,7 @@
 
 pub mod chart;
 pub mod converged;
+pub mod convergence;
 pub mod critical;
 pub mod frequency_response;
 pub mod operators;
