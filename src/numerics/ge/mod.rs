@@ -57,6 +57,7 @@ pub mod qs_critical;
 pub mod qs_flutter;
 pub mod qs_levels;
 pub mod qs_mesh;
+pub mod qs_root;
 pub mod qs_wind;
 pub mod qs_wind_onset;
 pub mod quasi_static;

@@ -86,8 +86,7 @@ use super::GeModel;
 use super::air_load::AirLoads;
 use super::element::TipLoad;
 use super::qs_critical::{
-    OnsetState, QsSearchConfig, Scan, along_length, along_rate, nearest, onset_state, refine_root,
-    scan_change, search_onset_from,
+    OnsetState, QsSearchConfig, along_length, along_rate, nearest, onset_state, search_onset_from,
 };
 pub use super::qs_levels::{
     BASE_ELEMENTS, ConvergedOnset, ConvergedOutcome, ConvergedSearch, ConvergenceConfig,
@@ -99,6 +98,7 @@ pub use super::qs_mesh::{
     CalmGuess, FIRST_ELEMENT_IN_LAYERS, bisect_nodes, calm_length_guess, calm_rate_guess,
     graded_nodes,
 };
+use super::qs_root::{Scan, refine_root, scan_change};
 use super::qs_wind::{branch_equilibrium, continuum_start};
 use super::quasi_static::{QsConfig, divergence_indicator, wind_equilibrium, wind_stability};
 use super::stability::StateMotion;
