@@ -2,11 +2,15 @@
 //! what `/plan` only reports: its `go`, durations and altitude must be
 //! `/plan`'s bit for bit, in calm air, in uniform, power-law and log-law
 //! winds, with gusts, with haul-down forecasts inside, across and past
-//! their limits, and for a target out of reach.
+//! their limits, and for a target out of reach. An ensemble is priced
+//! accordingly: a plan per distinct wind of the first member, half a plan
+//! per other member's distinct wind.
 
 use serde_json::{Value, json};
+use tetherplan::contract::analysis::Analysis;
 use tetherplan::contract::plan::{PlanRequest, PlanResponse, PlanVerdict, plan, plan_verdict};
 use tetherplan::contract::run::NoProgress;
+use tetherplan::contract::windows::{WindowsRequest, prepare};
 
 fn request(wind: Option<Value>, haul_down: Option<Value>) -> PlanRequest {
     let mut b = json!({
@@ -173,5 +177,69 @@ fn a_target_out_of_reach_is_no_go_in_both() {
             Some(haul_down(&[(0.0, 23.0, 23.0)], 12.0, None)),
         ),
         true,
+    );
+}
+
+/// An ensemble is priced a plan per distinct wind of the first member
+/// (whose hours the answer reports in full) and half a plan per other
+/// distinct wind (a member's verdict).
+#[test]
+fn an_ensemble_is_priced_in_plans_and_verdicts() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/forecasts/open_meteo_hourly.json"
+    ))
+    .unwrap();
+    let mut data: Value = serde_json::from_str(&text).unwrap();
+    let hourly = data["hourly"].as_object().unwrap().clone();
+    let units = data["hourly_units"].as_object().unwrap().clone();
+    // Member 1 equals the control; member 2 blows 10 % harder every hour.
+    for (m, factor) in [(1, 1.0), (2, 1.1)] {
+        for (k, v) in &hourly {
+            if k == "time" {
+                continue;
+            }
+            let key = format!("{k}_member{m:02}");
+            let scaled: Vec<Value> = v
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| json!(x.as_f64().unwrap() * factor))
+                .collect();
+            data["hourly"][&key] = Value::Array(scaled);
+            data["hourly_units"][&key] = units[k].clone();
+        }
+    }
+    let req: WindowsRequest = serde_json::from_value(json!({
+        "cable": {"mass_per_length_kg_m": 0.078, "diameter_m": 0.006, "breaking_strength_n": 20000.0},
+        "aerostat": {"net_buoyancy_n": 1000.0, "mass_kg": 10.0, "drag_coefficient_nondim": 0.3,
+                     "reference_area_m2": 20.0},
+        "winch": {"max_rate_m_s": 10.0, "max_acceleration_m_s2": 1.0},
+        "target_elevation_m": 300.0,
+        "operation_s": 3600.0,
+        "forecast": {"format": "open_meteo", "data": data}
+    }))
+    .unwrap();
+    let prepared = prepare(&req).unwrap();
+    let full = prepared.full_plan_count();
+    let verdicts = prepared.plan_count() - full;
+    // The control's distinct winds; member 2's calm hours are the control's too.
+    assert!(
+        full >= 1 && verdicts >= 1 && verdicts <= full,
+        "{full} {verdicts}"
+    );
+    let price = req.price().unwrap();
+    let expected = (full as f64 + 0.5 * verdicts as f64) * 0.4;
+    assert!(
+        (price.cpu_s - expected).abs() < 1e-12,
+        "{} {expected}",
+        price.cpu_s
+    );
+    assert!(
+        price
+            .counts
+            .contains(&format!("{verdicts} members' verdicts")),
+        "{}",
+        price.counts
     );
 }

@@ -20,6 +20,11 @@ pub const PER_PERIOD: u64 = 24 * est::PER_NUMBER + 1200;
 /// through the route: 5 distinct hours 1.60 CPU-s, 10 hours 3.20, 30 hours
 /// 9.67: 0.32 s a plan), s.
 pub const PLAN_S: f64 = 0.4;
+/// The share of [`PLAN_S`] an ensemble member's verdict costs (the plan's
+/// deciding steps only, `plan_verdict`: measured 0.38–0.47 of a full plan
+/// for a GO verdict in 3–7 m/s at 10 m, less when a haul-down already past
+/// its limit decides it).
+pub const VERDICT_SHARE: f64 = 0.5;
 
 impl Analysis for WindowsRequest {
     const NAME: &'static str = "windows";
@@ -36,8 +41,9 @@ impl Analysis for WindowsRequest {
         that §9 `wind` per hour. With an ensemble each hour has\n\
         `probability_go` (Wilson interval) and the 10/50/90 % of\n\
         `max_altitude_m`, each window its probability. Synchronously as\n\
-        many distinct winds as 2 CPU-seconds allow (a plan each, priced at\n\
-        0.4 s: 5); more: a job with `\"kind\": \"windows\"`.";
+        many distinct winds as 2 CPU-seconds allow (a plan each for the\n\
+        first member, priced at 0.4 s: 5; half that for each other\n\
+        member's verdict); more: a job with `\"kind\": \"windows\"`.";
     const ABOUT: &'static str = "Launch windows by the hour from a forecast (Open-Meteo JSON, METAR, TAF or CSV): each period judged as the plan judges its wind (progress bar in plans).";
     type Response = WindowsResponse;
     fn parse(body: &[u8]) -> Result<Self, RequestError> {
@@ -59,13 +65,19 @@ impl Analysis for WindowsRequest {
         }
         Ok(())
     }
-    /// A plan (its stability in the hour's wind) per distinct wind.
+    /// A plan (its stability in the hour's wind) per distinct wind of the
+    /// first member, a verdict per other distinct wind.
     fn price(&self) -> Option<Price> {
-        let plans = windows::prepare(self).ok()?.plan_count();
+        let prepared = windows::prepare(self).ok()?;
+        let plans = prepared.plan_count();
+        let full = prepared.full_plan_count();
+        let verdicts = plans - full;
         Some(Price {
-            cpu_s: plans as f64 * PLAN_S,
+            cpu_s: (full as f64 + VERDICT_SHARE * verdicts as f64) * PLAN_S,
             field: "forecast.data".into(),
-            counts: format!("{plans} distinct winds, a plan each,"),
+            counts: format!(
+                "{plans} distinct winds ({full} planned in full, {verdicts} members' verdicts at {VERDICT_SHARE} of a plan),"
+            ),
         })
     }
     fn run(&self, progress: &dyn Progress) -> Result<WindowsResponse, RequestError> {

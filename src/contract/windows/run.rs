@@ -69,6 +69,15 @@ impl Prepared {
     pub fn plan_count(&self) -> usize {
         self.plans.len()
     }
+    /// Distinct plans run in full: those of the first member's periods;
+    /// the others are verdicts only.
+    pub fn full_plan_count(&self) -> usize {
+        let mut full = vec![false; self.plans.len()];
+        for c in self.cases.first().into_iter().flatten() {
+            full[c.plan] = true;
+        }
+        full.iter().filter(|&&f| f).count()
+    }
     /// Periods over all members.
     pub fn period_count(&self) -> usize {
         self.cases.iter().map(Vec::len).sum()
