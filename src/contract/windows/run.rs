@@ -510,10 +510,16 @@ pub fn answer(
     let control = &f.members[0];
     let mut hours = Vec::with_capacity(control.periods.len());
     for ((p, c), (j, alpha)) in control.periods.iter().zip(&prepared.cases[0]).zip(&first) {
-        let plan = plans[c.plan]
-            .full
-            .as_ref()
-            .expect("the first member's plans are run in full");
+        // The first member's plans ran in full ([`run_plans`]); were one
+        // not, it is planned here rather than trusted.
+        let planned_here;
+        let plan = match &plans[c.plan].full {
+            Some(full) => full,
+            None => {
+                planned_here = crate::contract::plan::plan(&prepared.plans[c.plan], progress)?;
+                &planned_here
+            }
+        };
         let mut h = WindowsHourOutput {
             time: p.time.clone(),
             end: f.style.format(p.end_s),
