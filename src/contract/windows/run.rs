@@ -69,14 +69,18 @@ impl Prepared {
     pub fn plan_count(&self) -> usize {
         self.plans.len()
     }
-    /// Distinct plans run in full: those of the first member's periods;
-    /// the others are verdicts only.
-    pub fn full_plan_count(&self) -> usize {
+    /// Per distinct plan, whether it runs in full: those of the first
+    /// member's periods; the others are verdicts only.
+    fn in_full(&self) -> Vec<bool> {
         let mut full = vec![false; self.plans.len()];
         for c in self.cases.first().into_iter().flatten() {
             full[c.plan] = true;
         }
-        full.iter().filter(|&&f| f).count()
+        full
+    }
+    /// Distinct plans run in full ([`Self::in_full`]).
+    pub fn full_plan_count(&self) -> usize {
+        self.in_full().iter().filter(|&&f| f).count()
     }
     /// Periods over all members.
     pub fn period_count(&self) -> usize {
@@ -340,10 +344,7 @@ fn run_plans(prepared: &Prepared, progress: &dyn Progress) -> Result<Vec<Planned
     let done = AtomicUsize::new(0);
     let total = prepared.plans.len();
     let quiet = PlanProgress { outer: progress };
-    let mut full = vec![false; total];
-    for c in prepared.cases.first().into_iter().flatten() {
-        full[c.plan] = true;
-    }
+    let full = prepared.in_full();
     prepared
         .plans
         .par_iter()

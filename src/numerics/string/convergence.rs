@@ -92,17 +92,7 @@ pub fn validate_tolerance(field: &str, tolerance: f64) -> Result<f64, InvalidInp
 /// Operators of refinement level `level` (shared, built once per process).
 pub fn graded_operators(level: usize) -> Arc<StringOperators> {
     static CACHE: OnceLock<Mutex<Vec<Arc<StringOperators>>>> = OnceLock::new();
-    let cache = CACHE.get_or_init(|| Mutex::new(Vec::new()));
-    let mut levels = cache.lock().unwrap_or_else(|e| e.into_inner());
-    while levels.len() <= level {
-        let k = levels.len() as i32;
-        let first = 0.5f64.powi(k) / BULK_ELEMENTS as f64;
-        levels.push(Arc::new(StringOperators::on_mesh(Mesh::graded(
-            first,
-            BULK_ELEMENTS,
-        ))));
-    }
-    levels[level].clone()
+    level_operators(&CACHE, level, |first| Mesh::graded(first, BULK_ELEMENTS))
 }
 
 /// Operators of the two-element mesh `[0, h₁, 1]` with the first element of
@@ -113,14 +103,23 @@ pub fn graded_operators(level: usize) -> Arc<StringOperators> {
 /// of the cost (checked in the tests).
 pub fn roller_operators(level: usize) -> Arc<StringOperators> {
     static CACHE: OnceLock<Mutex<Vec<Arc<StringOperators>>>> = OnceLock::new();
-    let cache = CACHE.get_or_init(|| Mutex::new(Vec::new()));
+    level_operators(&CACHE, level, Mesh::roller_element)
+}
+
+/// The operators of a family's level from its process-wide cache, the
+/// levels up to it built on first use: `mesh(h₁)` with the first element
+/// `h₁ = 2^{-k}/BULK_ELEMENTS` of level `k`.
+fn level_operators(
+    cache: &OnceLock<Mutex<Vec<Arc<StringOperators>>>>,
+    level: usize,
+    mesh: impl Fn(f64) -> Mesh,
+) -> Arc<StringOperators> {
+    let cache = cache.get_or_init(|| Mutex::new(Vec::new()));
     let mut levels = cache.lock().unwrap_or_else(|e| e.into_inner());
     while levels.len() <= level {
         let k = levels.len() as i32;
         let first = 0.5f64.powi(k) / BULK_ELEMENTS as f64;
-        levels.push(Arc::new(StringOperators::on_mesh(Mesh::roller_element(
-            first,
-        ))));
+        levels.push(Arc::new(StringOperators::on_mesh(mesh(first))));
     }
     levels[level].clone()
 }
