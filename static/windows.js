@@ -57,8 +57,10 @@ import S from "./shared/index.js";
     <button type="button" id="windows-job-cancel" class="secondary">Cancel</button>
   </div>
   <p id="windows-summary" class="note" hidden></p>
-  <div id="windows-timeline" class="windows-timeline" role="list" aria-label="Forecast periods" hidden></div>
-  <div id="windows-bands" class="windows-bands" aria-label="Launch windows"></div>`;
+  <div class="windows-scroll">
+    <div id="windows-timeline" class="windows-timeline" role="list" aria-label="Forecast periods" hidden></div>
+    <div id="windows-bands" class="windows-bands" aria-label="Launch windows"></div>
+  </div>`;
   plan.after(section);
   const $ = (id) => document.getElementById(id);
   // A forecast of many distinct winds costs more than a direct answer may
@@ -126,6 +128,19 @@ import S from "./shared/index.js";
     section.dataset.state = "done";
   }
 
+  // The hour a period starts, as its cell's label: "HH" of an ISO time
+  // (YYYY-MM-DDTHH:MM, with "HH:MM" off the hour), of an aviation time
+  // (DDHHMMZ) or of a TAF group (DDHH/DDHH); else the period's index.
+  function hourLabel(time, i) {
+    const iso = time.match(/T(\d\d):(\d\d)/);
+    if (iso) return iso[2] === "00" ? iso[1] : `${iso[1]}:${iso[2]}`;
+    const av = time.match(/^\d\d(\d\d)(\d\d)Z$/);
+    if (av) return av[2] === "00" ? av[1] : `${av[1]}:${av[2]}`;
+    const taf = time.match(/^\d\d(\d\d)\//);
+    if (taf) return taf[1];
+    return String(i + 1);
+  }
+
   function draw(r) {
     const tl = $("windows-timeline");
     tl.innerHTML = "";
@@ -145,13 +160,17 @@ import S from "./shared/index.js";
       bar.className = "bar";
       bar.style.height = `${Math.max(4, (100 * (h.max_altitude_m || 0)) / top)}%`;
       const lab = document.createElement("span");
-      lab.textContent = (h.time.match(/T(\d\d)|^\d\d(\d\d)/) || [])[1] ?? (h.time.match(/^\d\d(\d\d)/) || [])[1] ?? String(i);
+      lab.className = "hour";
+      lab.textContent = hourLabel(h.time, i);
       b.append(bar, lab);
       b.addEventListener("click", () => choose(r, i));
       tl.append(b);
     });
     const bands = $("windows-bands");
     bands.innerHTML = "";
+    // Cells and bands share the scrolling box (.windows-scroll, positioned),
+    // so a cell's offsetLeft is the band's left at any scroll.
+    bands.style.width = `${tl.scrollWidth}px`;
     const cells = [...tl.children];
     for (const w of r.windows) {
       const a = r.hours.findIndex((h) => h.time >= w.start);

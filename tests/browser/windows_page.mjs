@@ -7,8 +7,10 @@
 // day's timeline shows its 24 hours, coloured by verdict, with GO and NO-GO
 // hours; choosing a NO-GO hour sets the plan's wind to that hour's (the
 // fitted power law) and the plan's verdict turns NO-GO; choosing a GO hour
-// turns it GO. The page's units (the header's) reach the timeline and the URL. Screenshot:
-// tests/artifacts/windows_page.png.
+// turns it GO. Each cell is labelled by its hour, and the launch window's
+// band lies under its hours, also at 390 px with the day scrolled. The
+// page's units (the header's) reach the timeline and the URL. Screenshots:
+// tests/artifacts/windows_page.png, windows_page_390.png.
 
 import { readFileSync } from "node:fs";
 import path from "node:path";
@@ -49,6 +51,19 @@ try {
   check(cells.includes("go") && cells.includes("no-go"), `GO and NO-GO hours (${cells.join(" ")})`);
   const colours = await page.$$eval("#windows-timeline button .bar", (bs) => [...new Set(bs.map((b) => getComputedStyle(b).backgroundColor))]);
   check(colours.length === 2, `hours coloured by verdict (${colours.join(", ")})`);
+  const labels = await page.$$eval("#windows-timeline button .hour", (ls) => ls.map((l) => l.textContent));
+  const hours = Array.from({ length: 24 }, (_, h) => String(h).padStart(2, "0"));
+  check(labels.join(" ") === hours.join(" "), `each cell labelled by its hour (${labels.join(" ")})`);
+  // The window band lies under its hours: from the left edge of its first
+  // hour to the right edge of its last (the file's window is 00:00–10:00).
+  const band = () => page.evaluate(() => {
+    const cells = [...document.querySelectorAll("#windows-timeline button")].map((c) => c.getBoundingClientRect());
+    const b = document.querySelector("#windows-bands span")?.getBoundingClientRect();
+    return b && { text: document.querySelector("#windows-bands span").textContent, left: b.left - cells[0].left, right: b.right - cells[9].right };
+  });
+  const b = await band();
+  check(b && b.text.startsWith("2026-12-03T00:00–2026-12-03T10:00"), `the launch window marked (${b?.text})`);
+  check(b && Math.abs(b.left) <= 1 && Math.abs(b.right) <= 1, `the window's band spans its hours 00–09 (edges off by ${b?.left?.toFixed(1)} and ${b?.right?.toFixed(1)} px)`);
   await page.locator("#windows").screenshot({ path: path.join(artifacts, "windows_page.png") });
 
   phase = "choose";
@@ -67,6 +82,14 @@ try {
   check(q.get("speed") === "kn" && q.get("length") === "ft", `the page's units kept in the URL (${page.url()})`);
   const title = await page.getAttribute(`#windows-timeline button[data-index="${go}"]`, "title");
   check(/ kn/.test(title) && / ft/.test(title), `the timeline speaks knots and feet (“${title.split("\n")[0]}”)`);
+  // On a phone the day scrolls sideways, the band with its hours.
+  await page.setViewportSize({ width: 390, height: 844 });
+  await page.$eval(".windows-scroll", (s) => { s.scrollLeft = 120; });
+  const scrolled = await page.$eval(".windows-scroll", (s) => s.scrollLeft);
+  const p = await band();
+  check(scrolled > 0 && p && Math.abs(p.left) <= 1 && Math.abs(p.right) <= 1,
+    `at 390 px, scrolled ${scrolled} px, the band still spans its hours (edges off by ${p?.left?.toFixed(1)} and ${p?.right?.toFixed(1)} px)`);
+  await page.locator("#windows").screenshot({ path: path.join(artifacts, "windows_page_390.png") });
   await context.close();
 
   // A day of distinct winds costs more than a direct answer may (a plan
