@@ -40,12 +40,14 @@ import S from "./shared/index.js";
   <p class="hint">Paste a forecast or drop its file here: Open-Meteo JSON (or its ensemble), a METAR, a TAF, or CSV
     <code>time,height_m,speed_m_s,gust_m_s</code>. Each hour is judged as the plan above judges its wind; choose an hour to plan in it.</p>
   <form id="windows-form" novalidate>
+    <fieldset><legend>Forecast and flight</legend>
     <div class="field wide"><label for="windows-data">Forecast</label>
       <textarea id="windows-data" rows="4" placeholder="drop a file here or paste"></textarea></div>
-    <div class="field"><label for="windows-file">Forecast file</label><input id="windows-file" type="file" accept=".json,.csv,.txt"></div>
+    <div class="field wide"><label for="windows-file">Forecast file</label><input id="windows-file" type="file" accept=".json,.csv,.txt"></div>
     <div class="field"><label for="windows-operation">Time aloft (h)</label><input id="windows-operation" inputmode="decimal" value="1"></div>
     <div class="field"><label for="windows-limit">Highest wind at the aerostat (m/s, blank: the plan's limits only)</label>
       <input id="windows-limit" inputmode="decimal" value=""></div>
+    </fieldset>
     <div class="actions"><button type="submit" id="windows-button">Show the day</button>
       <button type="button" id="windows-fetch" class="secondary" hidden>Fetch today's forecast</button></div>
     <p id="windows-source" class="note" hidden></p>
@@ -189,7 +191,8 @@ import S from "./shared/index.js";
     const sum = $("windows-summary");
     sum.textContent = `${go} of ${r.hours.length} periods GO; ${r.windows.length} launch window(s)` +
       (r.members > 1 ? `; ${r.members} ensemble members` : "") +
-      `; limits × α from 1 down by ${r.lead_time_factor.per_hour_nondim} per hour of lead time.`;
+      `; limits × α from 1 down by ${r.lead_time_factor.per_hour_nondim} per hour of lead time. ` +
+      `Green GO, red NO-GO; a bar's height is the hour's reachable altitude (full height ${len(top)}).`;
     sum.hidden = false;
   }
 
