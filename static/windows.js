@@ -155,7 +155,11 @@ import S from "./shared/index.js";
       b.dataset.verdict = h.verdict;
       b.dataset.index = String(i);
       b.setAttribute("aria-pressed", "false");
-      const p = h.probability_go != null ? `, P(go) ${(100 * h.probability_go).toFixed(0)} %` : "";
+      const ens = h.probability_go != null;
+      const p = ens
+        ? `, P(go) ${(100 * h.probability_go).toFixed(0)} % (${(100 * h.probability_go_low).toFixed(0)}–${(100 * h.probability_go_high).toFixed(0)} %), ` +
+          `reach of the members ${len(h.max_altitude_p10_m)} / ${len(h.max_altitude_p50_m)} / ${len(h.max_altitude_p90_m)} (10/50/90 %)`
+        : "";
       b.title = `${h.time}: ${h.verdict.toUpperCase()}, reach ${len(h.max_altitude_m)}, wind at target ${sp(h.wind_at_target_m_s)}${p}\n${h.reason}`;
       b.setAttribute("aria-label", `${h.time} ${h.verdict}`);
       const bar = document.createElement("span");
@@ -165,6 +169,13 @@ import S from "./shared/index.js";
       lab.className = "hour";
       lab.textContent = hourLabel(h.time, i);
       b.append(bar, lab);
+      if (ens) {
+        // The share of the ensemble's members that go, under the hour.
+        const pr = document.createElement("span");
+        pr.className = "prob";
+        pr.textContent = `${(100 * h.probability_go).toFixed(0)}%`;
+        b.append(pr);
+      }
       b.addEventListener("click", () => choose(r, i));
       tl.append(b);
     });
@@ -192,7 +203,8 @@ import S from "./shared/index.js";
     sum.textContent = `${go} of ${r.hours.length} periods GO; ${r.windows.length} launch window(s)` +
       (r.members > 1 ? `; ${r.members} ensemble members` : "") +
       `; limits × α from 1 down by ${r.lead_time_factor.per_hour_nondim} per hour of lead time. ` +
-      `Green GO, red NO-GO; a bar's height is the hour's reachable altitude (full height ${len(top)}).`;
+      `Green GO, red NO-GO; a bar's height is the hour's reachable altitude (full height ${len(top)})` +
+      (r.members > 1 ? "; under each hour, the share of members that go." : ".");
     sum.hidden = false;
   }
 

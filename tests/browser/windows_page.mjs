@@ -10,7 +10,9 @@
 // turns it GO. Each cell is labelled by its hour, and the launch window's
 // band lies under its hours, also at 390 px with the day scrolled. The
 // page's units (the header's) reach the timeline and the URL. Screenshots:
-// tests/artifacts/windows_page.png, windows_page_390.png.
+// tests/artifacts/windows_page.png, windows_page_390.png. Dropped as an
+// ensemble (the file as control and three members, one stormy), each hour
+// shows its share of members that go: windows_page_ensemble.png.
 
 import { readFileSync } from "node:fs";
 import path from "node:path";
@@ -90,12 +92,42 @@ try {
   check(scrolled > 0 && p && Math.abs(p.left) <= 1 && Math.abs(p.right) <= 1,
     `at 390 px, scrolled ${scrolled} px, the band still spans its hours (edges off by ${p?.left?.toFixed(1)} and ${p?.right?.toFixed(1)} px)`);
   await page.locator("#windows").screenshot({ path: path.join(artifacts, "windows_page_390.png") });
+
+  // An ensemble: the file's hours as the control and three members, the
+  // third blowing three times as hard. Each hour shows its share of
+  // members that go: 100 % or 75 % where the control goes (the stormy
+  // member may not), 0 % or 25 % where it does not.
+  phase = "ensemble";
+  await page.setViewportSize({ width: 1280, height: 900 });
+  await page.evaluate((text) => {
+    const f = JSON.parse(text);
+    for (const k of Object.keys(f.hourly).filter((k) => k.startsWith("wind_"))) {
+      for (const m of [1, 2, 3]) {
+        const key = `${k}_member0${m}`;
+        f.hourly[key] = f.hourly[k].map((v) => (m === 3 ? 3 * v : v));
+        f.hourly_units[key] = f.hourly_units[k];
+      }
+    }
+    const dt = new DataTransfer();
+    dt.items.add(new File([JSON.stringify(f)], "ensemble.json", { type: "application/json" }));
+    document.querySelector("#windows").dispatchEvent(new DragEvent("drop", { dataTransfer: dt, bubbles: true, cancelable: true }));
+  }, forecast);
+  await page.waitForFunction(() => /4 ensemble members/.test(document.querySelector("#windows-summary")?.textContent ?? "") &&
+    document.querySelectorAll("#windows-timeline .prob").length > 0, null, { timeout: 180_000 });
+  const shares = await page.$$eval("#windows-timeline button", (bs) => bs.map((b) => [b.dataset.verdict, b.querySelector(".prob")?.textContent]));
+  check(shares.length === 24 && shares.every(([, p]) => p != null), `each hour shows its share of members that go (${shares.map(([, p]) => p).join(" ")})`);
+  check(shares.every(([v, p]) => (v === "go" ? ["100%", "75%"] : ["0%", "25%"]).includes(p)),
+    `the shares agree with the control's verdicts (${shares.map(([v, p]) => `${v}:${p}`).join(" ")})`);
+  check(shares.some(([, p]) => p === "75%"), "the stormy member turns some GO hours to 75 %");
+  const ensTitle = await page.getAttribute('#windows-timeline button[data-index="0"]', "title");
+  check(/P\(go\) \d+ % \(\d+–\d+ %\)/.test(ensTitle) && /10\/50\/90 %/.test(ensTitle), `an hour's title gives P(go) with its interval and the members' reach (“${ensTitle.split("\n")[0]}”)`);
+  await page.locator("#windows").screenshot({ path: path.join(artifacts, "windows_page_ensemble.png") });
   await context.close();
 
   // A day of distinct winds costs more than a direct answer may (a plan
   // each, priced by the server): its 422 too_large sends the panel to a
   // job, the one 4xx expected.
-  const unexpected = consoleErrors.filter((e) => !(e.phase === "drop" && /status of 422/.test(e.text)));
+  const unexpected = consoleErrors.filter((e) => !(["drop", "ensemble"].includes(e.phase) && /status of 422/.test(e.text)));
   for (const e of unexpected) console.log(`  console error (${e.phase}): ${e.text}`);
   check(unexpected.length === 0, `no console errors (${unexpected.length})`);
 } catch (e) {
