@@ -62,7 +62,8 @@ import S from "./shared/index.js";
   <div class="windows-scroll">
     <div id="windows-timeline" class="windows-timeline" role="list" aria-label="Forecast periods" hidden></div>
     <div id="windows-bands" class="windows-bands" aria-label="Launch windows"></div>
-  </div>`;
+  </div>
+  <p id="windows-list" class="note" hidden></p>`;
   plan.after(section);
   const $ = (id) => document.getElementById(id);
   // A forecast of many distinct winds costs more than a direct answer may
@@ -143,6 +144,25 @@ import S from "./shared/index.js";
     return String(i + 1);
   }
 
+  // Times as the forecast writes them, made comparable: ISO 8601 by
+  // Date.parse, aviation DDHHMMZ in minutes from the first period's month
+  // (a day before the first one's is in the next month).
+  function timeKey(first) {
+    const av = /^(\d\d)(\d\d)(\d\d)Z$/;
+    const day0 = Number((first.match(av) || [])[1] ?? 0);
+    return (t) => {
+      const m = t.match(av);
+      if (m) return ((Number(m[1]) < day0 ? Number(m[1]) + 31 : Number(m[1])) * 24 + Number(m[2])) * 60 + Number(m[3]);
+      const ms = Date.parse(/[zZ]|[+-]\d\d:?\d\d$/.test(t) ? t : `${t}Z`);
+      return Number.isFinite(ms) ? ms / 60000 : t;
+    };
+  }
+
+  // A window in words: its span, the latest launch, and with an ensemble
+  // the share of members that support it.
+  const windowText = (w) => `${w.start}–${w.end}, launch by ${w.latest_launch}` +
+    (w.probability != null ? ` (${(100 * w.probability).toFixed(0)} % of members)` : "");
+
   function draw(r) {
     const tl = $("windows-timeline");
     tl.innerHTML = "";
@@ -154,13 +174,15 @@ import S from "./shared/index.js";
       b.setAttribute("role", "listitem");
       b.dataset.verdict = h.verdict;
       b.dataset.index = String(i);
+      b.dataset.time = h.time;
+      b.dataset.end = h.end;
       b.setAttribute("aria-pressed", "false");
       const ens = h.probability_go != null;
       const p = ens
         ? `, P(go) ${(100 * h.probability_go).toFixed(0)} % (${(100 * h.probability_go_low).toFixed(0)}–${(100 * h.probability_go_high).toFixed(0)} %), ` +
           `reach of the members ${len(h.max_altitude_p10_m)} / ${len(h.max_altitude_p50_m)} / ${len(h.max_altitude_p90_m)} (10/50/90 %)`
         : "";
-      b.title = `${h.time}: ${h.verdict.toUpperCase()}, reach ${len(h.max_altitude_m)}, wind at target ${sp(h.wind_at_target_m_s)}${p}\n${h.reason}`;
+      b.title = `${h.time}${h.group && h.group !== "base" ? ` (${h.group.toUpperCase()})` : ""}: ${h.verdict.toUpperCase()}, reach ${len(h.max_altitude_m)}, wind at target ${sp(h.wind_at_target_m_s)}${p}\n${h.reason}`;
       b.setAttribute("aria-label", `${h.time} ${h.verdict}`);
       const bar = document.createElement("span");
       bar.className = "bar";
@@ -185,19 +207,36 @@ import S from "./shared/index.js";
     // so a cell's offsetLeft is the band's left at any scroll.
     bands.style.width = `${tl.scrollWidth}px`;
     const cells = [...tl.children];
+    // A window lies under the periods it overlaps ([time, end) against
+    // [start, end)): the hours inside it, or a TAF's change groups (which
+    // last many hours and may overlap: a TEMPO inside a BECMG).
+    const at = timeKey(r.hours[0]?.time ?? "");
+    const rows = [];
     for (const w of r.windows) {
-      const a = r.hours.findIndex((h) => h.time >= w.start);
-      const e = r.hours.findIndex((h) => h.time >= w.end);
-      const first = cells[Math.max(a, 0)];
-      const lastCell = cells[(e < 0 ? cells.length : e) - 1] || first;
+      const over = r.hours.flatMap((h, i) => (at(h.time) < at(w.end) && at(h.end) > at(w.start) ? [i] : []));
+      if (!over.length) continue;
+      const first = cells[over[0]];
+      const lastCell = cells[over[over.length - 1]];
       const s = document.createElement("span");
       s.className = "window";
-      s.style.left = `${first.offsetLeft}px`;
-      s.style.width = `${lastCell.offsetLeft + lastCell.offsetWidth - first.offsetLeft}px`;
-      s.textContent = `${w.start}–${w.end}${w.probability != null ? ` (${(100 * w.probability).toFixed(0)} %)` : ""}`;
-      s.title = `launch by ${w.latest_launch}`;
+      const left = first.offsetLeft;
+      const right = lastCell.offsetLeft + lastCell.offsetWidth;
+      // Bands that would overlap (a TAF's windows under the same groups)
+      // take rows of their own.
+      let row = rows.findIndex((end) => end <= left);
+      if (row < 0) row = rows.push(0) - 1;
+      rows[row] = right + 2;
+      s.style.left = `${left}px`;
+      s.style.width = `${right - left}px`;
+      s.style.top = `${row * 1.3}rem`;
+      s.textContent = windowText(w);
+      s.title = windowText(w);
       bands.append(s);
     }
+    bands.style.height = `${Math.max(1, rows.length) * 1.3}rem`;
+    const list = $("windows-list");
+    list.textContent = r.windows.length ? `Launch windows: ${r.windows.map(windowText).join("; ")}.` : "No launch window in this forecast.";
+    list.hidden = false;
     const go = r.hours.filter((h) => h.verdict === "go").length;
     const sum = $("windows-summary");
     sum.textContent = `${go} of ${r.hours.length} periods GO; ${r.windows.length} launch window(s)` +

@@ -12,7 +12,9 @@
 // page's units (the header's) reach the timeline and the URL. Screenshots:
 // tests/artifacts/windows_page.png, windows_page_390.png. Dropped as an
 // ensemble (the file as control and three members, one stormy), each hour
-// shows its share of members that go: windows_page_ensemble.png.
+// shows its share of members that go: windows_page_ensemble.png. A TAF
+// pasted: one cell per change group, each window under the groups it
+// overlaps: windows_page_taf.png.
 
 import { readFileSync } from "node:fs";
 import path from "node:path";
@@ -122,12 +124,42 @@ try {
   const ensTitle = await page.getAttribute('#windows-timeline button[data-index="0"]', "title");
   check(/P\(go\) \d+ % \(\d+–\d+ %\)/.test(ensTitle) && /10\/50\/90 %/.test(ensTitle), `an hour's title gives P(go) with its interval and the members' reach (“${ensTitle.split("\n")[0]}”)`);
   await page.locator("#windows").screenshot({ path: path.join(artifacts, "windows_page_ensemble.png") });
+
+  // A TAF: one cell per change group, each lasting hours, a TEMPO inside
+  // the BECMG. Each window's band lies under the groups it overlaps (the
+  // overlap computed here from the cells' times), not from the first cell.
+  phase = "taf";
+  await page.fill("#windows-data", "TAF EGLL 051100Z 0512/0618 05005KT 9999 SCT030 BECMG 0515/0517 08004KT TEMPO 0520/0602 30040G55KT");
+  await page.click("#windows-button");
+  await page.waitForFunction(() => document.querySelectorAll("#windows-timeline button").length === 3 && document.querySelector("#windows")?.dataset.state === "done", null, { timeout: 120_000 });
+  const taf = await page.evaluate(() => {
+    const minutes = (t) => { const m = t.match(/^(\d\d)(\d\d)(\d\d)Z$/); return (Number(m[1]) * 24 + Number(m[2])) * 60 + Number(m[3]); };
+    const cells = [...document.querySelectorAll("#windows-timeline button")].map((c) => ({
+      from: minutes(c.dataset.time), to: minutes(c.dataset.end), verdict: c.dataset.verdict,
+      label: c.querySelector(".hour").textContent, box: c.getBoundingClientRect() }));
+    const bands = [...document.querySelectorAll("#windows-bands span")].map((b) => {
+      const [start, end] = b.textContent.match(/^(\d{6}Z)–(\d{6}Z)/).slice(1).map(minutes);
+      const over = cells.filter((c) => c.from < end && c.to > start);
+      const r = b.getBoundingClientRect();
+      return { text: b.textContent, over: over.length, top: r.top, bottom: r.bottom,
+        left: over.length ? r.left - over[0].box.left : NaN, right: over.length ? r.right - over[over.length - 1].box.right : NaN };
+    });
+    return { labels: cells.map((c) => c.label), verdicts: cells.map((c) => c.verdict), bands, list: document.querySelector("#windows-list").textContent };
+  });
+  check(taf.labels.join(" ") === "12 15 20", `the TAF's groups labelled by their hours (${taf.labels.join(" ")})`);
+  check(taf.verdicts.join(" ") === "go go no-go", `calm base and BECMG GO, the stormy TEMPO NO-GO (${taf.verdicts.join(" ")})`);
+  check(taf.bands.length === 2 && taf.bands.every((b) => b.over > 0 && Math.abs(b.left) <= 1 && Math.abs(b.right) <= 1),
+    `each TAF window under the groups it overlaps (${taf.bands.map((b) => `${b.text}: ${b.over} groups, edges ${b.left.toFixed(1)}/${b.right.toFixed(1)} px`).join("; ")})`);
+  const [b1, b2] = taf.bands;
+  check(b1 && b2 && (b1.bottom <= b2.top || b2.bottom <= b1.top), `two windows under the same groups take rows of their own (${b1?.top}–${b1?.bottom}, ${b2?.top}–${b2?.bottom})`);
+  check(/^Launch windows: 051200Z–052000Z, launch by \d{6}Z; 060200Z–061800Z, launch by \d{6}Z\.$/.test(taf.list), `the windows listed in words (“${taf.list}”)`);
+  await page.locator("#windows").screenshot({ path: path.join(artifacts, "windows_page_taf.png") });
   await context.close();
 
   // A day of distinct winds costs more than a direct answer may (a plan
   // each, priced by the server): its 422 too_large sends the panel to a
   // job, the one 4xx expected.
-  const unexpected = consoleErrors.filter((e) => !(["drop", "ensemble"].includes(e.phase) && /status of 422/.test(e.text)));
+  const unexpected = consoleErrors.filter((e) => !(["drop", "ensemble", "taf"].includes(e.phase) && /status of 422/.test(e.text)));
   for (const e of unexpected) console.log(`  console error (${e.phase}): ${e.text}`);
   check(unexpected.length === 0, `no console errors (${unexpected.length})`);
 } catch (e) {
