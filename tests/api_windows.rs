@@ -531,6 +531,15 @@ async fn bad_forecasts_are_refused_naming_field_and_key_or_line() {
             "forecast.data",
             "no wind",
         ),
+        // An FM group whose wind cannot be read (a speed of three digits
+        // and a two-digit gust field run together) would leave its hours
+        // unjudged: refused, naming the group.
+        (
+            "taf",
+            json!("TAF EDDB 031100Z 0312/0412 24010KT 9999 FM031500 99999KT 9999 BKN010"),
+            "forecast.data",
+            "TAF group 2 (fm, from 031500Z) has no wind group",
+        ),
     ];
     for (format, data, field, words) in cases {
         let (f, m) = refused(&windows_request(format, data.clone())).await;

@@ -6,7 +6,10 @@
 //! validity's start to the first `FM` (or the validity's end), each `FM` to
 //! the next, each `BECMG` from its start to the next `FM` or the end (the new
 //! wind then holds), each `TEMPO` and `PROB` over its own period (they
-//! overlap the others: a time is judged by every group covering it). Times
+//! overlap the others: a time is judged by every group covering it). An
+//! `FM` group without a wind is refused (it replaces the whole forecast);
+//! a `BECMG`, `TEMPO` or `PROB` group without one leaves the wind as it
+//! was. Times
 //! are day-of-month, hour, minute (`DDHHMMZ`); a report crossing the end of
 //! a month is taken to cross it after its issue day. Lead times count from
 //! the issue time.
@@ -190,6 +193,21 @@ pub fn parse_taf(s: &str) -> Result<ParsedForecast, InvalidInput> {
         }
         last_start = start;
         let Some(w) = &f.wind else {
+            // An FM group replaces the whole forecast from its time on
+            // (ICAO Annex 3), so its wind is needed: without one, the time
+            // after it would be judged by no wind at all. A BECMG, TEMPO or
+            // PROB group may change other elements only; the wind before
+            // it then holds.
+            if f.kind == TafForecastKind::FM {
+                return Err(InvalidInput::new(
+                    "forecast.data",
+                    format!(
+                        "TAF group {} (fm, from {}) has no wind group that can be read (dddffKT, dddffGggKT, VRBffKT or MPS): an FM group starts a complete new forecast, so its wind is needed",
+                        i + 1,
+                        text(style, start)
+                    ),
+                ));
+            }
             continue;
         };
         if end <= start {
