@@ -163,6 +163,46 @@ async fn open_meteo_hours_are_the_plan_of_their_echoed_wind() {
     }
 }
 
+/// Open-Meteo writes `null` where it has no value (past the horizon of a
+/// height or a model). An hour whose upper heights are null is fitted
+/// through the heights it has; an hour whose gust is null is judged in the
+/// mean wind only, and the answer says so; an hour with no speed at all is
+/// left out, and said so.
+#[tokio::test]
+async fn open_meteo_nulls_fit_what_remains_and_say_what_is_missing() {
+    let mut f = open_meteo_file();
+    for k in ["wind_speed_80m", "wind_speed_120m", "wind_speed_180m"] {
+        f["hourly"][k][20] = Value::Null;
+    }
+    f["hourly"]["wind_gusts_10m"][21] = Value::Null;
+    f["hourly"]["wind_gusts_10m"][22] = Value::Null;
+    for k in ["wind_speed_10m", "wind_speed_80m", "wind_speed_120m", "wind_speed_180m"] {
+        f["hourly"][k][23] = Value::Null;
+    }
+    let (s, r) = post("/api/v1/windows", &windows_request("open_meteo", f)).await;
+    assert_eq!(s, StatusCode::OK, "{r}");
+    let hours = r["hours"].as_array().unwrap();
+    assert_eq!(hours.len(), 23, "the hour without any speed is left out");
+    // 20:00 from its 10 m speed alone: the log law of the roughness.
+    assert_eq!(hours[20]["wind"]["flow"]["kind"], "log_law");
+    assert_eq!(hours[20]["wind"]["flow"]["reference_height_m"], 10.0);
+    assert!(hours[21]["wind"].get("gust").is_none());
+    assert!(hours[22]["wind"].get("gust").is_none());
+    assert!(hours[19]["wind"].get("gust").is_some());
+    for h in &hours[20..23] {
+        assert_hour_is_plan(h, &h["wind"]).await;
+    }
+    let notes = r["notes"].to_string();
+    assert!(
+        notes.contains("control: 2 hour(s) with no gust (null) judged in the mean wind only"),
+        "{notes}"
+    );
+    assert!(
+        notes.contains("control: 1 hour(s) with no wind speed at any height left out"),
+        "{notes}"
+    );
+}
+
 #[tokio::test]
 async fn a_uniform_hour_in_knots_is_the_plan_for_that_speed() {
     // 15 kn at 10 and 80 m: a uniform flow of exactly 15 × 1852/3600 m/s.

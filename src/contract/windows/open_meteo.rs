@@ -241,6 +241,7 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
         gusts.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut periods = Vec::with_capacity(ts.len());
         let mut skipped = 0;
+        let mut gustless = 0;
         for (i, &t) in ts.iter().enumerate() {
             let winds: Vec<(f64, f64)> = speeds
                 .iter()
@@ -251,6 +252,9 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
                 continue;
             }
             let gust = gusts.iter().find_map(|(h, v)| v[i].map(|g| (*h, g)));
+            if gust.is_none() && !gusts.is_empty() {
+                gustless += 1;
+            }
             let step = if i + 1 < ts.len() {
                 ts[i + 1] - t
             } else if i > 0 {
@@ -273,6 +277,11 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
         if skipped > 0 {
             notes.push(format!(
                 "{name}: {skipped} hour(s) with no wind speed at any height left out"
+            ));
+        }
+        if gustless > 0 {
+            notes.push(format!(
+                "{name}: {gustless} hour(s) with no gust (null) judged in the mean wind only, without the gust's checks"
             ));
         }
         out.push(Member { name, periods });
