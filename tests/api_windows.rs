@@ -176,7 +176,12 @@ async fn open_meteo_nulls_fit_what_remains_and_say_what_is_missing() {
     }
     f["hourly"]["wind_gusts_10m"][21] = Value::Null;
     f["hourly"]["wind_gusts_10m"][22] = Value::Null;
-    for k in ["wind_speed_10m", "wind_speed_80m", "wind_speed_120m", "wind_speed_180m"] {
+    for k in [
+        "wind_speed_10m",
+        "wind_speed_80m",
+        "wind_speed_120m",
+        "wind_speed_180m",
+    ] {
         f["hourly"][k][23] = Value::Null;
     }
     let (s, r) = post("/api/v1/windows", &windows_request("open_meteo", f)).await;
