@@ -208,6 +208,30 @@ async fn open_meteo_nulls_fit_what_remains_and_say_what_is_missing() {
     );
 }
 
+/// A CSV whose times carry an offset gets its ends and windows back in
+/// that offset (an end of `…T01:00` after a start of `…T00:00+01:00` read
+/// as if the period ended where it began).
+#[tokio::test]
+async fn csv_times_with_an_offset_are_answered_in_that_offset() {
+    let csv = "time,height_m,speed_m_s,gust_m_s\n\
+               2026-12-03T00:00+01:00,10,3,5\n\
+               2026-12-03T01:00+01:00,10,3,5\n";
+    let (s, r) = post("/api/v1/windows", &windows_request("csv", json!(csv))).await;
+    assert_eq!(s, StatusCode::OK, "{r}");
+    let hours = r["hours"].as_array().unwrap();
+    assert_eq!(hours[0]["time"], "2026-12-03T00:00+01:00");
+    assert_eq!(hours[0]["end"], "2026-12-03T01:00+01:00");
+    assert_eq!(hours[1]["end"], "2026-12-03T02:00+01:00");
+    assert_eq!(hours[1]["lead_time_s"], 3600.0);
+    let w = &r["windows"][0];
+    assert_eq!(w["start"], "2026-12-03T00:00+01:00", "{r}");
+    assert_eq!(w["end"], "2026-12-03T02:00+01:00");
+    assert!(
+        w["latest_launch"].as_str().unwrap().ends_with("+01:00"),
+        "{w}"
+    );
+}
+
 #[tokio::test]
 async fn a_uniform_hour_in_knots_is_the_plan_for_that_speed() {
     // 15 kn at 10 and 80 m: a uniform flow of exactly 15 × 1852/3600 m/s.

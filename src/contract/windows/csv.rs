@@ -7,7 +7,7 @@
 //! that has one.
 
 use crate::contract::windows::forecast::{Member, ParsedForecast, RawPeriod, field};
-use crate::contract::windows::time::{TimeStyle, parse_iso};
+use crate::contract::windows::time::{TimeStyle, parse_iso_zoned};
 use crate::numerics::params::InvalidInput;
 
 const HEADER: [&str; 4] = ["time", "height_m", "speed_m_s", "gust_m_s"];
@@ -64,8 +64,15 @@ pub fn parse(text: &str) -> Result<ParsedForecast, InvalidInput> {
                 ),
             ));
         }
-        let t = match parse_iso(f[0]) {
-            Some(t) => t,
+        let t = match parse_iso_zoned(f[0]) {
+            Some((t, zone)) => {
+                // Times written with an offset are written back with the
+                // first row's (ends and windows alike).
+                if let (Some(o), true) = (zone, rows.is_empty()) {
+                    style = TimeStyle::IsoOffset(o);
+                }
+                t
+            }
             None => match f[0].parse::<f64>() {
                 Ok(t) if t.is_finite() => {
                     style = TimeStyle::Unix;

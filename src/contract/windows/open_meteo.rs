@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use serde_json::Value;
 
 use crate::contract::windows::forecast::{Member, ParsedForecast, RawPeriod, field};
-use crate::contract::windows::time::{TimeStyle, parse_iso};
+use crate::contract::windows::time::{TimeStyle, parse_iso_zoned};
 use crate::numerics::forecast::units::SpeedUnit;
 use crate::numerics::params::InvalidInput;
 
@@ -118,12 +118,18 @@ pub fn parse(data: &Value) -> Result<ParsedForecast, InvalidInput> {
     for (i, t) in times.iter().enumerate() {
         let f = || field(&format!(".hourly.time[{i}]"));
         let v = match t {
-            Value::String(s) => parse_iso(s).ok_or_else(|| {
-                InvalidInput::new(
-                    f(),
-                    format!("`{s}` is not an ISO 8601 date-time (2026-12-03T14:00)"),
-                )
-            })?,
+            Value::String(s) => {
+                let (t, zone) = parse_iso_zoned(s).ok_or_else(|| {
+                    InvalidInput::new(
+                        f(),
+                        format!("`{s}` is not an ISO 8601 date-time (2026-12-03T14:00)"),
+                    )
+                })?;
+                if let (Some(o), 0) = (zone, i) {
+                    style = TimeStyle::IsoOffset(o);
+                }
+                t
+            }
             Value::Number(n) => {
                 style = TimeStyle::Unix;
                 n.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {

@@ -48,6 +48,12 @@ fn num(s: &str, lo: i64, hi: i64) -> Option<i64> {
 /// An ISO 8601 date-time as seconds since 1970-01-01T00:00 (in its own
 /// offset when it gives one; local times are taken as they read).
 pub fn parse_iso(s: &str) -> Option<f64> {
+    parse_iso_zoned(s).map(|(t, _)| t)
+}
+
+/// [`parse_iso`] and the offset the text gives (s east of UTC: `Z` is
+/// `Some(0)`, a local time without one `None`).
+pub fn parse_iso_zoned(s: &str) -> Option<(f64, Option<i64>)> {
     let s = s.trim();
     let (date, time) = s.split_once('T')?;
     let mut d = date.split('-');
@@ -59,14 +65,17 @@ pub fn parse_iso(s: &str) -> Option<f64> {
     }
     // Offset: `Z`, `+hh:mm`, `-hh:mm`.
     let (clock, offset_s) = if let Some(c) = time.strip_suffix('Z') {
-        (c, 0)
+        (c, Some(0))
     } else if let Some(i) = time.rfind(['+', '-']) {
         let (c, o) = time.split_at(i);
         let sign = if o.starts_with('-') { -1 } else { 1 };
         let (oh, om) = o[1..].split_once(':').unwrap_or((&o[1..], "00"));
-        (c, sign * (num(oh, 0, 23)? * 3600 + num(om, 0, 59)? * 60))
+        (
+            c,
+            Some(sign * (num(oh, 0, 23)? * 3600 + num(om, 0, 59)? * 60)),
+        )
     } else {
-        (time, 0)
+        (time, None)
     };
     let mut c = clock.split(':');
     let h = num(c.next()?, 0, 23)?;
@@ -78,7 +87,8 @@ pub fn parse_iso(s: &str) -> Option<f64> {
     if c.next().is_some() {
         return None;
     }
-    Some((days_from_civil(y, m, day) * 86_400 + h * 3600 + mi * 60 + sec - offset_s) as f64)
+    let t = days_from_civil(y, m, day) * 86_400 + h * 3600 + mi * 60 + sec - offset_s.unwrap_or(0);
+    Some((t as f64, offset_s))
 }
 
 /// Seconds since 1970-01-01 as `YYYY-MM-DDTHH:MM` (seconds shown when not zero).
@@ -99,6 +109,9 @@ pub fn format_iso(t_s: f64) -> String {
 pub enum TimeStyle {
     /// ISO 8601 local or UTC (`YYYY-MM-DDTHH:MM`).
     Iso,
+    /// ISO 8601 with the offset the forecast wrote (s east of UTC):
+    /// `YYYY-MM-DDTHH:MMZ` or `YYYY-MM-DDTHH:MM+hh:mm`.
+    IsoOffset(i64),
     /// Unix seconds, written as ISO 8601 UTC with `Z`.
     Unix,
     /// Aviation day-hour-minute `DDHHMMZ`; `month_days` the length assumed
@@ -110,6 +123,17 @@ impl TimeStyle {
     pub fn format(self, t_s: f64) -> String {
         match self {
             Self::Iso => format_iso(t_s),
+            Self::IsoOffset(0) => format!("{}Z", format_iso(t_s)),
+            Self::IsoOffset(o) => {
+                let a = o.unsigned_abs();
+                format!(
+                    "{}{}{:02}:{:02}",
+                    format_iso(t_s + o as f64),
+                    if o < 0 { '-' } else { '+' },
+                    a / 3600,
+                    (a % 3600) / 60
+                )
+            }
             Self::Unix => format!("{}Z", format_iso(t_s)),
             Self::Aviation { month_days } => {
                 let t = t_s.round() as i64;
@@ -145,6 +169,29 @@ mod tests {
         assert_eq!(
             TimeStyle::Aviation { month_days: 31 }.format((32 * 86_400 + 6 * 3600) as f64),
             "010600Z"
+        );
+    }
+
+    #[test]
+    fn zoned_times_are_written_back_in_their_offset() {
+        for text in [
+            "2026-12-03T15:00+01:00",
+            "2026-12-03T09:30-04:30",
+            "2026-12-03T14:00Z",
+        ] {
+            let (t, zone) = parse_iso_zoned(text).unwrap();
+            assert_eq!(t, 1_796_306_400.0, "{text}");
+            let style = TimeStyle::IsoOffset(zone.unwrap());
+            assert_eq!(style.format(t), text);
+        }
+        // an hour later, in the same offset (a period's end)
+        assert_eq!(
+            TimeStyle::IsoOffset(3600).format(1_796_306_400.0 + 3600.0),
+            "2026-12-03T16:00+01:00"
+        );
+        assert_eq!(
+            parse_iso_zoned("2026-12-03T14:00"),
+            Some((1_796_306_400.0, None))
         );
     }
 }
