@@ -81,12 +81,35 @@ import S from "./shared/index.js";
   document.addEventListener("tetherplan:units", () => last && draw(last));
 
   let last = null;
+  // An answer that failed leaves no earlier day on show: the timeline of
+  // another forecast (or other inputs) must not pass for this one's.
+  function clearDay() {
+    last = null;
+    for (const id of ["windows-timeline", "windows-summary", "windows-list"]) $(id).hidden = true;
+    $("windows-timeline").innerHTML = "";
+    $("windows-bands").innerHTML = "";
+  }
+
+  // A number typed in a panel field, or an error naming the request field.
+  function fieldNumber(id, field, unit, errors, { blank = null, min = 0 } = {}) {
+    const raw = $(id).value.trim();
+    if (!raw) return blank;
+    const v = Number(raw);
+    if (!Number.isFinite(v) || v < min) {
+      errors.push({ field, message: `“${raw}” is not a number ≥ ${min} (${unit})` });
+      return null;
+    }
+    return v;
+  }
+
   async function run() {
     const err = $("windows-error");
     err.hidden = true;
     const text = $("windows-data").value;
     if (!text.trim()) return;
     const errors = [];
+    const hoursAloft = fieldNumber("windows-operation", "operation_s", "hours aloft", errors, { blank: 0 });
+    const limit = fieldNumber("windows-limit", "haul_down.max_operating_wind_m_s", "m/s", errors);
     const sys = S.readSystem(errors, CARD);
     const format = detect(text);
     let data = text;
@@ -95,6 +118,8 @@ import S from "./shared/index.js";
     }
     const target = S.readNumber([document.getElementById("plan-form")], "target_elevation_m", errors);
     if (errors.length) {
+      clearDay();
+      section.dataset.state = "error";
       err.textContent = errors.map((e) => `${e.field}: ${e.message}`).join("; ");
       err.hidden = false;
       return;
@@ -105,11 +130,10 @@ import S from "./shared/index.js";
       required_safety_factor_nondim: sys.required_safety_factor_nondim,
       wind: { air_density_kg_m3: sys.wind.air_density_kg_m3 },
       target_elevation_m: target,
-      operation_s: 3600 * Number($("windows-operation").value || 0),
+      operation_s: 3600 * hoursAloft,
       forecast: { format, data },
     };
-    const limit = Number($("windows-limit").value);
-    if ($("windows-limit").value.trim() && Number.isFinite(limit)) body.haul_down = { max_operating_wind_m_s: limit };
+    if (limit != null) body.haul_down = { max_operating_wind_m_s: limit };
     $("windows-button").disabled = true;
     section.dataset.state = "pending";
     let res = await S.api("POST", "api/v1/windows", body);
@@ -121,8 +145,11 @@ import S from "./shared/index.js";
     }
     $("windows-button").disabled = false;
     if (!res.ok) {
+      clearDay();
       section.dataset.state = "error";
-      err.textContent = res.body?.error ? `${res.body.error.field}: ${res.body.error.message}` : `error ${res.status}`;
+      const e = res.body?.error;
+      // The server's message may already begin with its field.
+      err.textContent = e ? (e.message.startsWith(`${e.field}: `) ? e.message : `${e.field}: ${e.message}`) : `error ${res.status}`;
       err.hidden = false;
       return;
     }

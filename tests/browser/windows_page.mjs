@@ -14,7 +14,8 @@
 // ensemble (the file as control and three members, one stormy), each hour
 // shows its share of members that go: windows_page_ensemble.png. A TAF
 // pasted: one cell per change group, each window under the groups it
-// overlaps: windows_page_taf.png.
+// overlaps: windows_page_taf.png. A limit typed as "12 kn" and a TAF the
+// server refuses are each named, and the day shown before is cleared.
 
 import { readFileSync } from "node:fs";
 import path from "node:path";
@@ -154,12 +155,40 @@ try {
   check(b1 && b2 && (b1.bottom <= b2.top || b2.bottom <= b1.top), `two windows under the same groups take rows of their own (${b1?.top}–${b1?.bottom}, ${b2?.top}–${b2?.bottom})`);
   check(/^Launch windows: 051200Z–052000Z, launch by \d{6}Z; 060200Z–061800Z, launch by \d{6}Z\.$/.test(taf.list), `the windows listed in words (“${taf.list}”)`);
   await page.locator("#windows").screenshot({ path: path.join(artifacts, "windows_page_taf.png") });
+
+  // Break one input, then the forecast: each time the panel names the
+  // field and the day shown before is gone (not passed off as this one's).
+  phase = "break";
+  const dayShown = () => page.evaluate(() => ({
+    cells: document.querySelectorAll("#windows-timeline button").length,
+    timeline: !document.querySelector("#windows-timeline").hidden,
+    list: !document.querySelector("#windows-list").hidden,
+    error: document.querySelector("#windows-error").hidden ? null : document.querySelector("#windows-error").textContent,
+    state: document.querySelector("#windows").dataset.state,
+  }));
+  await page.fill("#windows-limit", "12 kn");
+  await page.click("#windows-button");
+  let shown = await dayShown();
+  check(shown.state === "error" && /^haul_down\.max_operating_wind_m_s: “12 kn” is not a number/.test(shown.error ?? "") && shown.cells === 0 && !shown.timeline && !shown.list,
+    `a limit that is not a number is named, and the day before is gone (${JSON.stringify(shown)})`);
+  await page.fill("#windows-limit", "");
+  await page.fill("#windows-data", "TAF EGLL 051100Z 0512/0618 24010KT FM051500 99999KT");
+  await page.click("#windows-button");
+  await page.waitForFunction(() => document.querySelector("#windows").dataset.state === "error", null, { timeout: 60_000 });
+  shown = await dayShown();
+  check(/^forecast\.data: TAF group 2 \(fm, from 051500Z\)/.test(shown.error ?? "") && shown.cells === 0,
+    `a TAF the server refuses: its reason shown, no day (${JSON.stringify(shown)})`);
+  await page.fill("#windows-data", "TAF EGLL 051100Z 0512/0618 05005KT 9999 SCT030");
+  await page.click("#windows-button");
+  await page.waitForFunction(() => document.querySelector("#windows").dataset.state === "done", null, { timeout: 120_000 });
+  shown = await dayShown();
+  check(shown.cells === 1 && shown.error === null && shown.timeline, `mended, the day is back (${JSON.stringify(shown)})`);
   await context.close();
 
   // A day of distinct winds costs more than a direct answer may (a plan
   // each, priced by the server): its 422 too_large sends the panel to a
   // job, the one 4xx expected.
-  const unexpected = consoleErrors.filter((e) => !(["drop", "ensemble", "taf"].includes(e.phase) && /status of 422/.test(e.text)));
+  const unexpected = consoleErrors.filter((e) => !(["drop", "ensemble", "taf", "break"].includes(e.phase) && /status of 422/.test(e.text)));
   for (const e of unexpected) console.log(`  console error (${e.phase}): ${e.text}`);
   check(unexpected.length === 0, `no console errors (${unexpected.length})`);
 } catch (e) {
