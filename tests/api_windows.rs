@@ -232,6 +232,36 @@ async fn csv_times_with_an_offset_are_answered_in_that_offset() {
     );
 }
 
+/// What the fit changes is said: a gust below the mean (taken as the
+/// mean) and a profile whose fitted exponent leaves [0, 2] (speeds falling
+/// with height: the exponent brought to 0).
+#[tokio::test]
+async fn a_low_gust_and_a_clamped_exponent_are_noted() {
+    let csv = "time,height_m,speed_m_s,gust_m_s\n\
+               2026-12-03T00:00,10,6,3\n\
+               2026-12-03T01:00,10,6,\n\
+               2026-12-03T01:00,80,3,\n";
+    let (s, r) = post("/api/v1/windows", &windows_request("csv", json!(csv))).await;
+    assert_eq!(s, StatusCode::OK, "{r}");
+    let h = &r["hours"][0];
+    // the gust taken as the mean: its speed at the reference height is the mean's
+    let (g, u) = (
+        h["wind"]["gust"]["gust_m_s"].as_f64().unwrap(),
+        h["wind"]["flow"]["speed_m_s"].as_f64().unwrap(),
+    );
+    assert!((g - u).abs() <= 1e-12 * u, "{h}");
+    assert_eq!(r["hours"][1]["wind"]["flow"]["exponent_nondim"], 0.0);
+    let notes = r["notes"].to_string();
+    assert!(
+        notes.contains("a gust below the mean wind at its height is taken as the mean (gust ratio 1): control 2026-12-03T00:00"),
+        "{notes}"
+    );
+    assert!(
+        notes.contains("exponent outside [0, 2], brought to its nearer end (the speeds refitted): control 2026-12-03T01:00"),
+        "{notes}"
+    );
+}
+
 #[tokio::test]
 async fn a_uniform_hour_in_knots_is_the_plan_for_that_speed() {
     // 15 kn at 10 and 80 m: a uniform flow of exactly 15 × 1852/3600 m/s.

@@ -232,12 +232,20 @@ pub fn prepare(req: &WindowsRequest) -> Result<Prepared, RequestError> {
     let mut plan_times = Vec::new();
     let mut cases = Vec::with_capacity(forecast.members.len());
     let mut calm_gusts: Vec<String> = Vec::new();
+    let mut low_gusts: Vec<String> = Vec::new();
+    let mut clamped: Vec<String> = Vec::new();
     for member in &forecast.members {
         let mut mc = Vec::with_capacity(member.periods.len());
         for p in &member.periods {
             let fitted = fit_hour(&p.winds, p.gust, z0).map_err(|e| fit_error(p, e))?;
             if p.gust.is_some_and(|g| g.1 > 0.0) && fitted.gust_at_reference_m_s.is_none() {
                 calm_gusts.push(format!("{} {}", member.name, p.time));
+            }
+            if fitted.gust_below_mean {
+                low_gusts.push(format!("{} {}", member.name, p.time));
+            }
+            if fitted.exponent_clamped {
+                clamped.push(format!("{} {}", member.name, p.time));
             }
             let wind = wind_input(&fitted, rho);
             let u_t = fitted.flow.speed_m_s(target);
@@ -291,6 +299,18 @@ pub fn prepare(req: &WindowsRequest) -> Result<Prepared, RequestError> {
         forecast.notes.push(format!(
             "a gust over a calm period is left out (the §9 gust scales the mean flow, which is zero): {}",
             calm_gusts.join(", ")
+        ));
+    }
+    if !low_gusts.is_empty() {
+        forecast.notes.push(format!(
+            "a gust below the mean wind at its height is taken as the mean (gust ratio 1): {}",
+            low_gusts.join(", ")
+        ));
+    }
+    if !clamped.is_empty() {
+        forecast.notes.push(format!(
+            "the power law fitted through the heights had an exponent outside [0, 2], brought to its nearer end (the speeds refitted): {}",
+            clamped.join(", ")
         ));
     }
     Ok(Prepared {

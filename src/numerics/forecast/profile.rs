@@ -88,6 +88,9 @@ pub struct FittedHour {
     pub gust_at_reference_m_s: Option<f64>,
     /// Whether the fitted exponent was brought into `[0, 2]`.
     pub exponent_clamped: bool,
+    /// Whether the gust was below the mean at its height (taken as the
+    /// mean: ratio 1).
+    pub gust_below_mean: bool,
 }
 
 /// Why an hour has no flow.
@@ -166,6 +169,7 @@ pub fn fit_hour(
             }
         }
     };
+    let mut gust_below_mean = false;
     let (ratio, at_ref) = match gust {
         None => (None, None),
         Some((zg, g)) => {
@@ -178,6 +182,7 @@ pub fn fit_hour(
             let measured = winds.iter().find(|w| w.0 == zg && w.1 > 0.0).map(|w| w.1);
             let mean = measured.unwrap_or_else(|| flow.speed_m_s(zg));
             if mean > 0.0 {
+                gust_below_mean = g < mean;
                 let r = (g / mean).max(1.0);
                 (Some(r), Some(r * flow.speed_m_s(flow.reference_height_m())))
             } else {
@@ -191,6 +196,7 @@ pub fn fit_hour(
         gust_ratio_nondim: ratio,
         gust_at_reference_m_s: at_ref,
         exponent_clamped: clamped,
+        gust_below_mean,
     })
 }
 
