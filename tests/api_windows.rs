@@ -262,6 +262,64 @@ async fn a_low_gust_and_a_clamped_exponent_are_noted() {
     );
 }
 
+/// The plan's `haul_down.source` takes the windows' formats: a TAF read at
+/// the target altitude is the `haul_down.forecast` of its groups' winds by
+/// the log law of 0.03 m (computed here), a group without `G` having the
+/// mean as its gust. A source without any gust cannot serve a gust limit,
+/// and one with gusts needs it: both refused, naming the field.
+#[tokio::test]
+async fn the_plans_haul_down_source_is_its_forecast_read_at_the_target() {
+    let taf = "TAF EGLL 051100Z 0512/0618 24010KT 9999 BECMG 0515/0517 27020G32KT \
+               TEMPO 0520/0602 30030G45KT";
+    let kn = 1852.0 / 3600.0;
+    let at_300 = |u10_kn: f64| u10_kn * kn * (300.0f64 / 0.03).ln() / (10.0f64 / 0.03).ln();
+    let limits = json!({"max_operating_wind_m_s": 14.0, "max_gust_m_s": 24.0});
+    let mut by_source = system();
+    by_source["haul_down"] = limits.clone();
+    by_source["haul_down"]["source"] = json!({"format": "taf", "data": taf});
+    let mut by_points = system();
+    by_points["haul_down"] = limits.clone();
+    by_points["haul_down"]["forecast"] = json!([
+        {"time_s": 0.0, "wind_speed_m_s": at_300(10.0), "gust_m_s": at_300(10.0)},
+        {"time_s": 10800.0, "wind_speed_m_s": at_300(20.0), "gust_m_s": at_300(32.0)},
+        {"time_s": 28800.0, "wind_speed_m_s": at_300(30.0), "gust_m_s": at_300(45.0)},
+    ]);
+    let (s, a) = post("/api/v1/plan", &by_source).await;
+    assert_eq!(s, StatusCode::OK, "{a}");
+    let (s, b) = post("/api/v1/plan", &by_points).await;
+    assert_eq!(s, StatusCode::OK, "{b}");
+    let (ha, hb) = (&a["haul_down"], &b["haul_down"]);
+    for k in [
+        "wind_exceeds_limit_at_s",
+        "gust_exceeds_limit_at_s",
+        "latest_start_s",
+        "retrieval_duration_s",
+    ] {
+        let (x, y) = (ha[k].as_f64().unwrap(), hb[k].as_f64().unwrap());
+        assert!((x - y).abs() <= 1e-9 * y.abs().max(1.0), "{k}: {x} vs {y}");
+    }
+    assert_eq!(ha["exceeded_by"], hb["exceeded_by"]);
+    assert_eq!(a["go"], b["go"]);
+    // the mean passes 14 m/s on the way to the BECMG's 20 kt (18 m/s aloft)
+    let t = ha["wind_exceeds_limit_at_s"].as_f64().unwrap();
+    assert!(t > 0.0 && t < 10800.0, "{t}");
+
+    let mut no_gusts = system();
+    no_gusts["haul_down"] = limits.clone();
+    no_gusts["haul_down"]["source"] = json!({"format": "csv",
+        "data": "time,height_m,speed_m_s\n2026-12-03T00:00,10,3\n2026-12-03T01:00,10,8\n"});
+    let (f, m) = refused_by("/api/v1/plan", &no_gusts).await;
+    assert_eq!(f, "haul_down.source.data", "{m}");
+    assert!(m.contains("gives no gust"), "{m}");
+    let mut no_limit = system();
+    no_limit["haul_down"] = json!({"max_operating_wind_m_s": 14.0,
+        "source": {"format": "taf", "data": taf}});
+    assert_eq!(
+        refused_by("/api/v1/plan", &no_limit).await.0,
+        "haul_down.max_gust_m_s"
+    );
+}
+
 #[tokio::test]
 async fn a_uniform_hour_in_knots_is_the_plan_for_that_speed() {
     // 15 kn at 10 and 80 m: a uniform flow of exactly 15 × 1852/3600 m/s.
@@ -508,7 +566,12 @@ async fn haul_down_limits_make_windy_hours_no_go_and_say_so() {
 }
 
 async fn refused(body: &Value) -> (String, String) {
-    let (s, r) = post("/api/v1/windows", body).await;
+    refused_by("/api/v1/windows", body).await
+}
+
+/// `uri`'s 422 for `body`: its field and message.
+async fn refused_by(uri: &str, body: &Value) -> (String, String) {
+    let (s, r) = post(uri, body).await;
     assert_eq!(s, StatusCode::UNPROCESSABLE_ENTITY, "{r}");
     (
         r["error"]["field"].as_str().unwrap_or_default().to_string(),

@@ -335,6 +335,13 @@ fn haul_down_forecast(
                 let u = match (p.gust_m_s, gust) {
                     (Some(u), _) => u,
                     (None, Some(gw)) => p.wind_speed_m_s * gw.factor,
+                    (None, None) if h.source.is_some() => {
+                        return Err(InvalidInput::new(
+                            "haul_down.source.data",
+                            "gives no gust, which haul_down.max_gust_m_s needs: leave the gust limit \
+                             out, or give wind.gust (its gust factor then scales the forecast wind)",
+                        ));
+                    }
                     (None, None) => {
                         return Err(InvalidInput::new(
                             at(i, "gust_m_s"),

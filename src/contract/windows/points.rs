@@ -1,7 +1,8 @@
 //! The plan's haul-down forecast from a forecast source (issue 32): the
 //! first member's periods, each fitted as the windows request fits it, read
 //! at the aerostat's altitude — `(time from the first period, wind, gust)`,
-//! the points of `haul_down.forecast`.
+//! the points of `haul_down.forecast`. In a forecast that gives gusts, a
+//! period without one (a report group without `G`) has the mean as its gust.
 
 use crate::contract::plan::dto::WindForecastPointInput;
 use crate::contract::windows::dto::{DEFAULT_ROUGHNESS_LENGTH_M, ForecastInput};
@@ -30,6 +31,10 @@ pub fn haul_down_points(
     let f = parse_forecast(source).map_err(renamed)?;
     let periods = &f.members[0].periods;
     let t0 = periods.first().map_or(0.0, |p| p.start_s);
+    // A forecast that gives gusts, but not in every period, reports none
+    // where they are not significant (a METAR or TAF group without `G`):
+    // there the gust is the mean, as the windows judge such an hour.
+    let reports_gusts = periods.iter().any(|p| p.gust.is_some());
     let mut out: Vec<WindForecastPointInput> = Vec::with_capacity(periods.len());
     for p in periods {
         let h = fit_hour(&p.winds, p.gust, z0).map_err(|_| {
@@ -42,7 +47,8 @@ pub fn haul_down_points(
         let g = match (h.gust_ratio_nondim, h.gust_at_reference_m_s) {
             (Some(r), _) => Some(r * u),
             (None, g) => g,
-        };
+        }
+        .or(reports_gusts.then_some(u));
         // Overlapping periods (a TAF's TEMPO) are read in start order; a
         // period starting with the one before keeps the stronger wind.
         let t = p.start_s - t0;
