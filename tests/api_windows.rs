@@ -320,6 +320,44 @@ async fn the_plans_haul_down_source_is_its_forecast_read_at_the_target() {
     );
 }
 
+/// A text with several reports (a METAR history, a TAF and its
+/// amendment) is judged by its latest report alone, and says so: read as
+/// one, the later groups overwrote the earlier ones (the first TAF's
+/// validity with the amendment's wind).
+#[tokio::test]
+async fn of_several_reports_the_latest_is_judged() {
+    let older = "METAR EDDB 031150Z 27025KT 9999 FEW030 08/02 Q1012";
+    let newer = "METAR EDDB 031220Z 27005KT 9999 FEW030 08/02 Q1012";
+    let taf = "TAF EDDB 031100Z 0312/0412 24010KT 9999 SCT030";
+    let amd = "TAF AMD EDDB 031300Z 0313/0412 30025KT 9999 SCT030";
+    for (format, text, alone, at) in [
+        ("metar", format!("{newer}\n{older}"), newer, "031220Z"),
+        ("metar", format!("{older} {newer}"), newer, "031220Z"),
+        ("taf", format!("{taf}\n{amd}"), amd, "031300Z"),
+    ] {
+        let (s, both) = post("/api/v1/windows", &windows_request(format, json!(text))).await;
+        assert_eq!(s, StatusCode::OK, "{both}");
+        let (s, one) = post("/api/v1/windows", &windows_request(format, json!(alone))).await;
+        assert_eq!(s, StatusCode::OK, "{one}");
+        assert_eq!(both["hours"], one["hours"], "{text}");
+        assert_eq!(both["windows"], one["windows"], "{text}");
+        let note = both["notes"][0].as_str().unwrap();
+        let what = format.to_uppercase();
+        assert_eq!(
+            note,
+            format!("2 {what} reports given: the latest, of {at}, is judged, the others left out")
+        );
+    }
+    // A report among them that cannot be read is named by its place.
+    let (f, m) = refused(&windows_request(
+        "metar",
+        json!(format!("{older}\nMETAR EDDB 031220Z /////KT 9999")),
+    ))
+    .await;
+    assert_eq!(f, "forecast.data");
+    assert!(m.contains("METAR 2 of 2"), "{m}");
+}
+
 #[tokio::test]
 async fn a_uniform_hour_in_knots_is_the_plan_for_that_speed() {
     // 15 kn at 10 and 80 m: a uniform flow of exactly 15 × 1852/3600 m/s.

@@ -9,7 +9,10 @@
 //! overlap the others: a time is judged by every group covering it). An
 //! `FM` group without a wind is refused (it replaces the whole forecast);
 //! a `BECMG`, `TEMPO` or `PROB` group without one leaves the wind as it
-//! was. Times
+//! was. A text holding several reports (a history, or a TAF and its
+//! amendment) is split at each `METAR`, `SPECI` or `TAF` (or each line
+//! opening with a station and a time) and the latest is judged, with a
+//! note; read together, later groups would overwrite earlier ones. Times
 //! are day-of-month, hour, minute (`DDHHMMZ`); a report crossing the end of
 //! a month is taken to cross it after its issue day. Lead times count from
 //! the issue time.
@@ -61,6 +64,94 @@ fn axis(day0: u8, (d, h, m): (u8, u8, u8)) -> f64 {
 
 fn text(style: TimeStyle, t: f64) -> String {
     style.format(t)
+}
+
+/// The reports of a text that may hold several (a history pasted from a
+/// weather service, an amended TAF after the first): split before each
+/// word in `keywords` (`METAR`, `SPECI`, `TAF`) or, without one, before
+/// each line that opens with a station and a time (`EGLL 051150Z`).
+fn split_reports<'a>(s: &'a str, keywords: &[&str]) -> Vec<&'a str> {
+    let s = s.trim();
+    let word_at = |i: usize| {
+        let before_ok = i == 0 || s[..i].ends_with(char::is_whitespace);
+        before_ok
+            && keywords
+                .iter()
+                .any(|k| s[i..].starts_with(k) && s[i + k.len()..].starts_with(char::is_whitespace))
+    };
+    let mut starts: Vec<usize> = s
+        .char_indices()
+        .map(|(i, _)| i)
+        .filter(|&i| word_at(i))
+        .collect();
+    if starts.is_empty() {
+        let mut at = 0;
+        for line in s.split_inclusive('\n') {
+            let b = line.trim_start().as_bytes();
+            let opens = b.len() >= 12
+                && b[..4].iter().all(u8::is_ascii_uppercase)
+                && b[4] == b' '
+                && b[5..11].iter().all(u8::is_ascii_digit)
+                && b[11] == b'Z';
+            if opens {
+                starts.push(at);
+            }
+            at += line.len();
+        }
+    }
+    // Text before the first report (a date line) stays with it.
+    match starts.first_mut() {
+        Some(first) => *first = 0,
+        None => starts.push(0),
+    }
+    starts.push(s.len());
+    starts
+        .windows(2)
+        .map(|w| s[w[0]..w[1]].trim())
+        .filter(|r| !r.is_empty())
+        .collect()
+}
+
+/// Of several reports, the latest (by its time on its own axis), with a
+/// note naming it; one report as it is.
+fn latest_of(
+    text: &str,
+    keywords: &[&str],
+    what: &str,
+    parse: fn(&str) -> Result<ParsedForecast, InvalidInput>,
+) -> Result<ParsedForecast, InvalidInput> {
+    let reports = split_reports(text, keywords);
+    if reports.len() <= 1 {
+        return parse(text);
+    }
+    let mut parsed = Vec::with_capacity(reports.len());
+    for (i, r) in reports.iter().enumerate() {
+        parsed.push(parse(r).map_err(|e| InvalidInput {
+            field: e.field,
+            reason: format!("{what} {} of {}: {}", i + 1, reports.len(), e.reason),
+        })?);
+    }
+    let n = parsed.len();
+    let mut latest = parsed
+        .into_iter()
+        .max_by(|a, b| a.origin_s.total_cmp(&b.origin_s))
+        .expect("two or more reports");
+    let at = latest.style.format(latest.origin_s);
+    latest.notes.insert(
+        0,
+        format!("{n} {what} reports given: the latest, of {at}, is judged, the others left out"),
+    );
+    Ok(latest)
+}
+
+/// A METAR, or the latest of several.
+pub fn parse_metars(s: &str) -> Result<ParsedForecast, InvalidInput> {
+    latest_of(s, &["METAR", "SPECI"], "METAR", parse_metar)
+}
+
+/// A TAF, or the latest of several (an amendment after the first).
+pub fn parse_tafs(s: &str) -> Result<ParsedForecast, InvalidInput> {
+    latest_of(s, &["TAF"], "TAF", parse_taf)
 }
 
 pub fn parse_metar(s: &str) -> Result<ParsedForecast, InvalidInput> {

@@ -23,8 +23,8 @@ pub fn parse_forecast(f: &ForecastInput) -> Result<ParsedForecast, InvalidInput>
     let parsed = match f.format {
         ForecastFormat::OpenMeteo => open_meteo::parse(&f.data)?,
         ForecastFormat::Csv => csv::parse(text()?)?,
-        ForecastFormat::Metar => aviation::parse_metar(text()?)?,
-        ForecastFormat::Taf => aviation::parse_taf(text()?)?,
+        ForecastFormat::Metar => aviation::parse_metars(text()?)?,
+        ForecastFormat::Taf => aviation::parse_tafs(text()?)?,
     };
     if parsed.members.iter().all(|m| m.periods.is_empty()) {
         return Err(InvalidInput::new(
