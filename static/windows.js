@@ -158,6 +158,15 @@ import S from "./shared/index.js";
     section.dataset.state = "done";
   }
 
+  // The day a period starts: the date of an ISO time, the DD of an
+  // aviation time or TAF group; null otherwise.
+  function dayOf(time) {
+    const iso = time.match(/^(\d{4}-\d\d-\d\d)T/);
+    if (iso) return iso[1];
+    const av = time.match(/^(\d\d)\d\d(?:\d\dZ$|\/)/);
+    return av ? av[1] : null;
+  }
+
   // The hour a period starts, as its cell's label: "HH" of an ISO time
   // (YYYY-MM-DDTHH:MM, with "HH:MM" off the hour), of an aviation time
   // (DDHHMMZ) or of a TAF group (DDHH/DDHH); else the period's index.
@@ -217,6 +226,12 @@ import S from "./shared/index.js";
       const lab = document.createElement("span");
       lab.className = "hour";
       lab.textContent = hourLabel(h.time, i);
+      // A new day (after the first cell) is marked, its day before its hour.
+      const day = dayOf(h.time);
+      if (i > 0 && day != null && day !== dayOf(r.hours[i - 1].time)) {
+        b.classList.add("new-day");
+        lab.textContent = `${day.slice(-2)}/${lab.textContent}`;
+      }
       b.append(bar, lab);
       if (ens) {
         // The share of the ensemble's members that go, under the hour.

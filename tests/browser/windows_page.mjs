@@ -183,12 +183,20 @@ try {
   await page.waitForFunction(() => document.querySelector("#windows").dataset.state === "done", null, { timeout: 120_000 });
   shown = await dayShown();
   check(shown.cells === 1 && shown.error === null && shown.timeline, `mended, the day is back (${JSON.stringify(shown)})`);
+
+  // Across midnight the new day is marked: its first hour labelled with its day.
+  phase = "midnight";
+  await page.fill("#windows-data", "time,height_m,speed_m_s,gust_m_s\n2026-12-03T23:00,10,3,\n2026-12-04T00:00,10,3,\n2026-12-04T01:00,10,3,\n");
+  await page.click("#windows-button");
+  await page.waitForFunction(() => document.querySelectorAll("#windows-timeline button").length === 3 && document.querySelector("#windows").dataset.state === "done", null, { timeout: 120_000 });
+  const days = await page.$$eval("#windows-timeline button", (bs) => bs.map((b) => `${b.classList.contains("new-day") ? "|" : ""}${b.querySelector(".hour").textContent}`));
+  check(days.join(" ") === "23 |04/00 01", `a new day marked and labelled (${days.join(" ")})`);
   await context.close();
 
   // A day of distinct winds costs more than a direct answer may (a plan
   // each, priced by the server): its 422 too_large sends the panel to a
   // job, the one 4xx expected.
-  const unexpected = consoleErrors.filter((e) => !(["drop", "ensemble", "taf", "break"].includes(e.phase) && /status of 422/.test(e.text)));
+  const unexpected = consoleErrors.filter((e) => !(["drop", "ensemble", "taf", "break", "midnight"].includes(e.phase) && /status of 422/.test(e.text)));
   for (const e of unexpected) console.log(`  console error (${e.phase}): ${e.text}`);
   check(unexpected.length === 0, `no console errors (${unexpected.length})`);
 } catch (e) {
